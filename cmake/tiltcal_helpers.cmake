@@ -1,0 +1,53 @@
+# Helpers that give every target of the project the same warnings, sanitizers
+# and output directories. Sources are always listed explicitly.
+
+function(tiltcal_set_target_options target)
+  target_compile_options(${target} PRIVATE -Wall -Wextra -Wno-unused-parameter)
+  if(TILTCAL_WERROR)
+    target_compile_options(${target} PRIVATE -Werror)
+  endif()
+  if(TILTCAL_SANITIZE)
+    target_compile_options(${target} PRIVATE -fsanitize=${TILTCAL_SANITIZE} -fno-omit-frame-pointer)
+    target_link_options(${target} PRIVATE -fsanitize=${TILTCAL_SANITIZE})
+  endif()
+  if(CMAKE_BUILD_TYPE STREQUAL "Debug")
+    target_compile_definitions(${target} PRIVATE EIGEN_INITIALIZE_MATRICES_BY_NAN)
+  endif()
+endfunction()
+
+# tiltcal_add_library(NAME SRCS ... DEPS ...)
+function(tiltcal_add_library)
+  cmake_parse_arguments(ARG "" "NAME" "SRCS;DEPS" ${ARGN})
+  add_library(${ARG_NAME} STATIC ${ARG_SRCS})
+  target_include_directories(${ARG_NAME} PUBLIC ${PROJECT_SOURCE_DIR} ${PROJECT_BINARY_DIR}/generated)
+  target_link_libraries(${ARG_NAME} PUBLIC ${ARG_DEPS})
+  tiltcal_set_target_options(${ARG_NAME})
+endfunction()
+
+# tiltcal_add_stage(NAME decode SRCS lib sources... DEPS ...)
+# Builds tiltcal_<NAME>_lib from SRCS and the executable tiltcal_<NAME> from
+# main.cc of the current directory, landing in build/bin/.
+function(tiltcal_add_stage)
+  cmake_parse_arguments(ARG "" "NAME" "SRCS;DEPS" ${ARGN})
+  tiltcal_add_library(NAME tiltcal_${ARG_NAME}_lib SRCS ${ARG_SRCS} DEPS ${ARG_DEPS})
+  add_executable(tiltcal_${ARG_NAME} main.cc)
+  target_link_libraries(tiltcal_${ARG_NAME} PRIVATE tiltcal_${ARG_NAME}_lib gflags)
+  tiltcal_set_target_options(tiltcal_${ARG_NAME})
+endfunction()
+
+# tiltcal_add_test(NAME SRCS ... DEPS ... [LABELS ...])
+# One GoogleTest executable; every test case is registered with CTest. Tests
+# find the shared fixtures and the project tree through compile definitions.
+function(tiltcal_add_test)
+  cmake_parse_arguments(ARG "" "NAME" "SRCS;DEPS;LABELS" ${ARGN})
+  add_executable(${ARG_NAME} ${ARG_SRCS})
+  target_link_libraries(${ARG_NAME} PRIVATE ${ARG_DEPS} tiltcal_testing GTest::gtest GTest::gtest_main)
+  tiltcal_set_target_options(${ARG_NAME})
+  if(NOT ARG_LABELS)
+    set(ARG_LABELS unit)
+  endif()
+  gtest_discover_tests(${ARG_NAME}
+    WORKING_DIRECTORY ${PROJECT_BINARY_DIR}
+    PROPERTIES LABELS "${ARG_LABELS}"
+    DISCOVERY_TIMEOUT 60)
+endfunction()

@@ -1,0 +1,87 @@
+#include "common/io/lz4_stream.h"
+
+#include <lz4frame.h>
+
+namespace tiltcal {
+
+namespace {
+constexpr size_t kInputBufferBytes = 1 << 16;
+constexpr size_t kMaxWriteBytes = 1 << 16;  // CopyingOutputStreamAdaptor's block size is 8 KiB
+}  // namespace
+
+Lz4FrameOutput::Lz4FrameOutput(std::FILE* file) : file_(file) {
+  if (LZ4F_isError(LZ4F_createCompressionContext(&context_, LZ4F_VERSION))) {
+    failed_ = true;
+    return;
+  }
+  LZ4F_preferences_t preferences = LZ4F_INIT_PREFERENCES;
+  preferences.frameInfo.blockSizeID = LZ4F_max256KB;
+  preferences.frameInfo.contentChecksumFlag = LZ4F_contentChecksumEnabled;
+  out_.resize(LZ4F_compressBound(kMaxWriteBytes, &preferences) + LZ4F_HEADER_SIZE_MAX);
+  const size_t header = LZ4F_compressBegin(context_, out_.data(), out_.size(), &preferences);
+  failed_ = LZ4F_isError(header) || !Flush(header);
+}
+
+Lz4FrameOutput::~Lz4FrameOutput() { LZ4F_freeCompressionContext(context_); }
+
+bool Lz4FrameOutput::Flush(size_t bytes) {
+  return std::fwrite(out_.data(), 1, bytes, file_) == bytes;
+}
+
+bool Lz4FrameOutput::Write(const void* buffer, int size) {
+  const char* data = static_cast<const char*>(buffer);
+  while (!failed_ && size > 0) {
+    const size_t piece = std::min<size_t>(size, kMaxWriteBytes);
+    const size_t written =
+        LZ4F_compressUpdate(context_, out_.data(), out_.size(), data, piece, nullptr);
+    failed_ = LZ4F_isError(written) || !Flush(written);
+    data += piece;
+    size -= static_cast<int>(piece);
+  }
+  return !failed_;
+}
+
+bool Lz4FrameOutput::Close() {
+  if (failed_) return false;
+  const size_t written = LZ4F_compressEnd(context_, out_.data(), out_.size(), nullptr);
+  failed_ = LZ4F_isError(written) || !Flush(written);
+  return !failed_;
+}
+
+Lz4FrameInput::Lz4FrameInput(std::FILE* file) : file_(file), in_(kInputBufferBytes) {
+  if (LZ4F_isError(LZ4F_createDecompressionContext(&context_, LZ4F_VERSION))) {
+    error_ = "cannot create an LZ4 decompression context";
+  }
+}
+
+Lz4FrameInput::~Lz4FrameInput() { LZ4F_freeDecompressionContext(context_); }
+
+int Lz4FrameInput::Read(void* buffer, int size) {
+  if (!error_.empty()) return -1;
+  char* out = static_cast<char*>(buffer);
+  size_t produced_total = 0;
+  while (produced_total == 0 && !frame_done_) {
+    if (in_begin_ == in_end_) {
+      in_begin_ = 0;
+      in_end_ = std::fread(in_.data(), 1, in_.size(), file_);
+      if (in_end_ == 0) {
+        error_ = std::ferror(file_) ? "read error" : "LZ4 frame is truncated";
+        return -1;
+      }
+    }
+    size_t produced = static_cast<size_t>(size) - produced_total;
+    size_t consumed = in_end_ - in_begin_;
+    const size_t hint = LZ4F_decompress(context_, out + produced_total, &produced,
+                                        in_.data() + in_begin_, &consumed, nullptr);
+    if (LZ4F_isError(hint)) {
+      error_ = std::string("LZ4 frame is corrupt: ") + LZ4F_getErrorName(hint);
+      return -1;
+    }
+    in_begin_ += consumed;
+    produced_total += produced;
+    frame_done_ = hint == 0;
+  }
+  return static_cast<int>(produced_total);  // 0 only after the frame's end mark
+}
+
+}  // namespace tiltcal

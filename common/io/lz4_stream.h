@@ -1,0 +1,58 @@
+#ifndef TILTCAL_COMMON_IO_LZ4_STREAM_H_
+#define TILTCAL_COMMON_IO_LZ4_STREAM_H_
+
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include <google/protobuf/io/zero_copy_stream_impl_lite.h>
+
+struct LZ4F_cctx_s;
+struct LZ4F_dctx_s;
+
+namespace tiltcal {
+
+// First four bytes of every LZ4 frame (0x184D2204, little-endian).
+inline constexpr unsigned char kLz4FrameMagic[4] = {0x04, 0x22, 0x4D, 0x18};
+
+// Compresses everything written into one standard LZ4 frame on `file`
+// (content checksum on), so `lz4 -dc` gives back the plain bytes.
+// Close() writes the end mark; the caller owns and closes `file`.
+class Lz4FrameOutput : public google::protobuf::io::CopyingOutputStream {
+ public:
+  explicit Lz4FrameOutput(std::FILE* file);
+  ~Lz4FrameOutput() override;
+  bool Write(const void* buffer, int size) override;
+  bool Close();
+
+ private:
+  bool Flush(size_t bytes);
+  std::FILE* file_;
+  LZ4F_cctx_s* context_ = nullptr;
+  std::vector<char> out_;
+  bool failed_ = false;
+};
+
+// Reads the decompressed content of one LZ4 frame from `file`. A frame that
+// ends before its end mark, or fails its checksum, sets error() instead of
+// looking like a clean end of data.
+class Lz4FrameInput : public google::protobuf::io::CopyingInputStream {
+ public:
+  explicit Lz4FrameInput(std::FILE* file);
+  ~Lz4FrameInput() override;
+  int Read(void* buffer, int size) override;
+  const std::string& error() const { return error_; }
+
+ private:
+  std::FILE* file_;
+  LZ4F_dctx_s* context_ = nullptr;
+  std::vector<char> in_;
+  size_t in_begin_ = 0;
+  size_t in_end_ = 0;
+  bool frame_done_ = false;
+  std::string error_;
+};
+
+}  // namespace tiltcal
+
+#endif  // TILTCAL_COMMON_IO_LZ4_STREAM_H_

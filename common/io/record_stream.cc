@@ -1,0 +1,167 @@
+#include "common/io/record_stream.h"
+
+#include <cstring>
+
+#include <google/protobuf/io/coded_stream.h>
+#include <google/protobuf/io/zero_copy_stream_impl.h>
+#include <google/protobuf/util/delimited_message_util.h>
+
+#include "common/io/lz4_stream.h"
+
+namespace tiltcal {
+
+namespace pbio = google::protobuf::io;
+using google::protobuf::util::ParseDelimitedFromZeroCopyStream;
+using google::protobuf::util::SerializeDelimitedToZeroCopyStream;
+
+// ---------------------------------------------------------------- writer --
+
+class RecordWriter::Impl {
+ public:
+  AtomicFile file;
+  std::unique_ptr<Lz4FrameOutput> lz4;
+  std::unique_ptr<pbio::CopyingOutputStreamAdaptor> lz4_adaptor;
+  std::unique_ptr<pbio::FileOutputStream> plain;
+
+  pbio::ZeroCopyOutputStream* stream() {
+    return lz4_adaptor ? static_cast<pbio::ZeroCopyOutputStream*>(lz4_adaptor.get())
+                       : plain.get();
+  }
+};
+
+RecordWriter::RecordWriter() = default;
+RecordWriter::~RecordWriter() = default;
+
+Status RecordWriter::Open(const std::string& path, const std::string& payload_type,
+                          const proto::Provenance& provenance, bool compress) {
+  impl_ = std::make_unique<Impl>();
+  num_records_ = 0;
+  TILTCAL_RETURN_IF_ERROR(impl_->file.Open(path));
+  if (compress) {
+    impl_->lz4 = std::make_unique<Lz4FrameOutput>(impl_->file.file());
+    impl_->lz4_adaptor = std::make_unique<pbio::CopyingOutputStreamAdaptor>(impl_->lz4.get(),
+                                                                            1 << 16);
+  } else {
+    std::fflush(impl_->file.file());
+    impl_->plain = std::make_unique<pbio::FileOutputStream>(::fileno(impl_->file.file()));
+  }
+  {
+    pbio::CodedOutputStream coded(impl_->stream());
+    coded.WriteRaw(kStreamMagic, sizeof(kStreamMagic));
+  }
+  proto::StreamHeader header;
+  header.set_payload_type(payload_type);
+  header.set_format_version(kStreamFormatVersion);
+  *header.mutable_provenance() = provenance;
+  if (!SerializeDelimitedToZeroCopyStream(header, impl_->stream())) {
+    return Status::Error(path + ": cannot write the stream header");
+  }
+  return Status::Ok();
+}
+
+Status RecordWriter::Write(const google::protobuf::Message& record) {
+  if (!SerializeDelimitedToZeroCopyStream(record, impl_->stream())) {
+    return Status::Error(impl_->file.path() + ": cannot write record " +
+                         std::to_string(num_records_));
+  }
+  ++num_records_;
+  return Status::Ok();
+}
+
+Status RecordWriter::Close() {
+  const std::string& path = impl_->file.path();
+  bool ok = true;
+  if (impl_->lz4_adaptor) {
+    ok = impl_->lz4_adaptor->Flush() && impl_->lz4->Close();
+  } else {
+    ok = impl_->plain->Flush();
+  }
+  if (!ok) {
+    impl_->file.Abandon();
+    return Status::Error(path + ": cannot write output");
+  }
+  return impl_->file.Commit();
+}
+
+// ---------------------------------------------------------------- reader --
+
+class RecordReader::Impl {
+ public:
+  ~Impl() {
+    stream_holder.reset();
+    lz4.reset();
+    if (file != nullptr) std::fclose(file);
+  }
+  std::FILE* file = nullptr;
+  std::unique_ptr<Lz4FrameInput> lz4;
+  std::unique_ptr<pbio::ZeroCopyInputStream> stream_holder;
+  pbio::ZeroCopyInputStream* stream() { return stream_holder.get(); }
+  // Error of the decompressor, if any: a decompression failure at a record
+  // boundary would otherwise look like a clean end of the stream.
+  std::string StreamError() const { return lz4 ? lz4->error() : std::string(); }
+};
+
+RecordReader::RecordReader() = default;
+RecordReader::~RecordReader() = default;
+
+Status RecordReader::Open(const std::string& path, const std::string& expected_payload_type) {
+  impl_ = std::make_unique<Impl>();
+  path_ = path;
+  num_read_ = 0;
+  impl_->file = std::fopen(path.c_str(), "rb");
+  if (impl_->file == nullptr) {
+    return Status::Error(path + ": cannot open: " + std::strerror(errno));
+  }
+  unsigned char first[4] = {0, 0, 0, 0};
+  const size_t got = std::fread(first, 1, sizeof(first), impl_->file);
+  std::rewind(impl_->file);
+  if (got == sizeof(first) && std::memcmp(first, kLz4FrameMagic, sizeof(first)) == 0) {
+    impl_->lz4 = std::make_unique<Lz4FrameInput>(impl_->file);
+    impl_->stream_holder =
+        std::make_unique<pbio::CopyingInputStreamAdaptor>(impl_->lz4.get(), 1 << 16);
+  } else {
+    impl_->stream_holder = std::make_unique<pbio::FileInputStream>(::fileno(impl_->file));
+  }
+  char magic[sizeof(kStreamMagic)] = {};
+  {
+    pbio::CodedInputStream coded(impl_->stream());
+    if (!coded.ReadRaw(magic, sizeof(magic)) ||
+        std::memcmp(magic, kStreamMagic, sizeof(magic)) != 0) {
+      const std::string detail = impl_->StreamError();
+      return Status::Error(path + ": not a tiltcal record stream (bad magic" +
+                           (detail.empty() ? "" : ", " + detail) + ")");
+    }
+  }
+  bool clean_eof = false;
+  if (!ParseDelimitedFromZeroCopyStream(&header_, impl_->stream(), &clean_eof)) {
+    return Status::Error(path + ": cannot read the stream header");
+  }
+  if (header_.format_version() != kStreamFormatVersion) {
+    return Status::Error(path + ": unsupported stream format version " +
+                         std::to_string(header_.format_version()) + " (this build reads " +
+                         std::to_string(kStreamFormatVersion) + ")");
+  }
+  if (!expected_payload_type.empty() && header_.payload_type() != expected_payload_type) {
+    return Status::Error(path + ": holds " + header_.payload_type() + " records, expected " +
+                         expected_payload_type);
+  }
+  return Status::Ok();
+}
+
+Status RecordReader::Read(google::protobuf::Message* record, bool* end) {
+  *end = false;
+  bool clean_eof = false;
+  if (ParseDelimitedFromZeroCopyStream(record, impl_->stream(), &clean_eof)) {
+    ++num_read_;
+    return Status::Ok();
+  }
+  const std::string stream_error = impl_->StreamError();
+  if (clean_eof && stream_error.empty()) {
+    *end = true;
+    return Status::Ok();
+  }
+  return Status::Error(path_ + ": record " + std::to_string(num_read_) + ": " +
+                       (stream_error.empty() ? "truncated or corrupt record" : stream_error));
+}
+
+}  // namespace tiltcal

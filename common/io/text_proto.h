@@ -1,0 +1,25 @@
+#ifndef TILTCAL_COMMON_IO_TEXT_PROTO_H_
+#define TILTCAL_COMMON_IO_TEXT_PROTO_H_
+
+#include <string>
+
+#include <google/protobuf/message.h>
+
+#include "common/status.h"
+
+namespace tiltcal {
+
+// Parses a protobuf text-format file. Unknown fields are errors; the message
+// names the file, line and column.
+Status ReadTextProto(const std::string& path, google::protobuf::Message* message);
+
+// Parses text format from memory; `source_name` is used in error messages.
+Status ParseTextProto(const std::string& text, const std::string& source_name,
+                      google::protobuf::Message* message);
+
+// Writes `message` in text format, atomically. Doubles round-trip exactly.
+Status WriteTextProto(const std::string& path, const google::protobuf::Message& message);
+
+}  // namespace tiltcal
+
+#endif  // TILTCAL_COMMON_IO_TEXT_PROTO_H_

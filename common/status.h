@@ -1,0 +1,41 @@
+#ifndef TILTCAL_COMMON_STATUS_H_
+#define TILTCAL_COMMON_STATUS_H_
+
+#include <string>
+#include <utility>
+
+namespace tiltcal {
+
+// Result of an operation that can fail on bad input. The message is one line
+// meant for the user: it names the file and the record or field at fault.
+// Programmer errors are not reported this way.
+class [[nodiscard]] Status {
+ public:
+  Status() = default;
+  static Status Ok() { return Status(); }
+  static Status Error(std::string message) { return Status(std::move(message)); }
+
+  bool ok() const { return !failed_; }
+  const std::string& message() const { return message_; }
+
+  // Prefixes the message with context, e.g. the file name: "file: message".
+  Status WithContext(const std::string& context) const {
+    return ok() ? *this : Status(context + ": " + message_);
+  }
+
+ private:
+  explicit Status(std::string message) : failed_(true), message_(std::move(message)) {}
+  bool failed_ = false;
+  std::string message_;
+};
+
+}  // namespace tiltcal
+
+// Returns from the calling function when `expr` yields a failed Status.
+#define TILTCAL_RETURN_IF_ERROR(expr)          \
+  do {                                         \
+    ::tiltcal::Status tiltcal_status_ = (expr); \
+    if (!tiltcal_status_.ok()) return tiltcal_status_; \
+  } while (0)
+
+#endif  // TILTCAL_COMMON_STATUS_H_

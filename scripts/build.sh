@@ -1,0 +1,11 @@
+#!/usr/bin/env bash
+# Configures and builds tiltcal into build/ (Release, Ninja). Binaries land in
+# build/bin/. Extra arguments go to cmake, e.g. -DTILTCAL_SANITIZE=address.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+scripts/setup.sh
+BUILD_DIR=${BUILD_DIR:-build}
+if [ ! -f "$BUILD_DIR/build.ninja" ] || [ $# -gt 0 ]; then
+  cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=Release "$@" >/dev/null
+fi
+cmake --build "$BUILD_DIR" -j "$(nproc)"

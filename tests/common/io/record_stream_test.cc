@@ -1,0 +1,162 @@
+#include "common/io/record_stream.h"
+
+#include <cstdio>
+#include <filesystem>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "common/io/atomic_file.h"
+#include "tests/testing/test_env.h"
+#include "tiltcal/proto/imu.pb.h"
+#include "tiltcal/proto/scan.pb.h"
+
+namespace tiltcal {
+namespace {
+
+using testing::TempDir;
+
+proto::Scan MakeScan(int index, int num_points) {
+  proto::Scan scan;
+  scan.set_index(index);
+  scan.set_stamp_ns(1'700'000'000'000'000'000LL + index * 100'000'000LL);
+  for (int i = 0; i < num_points; ++i) {
+    scan.add_x(0.5f * i);
+    scan.add_y(-0.25f * i);
+    scan.add_z(0.01f * index);
+    scan.add_intensity(i % 256);
+    scan.add_ring(i % 16);
+    scan.add_time_offset_ns(-100'000'000 + i * 1000);
+  }
+  return scan;
+}
+
+void WriteScans(const std::string& path, bool compress, int count, int points) {
+  RecordWriter writer;
+  proto::Provenance provenance;
+  provenance.set_producer("record_stream_test");
+  ASSERT_TRUE(writer.Open(path, "tiltcal.proto.Scan", provenance, compress).ok());
+  for (int i = 0; i < count; ++i) ASSERT_TRUE(writer.Write(MakeScan(i, points)).ok());
+  ASSERT_TRUE(writer.Close().ok());
+}
+
+class RecordStreamTest : public ::testing::TestWithParam<bool> {};
+
+TEST_P(RecordStreamTest, RoundTripKeepsEveryRecordAndTheHeader) {
+  TempDir dir;
+  const std::string path = dir.File("scans.binpb");
+  WriteScans(path, GetParam(), 25, 3000);
+  std::vector<proto::Scan> scans;
+  proto::StreamHeader header;
+  const Status status = ReadAllRecords<proto::Scan>(path, &scans, &header);
+  ASSERT_TRUE(status.ok()) << status.message();
+  EXPECT_EQ(header.payload_type(), "tiltcal.proto.Scan");
+  EXPECT_EQ(header.provenance().producer(), "record_stream_test");
+  ASSERT_EQ(scans.size(), 25u);
+  for (int i = 0; i < 25; ++i) {
+    EXPECT_EQ(scans[i].SerializeAsString(), MakeScan(i, 3000).SerializeAsString());
+  }
+}
+
+TEST_P(RecordStreamTest, EmptyStreamEndsCleanly) {
+  TempDir dir;
+  const std::string path = dir.File("empty.binpb");
+  WriteScans(path, GetParam(), 0, 0);
+  std::vector<proto::Scan> scans;
+  EXPECT_TRUE(ReadAllRecords<proto::Scan>(path, &scans).ok());
+  EXPECT_TRUE(scans.empty());
+}
+
+TEST_P(RecordStreamTest, TruncatedFileIsAnErrorNamingFileAndRecord) {
+  TempDir dir;
+  const std::string path = dir.File("scans.binpb");
+  WriteScans(path, GetParam(), 10, 2000);
+  const auto size = std::filesystem::file_size(path);
+  std::filesystem::resize_file(path, size - size / 3);
+  std::vector<proto::Scan> scans;
+  const Status status = ReadAllRecords<proto::Scan>(path, &scans);
+  ASSERT_FALSE(status.ok());
+  EXPECT_NE(status.message().find(path), std::string::npos) << status.message();
+  EXPECT_NE(status.message().find("record " + std::to_string(scans.size())), std::string::npos)
+      << status.message();
+  EXPECT_LT(scans.size(), 10u);
+}
+
+TEST_P(RecordStreamTest, CutExactlyAtARecordBoundaryIsDetectedWhenCompressed) {
+  // In a plain stream a cut at a boundary cannot be told from the end; in an
+  // LZ4 frame the missing end mark gives it away.
+  if (!GetParam()) GTEST_SKIP() << "plain streams have no end mark";
+  TempDir dir;
+  const std::string path = dir.File("scans.binpb.lz4");
+  WriteScans(path, true, 3, 10);
+  std::filesystem::resize_file(path, std::filesystem::file_size(path) - 4);  // drop checksum
+  std::vector<proto::Scan> scans;
+  EXPECT_FALSE(ReadAllRecords<proto::Scan>(path, &scans).ok());
+}
+
+INSTANTIATE_TEST_SUITE_P(PlainAndLz4, RecordStreamTest, ::testing::Bool(),
+                         [](const auto& info) { return info.param ? "Lz4" : "Plain"; });
+
+TEST(RecordStream, CompressedStreamIsOneStandardLz4Frame) {
+  if (testing::RunCommand("command -v lz4 >/dev/null") != 0) GTEST_SKIP() << "lz4 tool missing";
+  TempDir dir;
+  WriteScans(dir.File("a.binpb.lz4"), true, 5, 100);
+  WriteScans(dir.File("b.binpb"), false, 5, 100);
+  ASSERT_EQ(testing::RunCommand("lz4 -dc " + dir.File("a.binpb.lz4") + " > " + dir.File("a.binpb")),
+            0);
+  std::string a, b;
+  ASSERT_TRUE(ReadFileToString(dir.File("a.binpb"), &a).ok());
+  ASSERT_TRUE(ReadFileToString(dir.File("b.binpb"), &b).ok());
+  // Same content apart from the creation time in the header: compare records.
+  std::vector<proto::Scan> from_a, from_b;
+  ASSERT_TRUE(ReadAllRecords<proto::Scan>(dir.File("a.binpb"), &from_a).ok());
+  ASSERT_TRUE(ReadAllRecords<proto::Scan>(dir.File("b.binpb"), &from_b).ok());
+  ASSERT_EQ(from_a.size(), 5u);
+  for (size_t i = 0; i < from_a.size(); ++i) {
+    EXPECT_EQ(from_a[i].SerializeAsString(), from_b[i].SerializeAsString());
+  }
+}
+
+TEST(RecordStream, WrongMagicIsRejected) {
+  TempDir dir;
+  ASSERT_TRUE(WriteFileAtomically(dir.File("junk"), "#ROSBAG V2.0\nxxxxxxxx").ok());
+  RecordReader reader;
+  const Status status = reader.Open(dir.File("junk"));
+  ASSERT_FALSE(status.ok());
+  EXPECT_NE(status.message().find("not a tiltcal record stream"), std::string::npos);
+}
+
+TEST(RecordStream, WrongPayloadTypeIsRejected) {
+  TempDir dir;
+  WriteScans(dir.File("scans.binpb"), false, 1, 1);
+  std::vector<proto::ImuSample> imu;
+  const Status status = ReadAllRecords<proto::ImuSample>(dir.File("scans.binpb"), &imu);
+  ASSERT_FALSE(status.ok());
+  EXPECT_NE(status.message().find("expected tiltcal.proto.ImuSample"), std::string::npos);
+}
+
+TEST(RecordStream, CorruptCompressedByteIsAnError) {
+  TempDir dir;
+  const std::string path = dir.File("scans.binpb.lz4");
+  WriteScans(path, true, 5, 500);
+  std::string bytes;
+  ASSERT_TRUE(ReadFileToString(path, &bytes).ok());
+  bytes[bytes.size() / 2] ^= 0x5A;
+  ASSERT_TRUE(WriteFileAtomically(path, bytes).ok());
+  std::vector<proto::Scan> scans;
+  EXPECT_FALSE(ReadAllRecords<proto::Scan>(path, &scans).ok());
+}
+
+TEST(RecordStream, UnclosedWriterLeavesNoFile) {
+  TempDir dir;
+  const std::string path = dir.File("scans.binpb");
+  {
+    RecordWriter writer;
+    ASSERT_TRUE(writer.Open(path, "tiltcal.proto.Scan", {}, true).ok());
+    ASSERT_TRUE(writer.Write(MakeScan(0, 10)).ok());
+  }  // destroyed without Close()
+  EXPECT_TRUE(std::filesystem::is_empty(dir.path()));
+}
+
+}  // namespace
+}  // namespace tiltcal
