@@ -75,4 +75,13 @@ Status ReadFileToString(const std::string& path, std::string* contents) {
   return Status::Ok();
 }
 
+Status ReadFileHead(const std::string& path, size_t max_bytes, std::string* contents) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Status::Error(path + ": cannot open: " + ErrnoText());
+  contents->assign(max_bytes, '\0');
+  in.read(contents->data(), static_cast<std::streamsize>(max_bytes));
+  contents->resize(static_cast<size_t>(in.gcount()));
+  return Status::Ok();
+}
+
 }  // namespace tiltcal

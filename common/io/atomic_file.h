@@ -40,6 +40,9 @@ Status WriteFileAtomically(const std::string& path, const std::string& contents)
 // Reads a whole file.
 Status ReadFileToString(const std::string& path, std::string* contents);
 
+// Reads at most the first `max_bytes` bytes of a file.
+Status ReadFileHead(const std::string& path, size_t max_bytes, std::string* contents);
+
 }  // namespace tiltcal
 
 #endif  // TILTCAL_COMMON_IO_ATOMIC_FILE_H_

@@ -151,6 +151,7 @@ Status RecordReader::Open(const std::string& path, const std::string& expected_p
 Status RecordReader::Read(google::protobuf::Message* record, bool* end) {
   *end = false;
   bool clean_eof = false;
+  record->Clear();  // parsing merges into what the message holds
   if (ParseDelimitedFromZeroCopyStream(record, impl_->stream(), &clean_eof)) {
     ++num_read_;
     return Status::Ok();
