@@ -1,0 +1,243 @@
+#!/usr/bin/env bash
+# Decode benchmark (DESIGN §6; see README.md beside this file).
+#
+# Builds tiltcal_decode (Release) and, when Debian's C++ rosbag library
+# installs, the anchor reader tiltcal_bench_rosbag_cpp_reader; generates
+# lz4 bags of VLP-16-like clouds + 200 Hz IMU (reused when present); runs
+# on the same large bag:
+#   tiltcal_decode                      (ours, full decode to .binpb files)
+#   C++ rosbag library reader           (anchor: rosbag::View + instantiate)
+#   Python rosbag reader                (read_points, and numpy.frombuffer)
+# each under /usr/bin/time -v, and prints wall s, MB/s (bag bytes / wall),
+# points/s, peak RSS and the speed ratio against the C++ rosbag reader
+# (anchor wall / tool wall; > 1 = faster than the anchor). tiltcal_decode is
+# also run on a smaller bag to show that its peak memory does not grow with
+# the bag size. Runs are on a warm page cache (each bag is read once first).
+#
+# Usage: bench/decode/run_decode_bench.sh [options]
+#   --scratch DIR        where bags and outputs go (default /tmp)
+#   --size_gb X          large bag size, 1e9 bytes (default 1.0)
+#   --small_gb X         small bag size for the memory check (default 0.25)
+#   --repeats N          runs of tiltcal_decode and the C++ reader; the table
+#                        shows the median wall and the largest RSS (default 3)
+#   --python_points M    read_points | numpy | both (default both)
+#   --python_max_bytes N read_points on a prefix carrying N bytes of point
+#                        data only (default 0 = whole bag)
+#   --build_dir DIR      (default <repo>/build-bench)
+#   --clean              delete the generated bags at the end
+# Exit status is non-zero when a step fails; the table is still printed for
+# the steps that ran.
+set -euo pipefail
+
+REPO=$(cd "$(dirname "$0")/../.." && pwd)
+SCRATCH=/tmp
+SIZE_GB=1.0
+SMALL_GB=0.25
+REPEATS=3
+PYTHON_POINTS=both
+PYTHON_MAX_BYTES=0
+BUILD_DIR="$REPO/build-bench"
+CLEAN=0
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --scratch) SCRATCH=$2; shift 2 ;;
+    --size_gb) SIZE_GB=$2; shift 2 ;;
+    --small_gb) SMALL_GB=$2; shift 2 ;;
+    --repeats) REPEATS=$2; shift 2 ;;
+    --python_points) PYTHON_POINTS=$2; shift 2 ;;
+    --python_max_bytes) PYTHON_MAX_BYTES=$2; shift 2 ;;
+    --build_dir) BUILD_DIR=$2; shift 2 ;;
+    --clean) CLEAN=1; shift ;;
+    -h|--help) sed -n '2,/^set -euo/p' "$0" | sed '$d'; exit 0 ;;
+    *) echo "run_decode_bench: unknown argument $1" >&2; exit 2 ;;
+  esac
+done
+
+DEBIAN_PYTHON=/usr/bin/python3
+BENCH_DIR="$REPO/bench/decode"
+WORK="$SCRATCH/tiltcal_decode_bench"
+LOGS="$WORK/logs"
+mkdir -p "$LOGS"
+log() { echo "run_decode_bench: $*" >&2; }
+
+# ---- Packages: build deps of the project, plus the benchmark's extras. ----
+"$REPO/scripts/setup.sh"
+apt_install() {  # best effort; returns non-zero when a package is unavailable
+  local missing=()
+  for package in "$@"; do
+    dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed" ||
+      missing+=("$package")
+  done
+  [ ${#missing[@]} -eq 0 ] && return 0
+  local sudo=""
+  [ "$(id -u)" -ne 0 ] && sudo="sudo"
+  log "installing ${missing[*]}"
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends \
+    "${missing[@]}" >/dev/null 2>&1 ||
+    { $sudo apt-get update -qq && DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq \
+        --no-install-recommends "${missing[@]}" >/dev/null 2>&1; }
+}
+apt_install time
+HAVE_ROS_CPP=1
+apt_install librosbag-storage-dev libsensor-msgs-dev ||
+  { HAVE_ROS_CPP=0; log "C++ rosbag library not installable: no C++ anchor"; }
+
+# ---- Build (Release). ----
+cmake -S "$REPO" -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=Release >"$LOGS/cmake.log" 2>&1
+HAVE_DECODE=1
+if ! cmake --build "$BUILD_DIR" --target tiltcal_decode -j2 >"$LOGS/build_decode.log" 2>&1; then
+  HAVE_DECODE=0
+  log "building tiltcal_decode failed (see $LOGS/build_decode.log); measuring the anchors only"
+  tail -5 "$LOGS/build_decode.log" >&2
+fi
+DECODE="$BUILD_DIR/bin/tiltcal_decode"
+CPP_READER="$BUILD_DIR/bin/tiltcal_bench_rosbag_cpp_reader"
+if [ $HAVE_ROS_CPP = 1 ]; then
+  if ! cmake --build "$BUILD_DIR" --target tiltcal_bench_rosbag_cpp_reader -j2 \
+      >"$LOGS/build_cpp_reader.log" 2>&1; then
+    HAVE_ROS_CPP=0
+    log "C++ rosbag reader did not build (see $LOGS/build_cpp_reader.log): no C++ anchor"
+  fi
+fi
+
+# ---- Bags (reused when present with their .meta). ----
+need_gb=$(awk -v a="$SIZE_GB" -v b="$SMALL_GB" 'BEGIN { printf "%d", (2 * a + 2 * b + 1) * 1e9 }')
+avail=$(df -B1 --output=avail "$SCRATCH" | tail -1)
+make_bag() {  # SIZE_GB -> path on stdout
+  local bag="$WORK/vlp16_lz4_${1}gb.bag"
+  if [ ! -f "$bag" ] || [ ! -f "$bag.meta" ]; then
+    if [ "$avail" -lt "$need_gb" ]; then
+      log "not enough space in $SCRATCH ($avail bytes free, want $need_gb for bags and outputs)"
+      exit 1
+    fi
+    log "generating $bag"
+    "$DEBIAN_PYTHON" "$BENCH_DIR/make_vlp16_bag.py" --out "$bag" --size_gb "$1" \
+      2>"$LOGS/make_bag_${1}gb.log" >&2
+    tail -1 "$LOGS/make_bag_${1}gb.log" >&2
+  else
+    log "reusing $bag"
+  fi
+  echo "$bag"
+}
+BAG=$(make_bag "$SIZE_GB")
+SMALL_BAG=$(make_bag "$SMALL_GB")
+meta() { sed -n "s/^$2=//p" "$1.meta"; }
+
+# ---- Timed runs. ----
+# Results, one line per run: label bag wall_s max_rss_kb points_read exit
+RESULTS="$LOGS/results.txt"
+: >"$RESULTS"
+# run_timed LABEL BAG POINTS_READ_CMD|- CMD...   (POINTS_READ "-" = all points of BAG)
+run_timed() {
+  local label=$1 bag=$2 i=$3
+  shift 3
+  local tlog="$LOGS/$label.$i.time" out="$LOGS/$label.$i.out"
+  local status=0
+  /usr/bin/time -v -o "$tlog" "$@" >"$out" 2>&1 || status=$?
+  local wall rss
+  wall=$(awk -F': ' '/Elapsed \(wall clock\)/ { n = split($2, p, ":"); s = 0;
+           for (k = 1; k <= n; ++k) s = s * 60 + p[k]; print s }' "$tlog")
+  rss=$(awk -F': ' '/Maximum resident set size/ { print $2 }' "$tlog")
+  local points
+  points=$(sed -n 's/.* points=\([0-9]*\).*/\1/p' "$out" | tail -1)
+  [ -z "$points" ] && points=$(meta "$bag" points)
+  echo "$label $bag $wall $rss $points $status" >>"$RESULTS"
+  if [ $status -ne 0 ]; then
+    log "$label failed (exit $status), output in $out:"
+    tail -5 "$out" >&2
+  fi
+  return 0
+}
+warm() { cat "$1" >/dev/null; }
+
+PARAMS="$REPO/stages/decode/default_params.txtpb"
+run_decode() {  # LABEL BAG REPEAT
+  local outdir="$WORK/out"
+  mkdir -p "$outdir"
+  run_timed "$1" "$2" "$3" "$DECODE" --bag="$2" --params="$PARAMS" \
+    --out_imu="$outdir/imu.binpb" --out_scans="$outdir/scans.binpb.lz4"
+  ls -l "$outdir" >>"$LOGS/$1.$3.out" 2>&1 || true
+  rm -rf "$outdir"
+}
+
+warm "$BAG"
+for ((r = 1; r <= REPEATS; ++r)); do
+  log "run $r/$REPEATS on $(basename "$BAG")"
+  [ $HAVE_DECODE = 1 ] && run_decode tiltcal_decode "$BAG" "$r"
+  if [ $HAVE_ROS_CPP = 1 ]; then
+    run_timed rosbag_cpp "$BAG" "$r" "$CPP_READER" "$BAG"
+  fi
+done
+if [ "$PYTHON_POINTS" = read_points ] || [ "$PYTHON_POINTS" = both ]; then
+  log "python read_points on $(basename "$BAG")"
+  run_timed rosbag_python_read_points "$BAG" 1 "$DEBIAN_PYTHON" \
+    "$BENCH_DIR/rosbag_python_reader.py" --points=read_points \
+    --max_bytes="$PYTHON_MAX_BYTES" "$BAG"
+fi
+if [ "$PYTHON_POINTS" = numpy ] || [ "$PYTHON_POINTS" = both ]; then
+  log "python numpy on $(basename "$BAG")"
+  run_timed rosbag_python_numpy "$BAG" 1 "$DEBIAN_PYTHON" \
+    "$BENCH_DIR/rosbag_python_reader.py" --points=numpy "$BAG"
+fi
+warm "$SMALL_BAG"
+for ((r = 1; r <= REPEATS && HAVE_DECODE; ++r)); do
+  log "run $r/$REPEATS on $(basename "$SMALL_BAG")"
+  run_decode tiltcal_decode "$SMALL_BAG" "$r"
+done
+
+# ---- Table. ----
+echo
+echo "Decode benchmark, $(date -u '+%Y-%m-%d %H:%M UTC'), $(nproc) cores," \
+  "$(sed -n 's/^model name\s*: //p' /proc/cpuinfo | head -1)"
+for b in "$BAG" "$SMALL_BAG"; do
+  echo "  $(basename "$b"): $(meta "$b" bytes) bytes, $(meta "$b" clouds) clouds," \
+    "$(meta "$b" points) points, $(meta "$b" imu) imu messages"
+done
+echo "  MB = 1e6 bytes of the bag file; median wall of $REPEATS runs for tiltcal_decode and"
+echo "  the C++ reader, largest peak RSS; ratio = C++ rosbag wall / tool wall on the same bag."
+awk -v big="$BAG" '
+  function median(list, n,   a, i, j, t) {
+    n = split(list, a, " ")
+    for (i = 1; i <= n; ++i) for (j = i + 1; j <= n; ++j) if (a[j] < a[i]) { t = a[i]; a[i] = a[j]; a[j] = t }
+    return (n % 2) ? a[(n + 1) / 2] : (a[n / 2] + a[n / 2 + 1]) / 2
+  }
+  {
+    key = $1 SUBSEP $2
+    if (!(key in walls)) { order[++n] = key }
+    walls[key] = walls[key] " " $3
+    if ($4 > rss[key]) rss[key] = $4
+    points[key] = $5
+    if ($6 != 0) failed[key] = 1
+  }
+  END {
+    printf "\n%-28s %-22s %8s %8s %10s %9s %10s\n", "tool", "bag", "wall s", "MB/s", "Mpoints/s", "RSS MB", "vs C++"
+    anchor_key = "rosbag_cpp" SUBSEP big
+    anchor = (anchor_key in walls) ? median(walls[anchor_key]) : 0
+    for (k = 1; k <= n; ++k) {
+      key = order[k]; split(key, parts, SUBSEP)
+      w = median(walls[key])
+      cmd = "stat -c %s " parts[2]; cmd | getline size; close(cmd)
+      name = parts[1]
+      if (failed[key]) name = name " (FAILED)"
+      ratio = (anchor > 0 && parts[2] == big && w > 0) ? sprintf("%.2fx", anchor / w) : "-"
+      bn = parts[2]; sub(".*/", "", bn)
+      # A prefix run (python read_points with --python_max_bytes) reads only
+      # part of the bag: MB/s is scaled by the fraction of points it read.
+      cmd = "sed -n s/^points=//p " parts[2] ".meta"; cmd | getline total; close(cmd)
+      frac = (total > 0) ? points[key] / total : 1
+      if (frac < 0.999) { name = name sprintf(" [%.0f%% prefix]", 100 * frac); if (ratio != "-") ratio = sprintf("%.2fx", anchor * frac / w) }
+      printf "%-28s %-22s %8.2f %8.1f %10.2f %9.1f %10s\n", name, bn, w,
+             (w > 0 ? size * frac / w / 1e6 : 0), (w > 0 ? points[key] / w / 1e6 : 0), rss[key] / 1024, ratio
+    }
+  }' "$RESULTS" | tee "$LOGS/table.txt"
+echo
+log "logs in $LOGS"
+
+status=0
+[ $HAVE_DECODE = 1 ] || status=1
+awk '$6 != 0 { bad = 1 } END { exit bad }' "$RESULTS" || status=1
+if [ $CLEAN = 1 ]; then
+  rm -f "$BAG" "$BAG.meta" "$SMALL_BAG" "$SMALL_BAG.meta"
+  log "removed the generated bags"
+fi
+exit $status
