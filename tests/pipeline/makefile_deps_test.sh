@@ -1,0 +1,119 @@
+#!/usr/bin/env bash
+# Tests the dependency graph of Makefile.pipeline with stub stage binaries:
+# which commands run after a params file, a binary or an input changes, that a
+# failed stage leaves no output, and that -j runs sequences in parallel.
+set -euo pipefail
+SRC=$(cd "$(dirname "$0")/../.." && pwd)
+WORK=$(mktemp -d)
+trap 'rm -rf "$WORK"' EXIT
+BIN=$WORK/bin
+DATA=$WORK/data
+mkdir -p "$BIN" "$DATA/params"
+
+# A stub stage: writes every --out*=PATH it is given; fails when
+# TILTCAL_STUB_FAIL names it (after writing, as a crash midway would).
+cat > "$BIN/stub" <<'STUB'
+#!/usr/bin/env bash
+name=$(basename "$0")
+for arg in "$@"; do
+  case "$arg" in --out*=*) echo "$name" > "${arg#*=}" ;; esac
+done
+[ "$name" = tiltcal_inspect ] && echo "stamp_ns,valid,normal_in_lidar.z,height_m"
+[ "${TILTCAL_STUB_FAIL:-}" = "$name" ] && exit 1
+exit 0
+STUB
+chmod +x "$BIN/stub"
+for stage in decode ground gravity calibrate report inspect; do
+  ln -s stub "$BIN/tiltcal_$stage"
+done
+# A stub interpreter for the plot scripts.
+cat > "$BIN/python" <<'STUB'
+#!/usr/bin/env bash
+for arg in "$@"; do
+  case "$arg" in
+    --out=*) echo png > "${arg#*=}" ;;
+    --out_dir=*) echo png > "${arg#*=}/extrinsic_positions.png"; echo png > "${arg#*=}/extrinsic_spread.png" ;;
+  esac
+done
+STUB
+chmod +x "$BIN/python"
+
+echo 'imu_height_m: 0.3' > "$DATA/rig.txtpb"
+for stage in decode ground gravity calibrate; do echo "# $stage" > "$DATA/params/$stage.txtpb"; done
+touch "$DATA/seq_a.bag" "$DATA/seq_b.bag"
+MAKE=(make --no-print-directory -f "$SRC/Makefile.pipeline" DATASET="$DATA" BIN="$BIN" PYTHON="$BIN/python")
+
+fail() { echo "FAIL: $*" >&2; exit 1; }
+# Stages that `make -n` would run, one "stage sequence" per line, sorted.
+planned() {
+  "${MAKE[@]}" -n "$@" | sed -e ':a' -e '/\\$/N; s/\\\n//; ta' | perl -ne '
+    next unless /(tiltcal_[a-z]+|plot_[a-z_]+\.py)/; my $stage = $1;
+    my ($seq) = m{/out/([^/ ]+)/} ? ($1) : m{/([^/ ]+)\.bag} ? ($1) : ("");
+    print $seq eq "" ? "$stage\n" : "$stage $seq\n";' | sort -u | tr '\n' ';'
+}
+expect() {  # expect "<description>" "<planned>" "<expected>"
+  [ "$2" = "$3" ] || fail "$1: planned '$2', expected '$3'"
+  echo "ok: $1"
+}
+sleep_past() { sleep 1.1; }  # make compares mtimes
+
+expect "fresh dataset runs every stage" "$(planned)" \
+"plot_extrinsics.py;plot_ground_timeline.py seq_a;plot_ground_timeline.py seq_b;tiltcal_calibrate seq_a;tiltcal_calibrate seq_b;tiltcal_decode seq_a;tiltcal_decode seq_b;tiltcal_gravity seq_a;tiltcal_gravity seq_b;tiltcal_ground seq_a;tiltcal_ground seq_b;tiltcal_inspect seq_a;tiltcal_inspect seq_b;tiltcal_report;"
+
+"${MAKE[@]}" -j2 all > /dev/null
+for s in seq_a seq_b; do
+  for f in imu.binpb scans.binpb.lz4 ground.binpb gravity.txtpb calibration.txtpb ground.csv ground_timeline.png; do
+    [ -f "$DATA/out/$s/$f" ] || fail "-j2 all did not make out/$s/$f"
+  done
+done
+[ -f "$DATA/out/repeatability.txt" ] && [ -f "$DATA/out/extrinsic_spread.png" ] || fail "no report"
+expect "up to date after a full run" "$(planned)" ""
+
+sleep_past; echo 'edited' >> "$DATA/params/ground.txtpb"
+expect "editing the ground params reruns ground and downstream, nothing upstream" "$(planned)" \
+"plot_extrinsics.py;plot_ground_timeline.py seq_a;plot_ground_timeline.py seq_b;tiltcal_calibrate seq_a;tiltcal_calibrate seq_b;tiltcal_gravity seq_a;tiltcal_gravity seq_b;tiltcal_ground seq_a;tiltcal_ground seq_b;tiltcal_inspect seq_a;tiltcal_inspect seq_b;tiltcal_report;"
+"${MAKE[@]}" all > /dev/null
+
+sleep_past; echo 'edited' >> "$DATA/params/calibrate.txtpb"
+expect "calibrate params rerun calibrate and the report only" "$(planned)" \
+"plot_extrinsics.py;tiltcal_calibrate seq_a;tiltcal_calibrate seq_b;tiltcal_report;"
+"${MAKE[@]}" all > /dev/null
+
+sleep_past; touch "$DATA/params/ground.txtpb"
+expect "editing the ground override again reruns ground" "$(planned ground)" \
+"tiltcal_ground seq_a;tiltcal_ground seq_b;"
+"${MAKE[@]}" all > /dev/null
+
+sleep_past; touch "$DATA/seq_b.bag"
+expect "a changed bag reruns that sequence only" "$(planned seq_b)" \
+"tiltcal_calibrate seq_b;tiltcal_decode seq_b;tiltcal_gravity seq_b;tiltcal_ground seq_b;"
+"${MAKE[@]}" all > /dev/null
+
+sleep_past; rm "$BIN/tiltcal_gravity"; cp "$BIN/stub" "$BIN/tiltcal_gravity"
+expect "a rebuilt gravity binary reruns gravity and downstream" "$(planned calibrate)" \
+"tiltcal_calibrate seq_a;tiltcal_calibrate seq_b;tiltcal_gravity seq_a;tiltcal_gravity seq_b;"
+"${MAKE[@]}" all > /dev/null
+
+# A tilted dataset takes its flat-ground gravity reference from the rig.
+mkdir -p "$DATA/flat"; echo 'gravity_flat_in_imu { z: -9.81 }' > "$DATA/flat/gravity.txtpb"
+sleep_past; printf 'imu_height_m: 0.3\ngravity_reference: "flat/gravity.txtpb"\n' > "$DATA/rig.txtpb"
+"${MAKE[@]}" all > /dev/null
+sleep_past; touch "$DATA/flat/gravity.txtpb"
+expect "a changed gravity reference reruns gravity and downstream" "$(planned calibrate)" \
+"tiltcal_calibrate seq_a;tiltcal_calibrate seq_b;tiltcal_gravity seq_a;tiltcal_gravity seq_b;"
+"${MAKE[@]}" all > /dev/null
+
+sleep_past; touch "$DATA/params/ground.txtpb"
+if TILTCAL_STUB_FAIL=tiltcal_ground "${MAKE[@]}" ground > /dev/null 2>&1; then
+  fail "a failing stage did not fail make"
+fi
+[ ! -e "$DATA/out/seq_a/ground.binpb" ] || fail "a failed stage left its output behind"
+echo "ok: a failed stage leaves no output"
+
+help_text=$("${MAKE[@]}" help); grep -q LAUNCH <<<"$help_text" || fail "help does not document LAUNCH"
+launched=$("${MAKE[@]}" LAUNCH="echo LAUNCHED" -n ground); grep -q "echo LAUNCHED .*tiltcal_ground" <<<"$launched" ||
+  fail "LAUNCH does not prefix stage commands"
+echo "ok: help and LAUNCH"
+"${MAKE[@]}" clean > /dev/null
+[ ! -e "$DATA/out" ] || fail "clean left out/"
+echo "PASS"
