@@ -1,0 +1,78 @@
+#include "stages/simulate/lidar_model.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+namespace tiltcal::simulate {
+
+namespace {
+
+constexpr double kDegToRad = M_PI / 180.0;
+constexpr double kVelodyneSequenceS = 55.296e-6;
+constexpr double kVelodyneSlotS = 2.304e-6;
+
+// Ring numbers: lasers ranked by increasing elevation.
+std::vector<int> RingsByElevation(const std::vector<double>& elevation) {
+  std::vector<int> order(elevation.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(),
+                   [&](int a, int b) { return elevation[a] < elevation[b]; });
+  std::vector<int> ring(elevation.size());
+  for (size_t r = 0; r < order.size(); ++r) ring[order[r]] = static_cast<int>(r);
+  return ring;
+}
+
+}  // namespace
+
+LidarModel Vlp16Model() {
+  // VLP-16 user manual: laser ids 0..15 at −15, 1, −13, 3, … , −1, 15 deg.
+  static const double kElevationDeg[16] = {-15, 1, -13, 3, -11, 5, -9, 7,
+                                           -7,  9, -5,  11, -3, 13, -1, 15};
+  LidarModel m;
+  m.name = "VLP-16";
+  m.kind = LidarModel::Kind::kVelodyne;
+  for (int i = 0; i < 16; ++i) {
+    m.elevation_rad.push_back(kElevationDeg[i] * kDegToRad);
+    m.firing_offset_s.push_back(i * kVelodyneSlotS);
+  }
+  m.ring = RingsByElevation(m.elevation_rad);
+  m.sequence_period_s = kVelodyneSequenceS;
+  return m;
+}
+
+LidarModel Vlp32cModel() {
+  // VLP-32C user manual: vertical angles of laser ids 0..31 (deg); lasers
+  // 2k and 2k+1 fire together in slot k.
+  static const double kElevationDeg[32] = {
+      -25,    -1,     -1.667, -15.639, -11.31, 0,      -0.667, -8.843,
+      -7.254, 0.333,  -0.333, -6.148,  -5.333, 1.333,  0.667,  -4,
+      -4.667, 1.667,  1,      -3.667,  -3.333, 3.333,  2.333,  -2.667,
+      -3,     7,      4.667,  -2.333,  -2,     15,     10.333, -1.333};
+  LidarModel m;
+  m.name = "VLP-32C";
+  m.kind = LidarModel::Kind::kVelodyne;
+  for (int i = 0; i < 32; ++i) {
+    m.elevation_rad.push_back(kElevationDeg[i] * kDegToRad);
+    m.firing_offset_s.push_back((i / 2) * kVelodyneSlotS);
+  }
+  m.ring = RingsByElevation(m.elevation_rad);
+  m.sequence_period_s = kVelodyneSequenceS;
+  return m;
+}
+
+LidarModel Os132Model(int columns) {
+  // OS1-32 (uniform beams): 45 deg vertical field of view, row 0 at +22.5 deg.
+  LidarModel m;
+  m.name = "OS1-32";
+  m.kind = LidarModel::Kind::kOuster;
+  for (int i = 0; i < 32; ++i) {
+    m.elevation_rad.push_back((22.5 - 45.0 * i / 31.0) * kDegToRad);
+    m.ring.push_back(i);
+    m.firing_offset_s.push_back(0.0);
+  }
+  m.columns = columns;
+  return m;
+}
+
+}  // namespace tiltcal::simulate

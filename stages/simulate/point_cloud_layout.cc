@@ -1,0 +1,72 @@
+#include "stages/simulate/point_cloud_layout.h"
+
+#include <cstring>
+#include <vector>
+
+#include "stages/simulate/ros1_messages.h"
+
+namespace tiltcal::simulate {
+
+namespace {
+
+template <typename T>
+inline void Put(char* base, uint32_t offset, T value) {
+  std::memcpy(base + offset, &value, sizeof(T));
+}
+
+}  // namespace
+
+bool SerializeScan(const SimulatedScan& scan, bool ouster, bool append_label, uint32_t seq,
+                   int64_t stamp_ns, const std::string& frame_id, std::string* message) {
+  std::vector<PointField> fields;
+  uint32_t step = 0;
+  if (!ouster) {
+    fields = {{"x", 0, kFloat32, 1},        {"y", 4, kFloat32, 1},
+              {"z", 8, kFloat32, 1},        {"intensity", 12, kFloat32, 1},
+              {"ring", 16, kUint16, 1},     {"time", 18, kFloat32, 1}};
+    step = 22;
+    if (append_label) {
+      fields.push_back({"label", 22, kUint8, 1});
+      step = 23;
+    }
+  } else {
+    fields = {{"x", 0, kFloat32, 1},          {"y", 4, kFloat32, 1},
+              {"z", 8, kFloat32, 1},          {"intensity", 16, kFloat32, 1},
+              {"t", 20, kUint32, 1},          {"reflectivity", 24, kUint16, 1},
+              {"ring", 26, kUint16, 1},       {"ambient", 28, kUint16, 1},
+              {"range", 32, kUint32, 1}};
+    if (append_label) fields.push_back({"label", 30, kUint8, 1});
+    step = 48;
+  }
+  const size_t n = scan.points.size();
+  std::string data(n * step, '\0');
+  char* base = data.data();
+  for (size_t i = 0; i < n; ++i) {
+    const ScanPoint& p = scan.points[i];
+    char* q = base + i * step;
+    Put(q, 0, p.x);
+    Put(q, 4, p.y);
+    Put(q, 8, p.z);
+    if (!ouster) {
+      Put(q, 12, p.intensity);
+      Put(q, 16, p.ring);
+      Put(q, 18, p.time_s);
+      if (append_label) Put(q, 22, p.label);
+    } else {
+      Put(q, 16, p.intensity);
+      Put(q, 20, p.time_ns);
+      Put(q, 24, p.reflectivity);
+      Put(q, 26, p.ring);
+      Put(q, 28, static_cast<uint16_t>(0));
+      if (append_label) Put(q, 30, p.label);
+      Put(q, 32, p.range_mm);
+    }
+  }
+  const uint32_t height = ouster ? static_cast<uint32_t>(scan.rows) : 1u;
+  const uint32_t width = ouster ? static_cast<uint32_t>(scan.columns) : static_cast<uint32_t>(n);
+  const bool dense = !ouster || scan.num_valid == n;
+  return SerializePointCloud2(seq, stamp_ns, frame_id, height, width, fields, step, data, dense,
+                              message);
+}
+
+}  // namespace tiltcal::simulate

@@ -1,0 +1,32 @@
+#ifndef TILTCAL_STAGES_SIMULATE_RANDOM_H_
+#define TILTCAL_STAGES_SIMULATE_RANDOM_H_
+
+#include <cstdint>
+
+namespace tiltcal::simulate {
+
+// A small, portable random generator (xoshiro256** seeded through
+// splitmix64) with its own normal sampler, so a seed gives the same numbers
+// with every compiler and standard library (std:: distributions do not).
+class Rng {
+ public:
+  // Streams with different `stream` values are independent for one seed
+  // (one stream per scan lets scans be simulated in parallel).
+  explicit Rng(uint64_t seed, uint64_t stream = 0);
+
+  uint64_t NextU64();
+  // Uniform in [0, 1).
+  double Uniform();
+  double Uniform(double lo, double hi) { return lo + (hi - lo) * Uniform(); }
+  // Standard normal (Marsaglia polar method).
+  double Gaussian();
+
+ private:
+  uint64_t s_[4];
+  bool have_spare_ = false;
+  double spare_ = 0.0;
+};
+
+}  // namespace tiltcal::simulate
+
+#endif  // TILTCAL_STAGES_SIMULATE_RANDOM_H_

@@ -1,0 +1,83 @@
+#ifndef TILTCAL_STAGES_SIMULATE_ROS1_BAG_WRITER_H_
+#define TILTCAL_STAGES_SIMULATE_ROS1_BAG_WRITER_H_
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "common/io/atomic_file.h"
+#include "common/status.h"
+
+namespace tiltcal::simulate {
+
+// Writes a ROS1 bag, format 2.0, as ros_comm's rosbag does
+// (wiki.ros.org/Bags/Format/2.0; record primitives in stages/decode/ros1_format.h):
+//   version line · bag header (padded to 4096 bytes, rewritten on Close) ·
+//   { chunk (connection records on first use + message data records),
+//     compressed none / bz2 / lz4 (one LZ4 frame, 1 MiB independent blocks,
+//     content checksum, as roslz4) · one index data record per connection } ·
+//   connection records · chunk info records.
+// A chunk is closed when its uncompressed size reaches the threshold. The
+// output is written atomically: nothing is left at `path` unless Close()
+// succeeds. The bytes depend only on the calls made (no clock, no host data).
+class Ros1BagWriter {
+ public:
+  enum class Compression { kNone, kBz2, kLz4 };
+
+  Ros1BagWriter() = default;
+  Ros1BagWriter(const Ros1BagWriter&) = delete;
+  Ros1BagWriter& operator=(const Ros1BagWriter&) = delete;
+
+  Status Open(const std::string& path, Compression compression, uint32_t chunk_threshold_bytes);
+  // Registers a connection (topic, message type); returns its id.
+  uint32_t AddConnection(const std::string& topic, const std::string& type,
+                         const std::string& md5sum, const std::string& definition);
+  // Appends one serialized message with record time `time_ns` (ns since epoch).
+  Status Write(uint32_t connection, int64_t time_ns, std::string_view message);
+  // Flushes the last chunk, writes the index section and the final bag header.
+  Status Close();
+
+  uint64_t bytes_written() const { return position_; }
+  static const char* CompressionName(Compression compression);
+
+ private:
+  struct Connection {
+    std::string topic;
+    std::string type;
+    std::string md5sum;
+    std::string definition;
+    bool written = false;  // its record has been put into a chunk
+  };
+  struct IndexEntry {
+    int64_t time_ns;
+    uint32_t offset;
+  };
+  struct ChunkInfo {
+    uint64_t position;
+    int64_t start_ns, end_ns;
+    std::map<uint32_t, uint32_t> counts;  // connection -> messages
+  };
+
+  Status WriteBytes(std::string_view bytes);
+  Status FlushChunk();
+  std::string BagHeaderRecord(uint64_t index_position) const;
+  std::string ConnectionRecord(uint32_t id) const;
+
+  AtomicFile file_;
+  std::string path_;
+  Compression compression_ = Compression::kNone;
+  uint32_t chunk_threshold_ = 768 * 1024;
+  uint64_t position_ = 0;
+  std::vector<Connection> connections_;
+  std::string chunk_;  // uncompressed records of the open chunk
+  std::map<uint32_t, std::vector<IndexEntry>> chunk_index_;
+  int64_t chunk_start_ns_ = 0, chunk_end_ns_ = 0;
+  std::vector<ChunkInfo> chunk_infos_;
+  bool open_ = false;
+};
+
+}  // namespace tiltcal::simulate
+
+#endif  // TILTCAL_STAGES_SIMULATE_ROS1_BAG_WRITER_H_

@@ -1,0 +1,228 @@
+#include "stages/simulate/ros1_messages.h"
+
+#include <cstring>
+
+#include "stages/decode/ros1_format.h"
+
+namespace tiltcal::simulate {
+
+// Full message definitions as recorded by rosbag (the top-level .msg, then
+// each dependency after a line of 80 '=' and "MSG: pkg/Type"), from
+// ros/common_msgs (sensor_msgs, geometry_msgs) and ros/std_msgs, noetic.
+const char kImuDefinition[] = R"msgdef(# This is a message to hold data from an IMU (Inertial Measurement Unit)
+#
+# Accelerations should be in m/s^2 (not in g's), and rotational velocity should be in rad/sec
+#
+# If the covariance of the measurement is known, it should be filled in (if all you know is the 
+# variance of each measurement, e.g. from the datasheet, just put those along the diagonal)
+# A covariance matrix of all zeros will be interpreted as "covariance unknown", and to use the
+# data a covariance will have to be assumed or gotten from some other source
+#
+# If you have no estimate for one of the data elements (e.g. your IMU doesn't produce an orientation 
+# estimate), please set element 0 of the associated covariance matrix to -1
+# If you are interpreting this message, please check for a value of -1 in the first element of each 
+# covariance matrix, and disregard the associated estimate.
+
+Header header
+
+geometry_msgs/Quaternion orientation
+float64[9] orientation_covariance # Row major about x, y, z axes
+
+geometry_msgs/Vector3 angular_velocity
+float64[9] angular_velocity_covariance # Row major about x, y, z axes
+
+geometry_msgs/Vector3 linear_acceleration
+float64[9] linear_acceleration_covariance # Row major x, y z 
+
+================================================================================
+MSG: std_msgs/Header
+# Standard metadata for higher-level stamped data types.
+# This is generally used to communicate timestamped data 
+# in a particular coordinate frame.
+# 
+# sequence ID: consecutively increasing ID 
+uint32 seq
+#Two-integer timestamp that is expressed as:
+# * stamp.sec: seconds (stamp_secs) since epoch (in Python the variable is called 'secs')
+# * stamp.nsec: nanoseconds since stamp_secs (in Python the variable is called 'nsecs')
+# time-handling sugar is provided by the client library
+time stamp
+#Frame this data is associated with
+string frame_id
+
+================================================================================
+MSG: geometry_msgs/Quaternion
+# This represents an orientation in free space in quaternion form.
+
+float64 x
+float64 y
+float64 z
+float64 w
+
+================================================================================
+MSG: geometry_msgs/Vector3
+# This represents a vector in free space. 
+# It is only meant to represent a direction. Therefore, it does not
+# make sense to apply a translation to it (e.g., when applying a 
+# generic rigid transformation to a Vector3, tf2 will only apply the
+# rotation). If you want your data to be translatable too, use the
+# geometry_msgs/Point message instead.
+
+float64 x
+float64 y
+float64 z)msgdef";
+
+const char kPointCloud2Definition[] = R"msgdef(# This message holds a collection of N-dimensional points, which may
+# contain additional information such as normals, intensity, etc. The
+# point data is stored as a binary blob, its layout described by the
+# contents of the "fields" array.
+
+# The point cloud data may be organized 2d (image-like) or 1d
+# (unordered). Point clouds organized as 2d images may be produced by
+# camera depth sensors such as stereo or time-of-flight.
+
+# Time of sensor data acquisition, and the coordinate frame ID (for 3d
+# points).
+Header header
+
+# 2D structure of the point cloud. If the cloud is unordered, height is
+# 1 and width is the length of the point cloud.
+uint32 height
+uint32 width
+
+# Describes the channels and their layout in the binary data blob.
+PointField[] fields
+
+bool    is_bigendian # Is this data bigendian?
+uint32  point_step   # Length of a point in bytes
+uint32  row_step     # Length of a row in bytes
+uint8[] data         # Actual point data, size is (row_step*height)
+
+bool is_dense        # True if there are no invalid points
+
+================================================================================
+MSG: std_msgs/Header
+# Standard metadata for higher-level stamped data types.
+# This is generally used to communicate timestamped data 
+# in a particular coordinate frame.
+# 
+# sequence ID: consecutively increasing ID 
+uint32 seq
+#Two-integer timestamp that is expressed as:
+# * stamp.sec: seconds (stamp_secs) since epoch (in Python the variable is called 'secs')
+# * stamp.nsec: nanoseconds since stamp_secs (in Python the variable is called 'nsecs')
+# time-handling sugar is provided by the client library
+time stamp
+#Frame this data is associated with
+string frame_id
+
+================================================================================
+MSG: sensor_msgs/PointField
+# This message holds the description of one point entry in the
+# PointCloud2 message format.
+uint8 INT8    = 1
+uint8 UINT8   = 2
+uint8 INT16   = 3
+uint8 UINT16  = 4
+uint8 INT32   = 5
+uint8 UINT32  = 6
+uint8 FLOAT32 = 7
+uint8 FLOAT64 = 8
+
+string name      # Name of field
+uint32 offset    # Offset from start of point struct
+uint8  datatype  # Datatype enumeration, see above
+uint32 count     # How many elements in the field
+)msgdef";
+
+const RosMessageType& ImuMessageType() {
+  static const RosMessageType kType{"sensor_msgs/Imu", "6a62c6daae103f4ff57a132d6f95cec2",
+                                    kImuDefinition};
+  return kType;
+}
+
+const RosMessageType& PointCloud2MessageType() {
+  static const RosMessageType kType{"sensor_msgs/PointCloud2",
+                                    "1158d486dd51d683ce2f1be655c3c181", kPointCloud2Definition};
+  return kType;
+}
+
+namespace {
+
+void AppendString(std::string* out, const std::string& s) {
+  ros1::AppendU32Le(out, static_cast<uint32_t>(s.size()));
+  out->append(s);
+}
+
+void AppendVector3(std::string* out, const Eigen::Vector3d& v) {
+  ros1::AppendLe(out, v.x());
+  ros1::AppendLe(out, v.y());
+  ros1::AppendLe(out, v.z());
+}
+
+// float64[9], diagonal.
+void AppendCovariance(std::string* out, double diagonal, double first) {
+  for (int i = 0; i < 9; ++i) {
+    double value = (i % 4 == 0) ? diagonal : 0.0;
+    if (i == 0) value = first;
+    ros1::AppendLe(out, value);
+  }
+}
+
+}  // namespace
+
+bool AppendHeader(std::string* out, uint32_t seq, int64_t stamp_ns, const std::string& frame_id) {
+  ros1::RosTime t;
+  if (!ros1::NsToRosTime(stamp_ns, &t)) return false;
+  ros1::AppendU32Le(out, seq);
+  ros1::AppendRosTime(out, t);
+  AppendString(out, frame_id);
+  return true;
+}
+
+bool SerializeImu(uint32_t seq, int64_t stamp_ns, const std::string& frame_id,
+                  const Eigen::Vector3d& angular_velocity_radps,
+                  const Eigen::Vector3d& linear_acceleration_mps2, double gyro_variance,
+                  double accel_variance, std::string* out) {
+  out->clear();
+  out->reserve(320 + frame_id.size());
+  if (!AppendHeader(out, seq, stamp_ns, frame_id)) return false;
+  // orientation (x, y, z, w): not provided.
+  ros1::AppendLe(out, 0.0);
+  ros1::AppendLe(out, 0.0);
+  ros1::AppendLe(out, 0.0);
+  ros1::AppendLe(out, 1.0);
+  AppendCovariance(out, 0.0, -1.0);
+  AppendVector3(out, angular_velocity_radps);
+  AppendCovariance(out, gyro_variance, gyro_variance);
+  AppendVector3(out, linear_acceleration_mps2);
+  AppendCovariance(out, accel_variance, accel_variance);
+  return true;
+}
+
+bool SerializePointCloud2(uint32_t seq, int64_t stamp_ns, const std::string& frame_id,
+                          uint32_t height, uint32_t width, const std::vector<PointField>& fields,
+                          uint32_t point_step, const std::string& data, bool is_dense,
+                          std::string* out) {
+  out->clear();
+  out->reserve(data.size() + 64 + 32 * fields.size() + frame_id.size());
+  if (!AppendHeader(out, seq, stamp_ns, frame_id)) return false;
+  ros1::AppendU32Le(out, height);
+  ros1::AppendU32Le(out, width);
+  ros1::AppendU32Le(out, static_cast<uint32_t>(fields.size()));
+  for (const PointField& f : fields) {
+    AppendString(out, f.name);
+    ros1::AppendU32Le(out, f.offset);
+    out->push_back(static_cast<char>(f.datatype));
+    ros1::AppendU32Le(out, f.count);
+  }
+  out->push_back(0);  // is_bigendian
+  ros1::AppendU32Le(out, point_step);
+  ros1::AppendU32Le(out, width * point_step);  // row_step
+  ros1::AppendU32Le(out, static_cast<uint32_t>(data.size()));
+  out->append(data);
+  out->push_back(is_dense ? 1 : 0);
+  return true;
+}
+
+}  // namespace tiltcal::simulate

@@ -1,0 +1,161 @@
+#include "stages/simulate/scan_simulator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "stages/simulate/random.h"
+
+namespace tiltcal::simulate {
+
+namespace {
+
+constexpr double kTwoPi = 2.0 * M_PI;
+// Random stream of sweep k (stream 0 is the IMU's, 1 the world's).
+constexpr uint64_t kSweepStreamBase = 1000;
+
+int VelodyneSequences(const ScanConfig& config) {
+  return static_cast<int>(std::floor(1.0 / (config.scan_rate_hz * config.model.sequence_period_s)));
+}
+
+// Synthetic intensity: a per-surface reflectivity times |cos(incidence)|.
+float Intensity(Surface surface, double cos_incidence, uint16_t* reflectivity) {
+  double base = 0.0;
+  switch (surface) {
+    case Surface::kGround: base = 20.0; break;
+    case Surface::kWall: base = 60.0; break;
+    case Surface::kBox: base = 100.0; break;
+    case Surface::kPillar: base = 140.0; break;
+    default: break;
+  }
+  *reflectivity = static_cast<uint16_t>(base);
+  return static_cast<float>(std::round(base * (0.3 + 0.7 * std::abs(cos_incidence))));
+}
+
+}  // namespace
+
+int64_t SweepStartNs(const ScanConfig& config, int k) {
+  return std::llround((config.first_scan_time_s + k / config.scan_rate_hz) * 1e9);
+}
+
+double SweepSpanS(const ScanConfig& config) {
+  const LidarModel& m = config.model;
+  if (m.kind == LidarModel::Kind::kOuster) {
+    return (m.columns - 1) / (config.scan_rate_hz * m.columns);
+  }
+  return (VelodyneSequences(config) - 1) * m.sequence_period_s +
+         *std::max_element(m.firing_offset_s.begin(), m.firing_offset_s.end());
+}
+
+SimulatedScan SimulateSweep(const ScanConfig& config, const PlanarTrajectory& trajectory,
+                            const World& world, uint64_t seed, int k) {
+  const LidarModel& m = config.model;
+  Rng rng(seed, kSweepStreamBase + static_cast<uint64_t>(k));
+  SimulatedScan scan;
+  const int64_t start_ns = SweepStartNs(config, k);
+  const double start_s = start_ns * 1e-9;
+  const int lasers = m.num_lasers();
+
+  // Unit direction of laser i at horizontal angle alpha, frame l.
+  std::vector<double> cos_el(lasers), sin_el(lasers);
+  for (int i = 0; i < lasers; ++i) {
+    cos_el[i] = std::cos(m.elevation_rad[i]);
+    sin_el[i] = std::sin(m.elevation_rad[i]);
+  }
+
+  const Eigen::Matrix3d& c_bl = config.imu_from_lidar_rotation;
+  const Eigen::Vector3d& r_b = config.imu_from_lidar_translation;
+  // Pose of the LiDAR at true time t (s since the first IMU sample).
+  auto lidar_pose = [&](double t, Eigen::Matrix3d* c_wl, Eigen::Vector3d* r_wl) {
+    Eigen::Matrix3d c_wb;
+    Eigen::Vector3d r_wb;
+    trajectory.Pose(t, &c_wb, &r_wb);
+    *c_wl = c_wb * c_bl;
+    *r_wl = r_wb + c_wb * r_b;
+  };
+  // Casts laser i at horizontal angle alpha from the pose; fills *p.
+  auto cast = [&](const Eigen::Matrix3d& c_wl, const Eigen::Vector3d& r_wl, int i, double alpha,
+                  ScanPoint* p) {
+    const Eigen::Vector3d d_l(cos_el[i] * std::cos(alpha), cos_el[i] * std::sin(alpha),
+                              sin_el[i]);
+    const Eigen::Vector3d d_w = c_wl * d_l;
+    RayHit hit;
+    p->ring = static_cast<uint16_t>(m.ring[i]);
+    // Cast a little beyond the limits: noise may bring the range back inside.
+    const double margin = 6.0 * config.range_noise_m;
+    if (!world.Cast(r_wl, d_w, std::max(0.0, config.min_range_m - margin),
+                    config.max_range_m + margin, &hit)) {
+      return;
+    }
+    const double range = hit.range + config.range_noise_m * rng.Gaussian();
+    if (range < config.min_range_m || range > config.max_range_m) return;
+    const Eigen::Vector3d q = range * d_l;
+    p->x = static_cast<float>(q.x());
+    p->y = static_cast<float>(q.y());
+    p->z = static_cast<float>(q.z());
+    p->intensity = Intensity(hit.surface, hit.normal.dot(d_w), &p->reflectivity);
+    p->range_mm = static_cast<uint32_t>(std::llround(range * 1000.0));
+    p->label = static_cast<uint8_t>(hit.surface);
+    p->valid = true;
+  };
+
+  if (m.kind == LidarModel::Kind::kVelodyne) {
+    const int sequences = VelodyneSequences(config);
+    const double span = SweepSpanS(config);
+    const int64_t stamp_ns =
+        config.velodyne_stamp_at_start ? start_ns : start_ns + std::llround(span * 1e9);
+    scan.stamp_true_ns = stamp_ns;
+    const double start_minus_stamp_s = (start_ns - stamp_ns) * 1e-9;
+    scan.points.reserve(static_cast<size_t>(sequences) * lasers);
+    Eigen::Matrix3d c_wl;
+    Eigen::Vector3d r_wl;
+    double pose_offset = std::numeric_limits<double>::quiet_NaN();
+    for (int j = 0; j < sequences; ++j) {
+      for (int i = 0; i < lasers; ++i) {
+        const double offset = j * m.sequence_period_s + m.firing_offset_s[i];
+        if (offset != pose_offset) {  // lasers sharing a slot share the pose
+          lidar_pose(start_s + offset, &c_wl, &r_wl);
+          pose_offset = offset;
+        }
+        const double alpha = -kTwoPi * config.scan_rate_hz * offset;
+        ScanPoint p;
+        cast(c_wl, r_wl, i, alpha, &p);
+        if (!p.valid) continue;
+        p.time_s = static_cast<float>(start_minus_stamp_s + offset);
+        ++scan.num_valid;
+        if (p.label == static_cast<uint8_t>(Surface::kGround)) ++scan.num_ground;
+        scan.points.push_back(p);
+      }
+    }
+    scan.rows = 1;
+    scan.columns = static_cast<int>(scan.points.size());
+  } else {
+    const int columns = m.columns;
+    scan.stamp_true_ns = start_ns;
+    scan.rows = lasers;
+    scan.columns = columns;
+    scan.points.resize(static_cast<size_t>(lasers) * columns);
+    const double column_period_ns = 1e9 / (config.scan_rate_hz * columns);
+    Eigen::Matrix3d c_wl;
+    Eigen::Vector3d r_wl;
+    for (int c = 0; c < columns; ++c) {
+      const int64_t t_ns = std::llround(c * column_period_ns);
+      lidar_pose((start_ns + t_ns) * 1e-9, &c_wl, &r_wl);
+      const double alpha = -kTwoPi * c / columns;
+      for (int i = 0; i < lasers; ++i) {
+        ScanPoint& p = scan.points[static_cast<size_t>(i) * columns + c];
+        cast(c_wl, r_wl, i, alpha, &p);
+        p.time_ns = static_cast<uint32_t>(t_ns);
+        if (!p.valid) {
+          p.x = p.y = p.z = std::numeric_limits<float>::quiet_NaN();
+          continue;
+        }
+        ++scan.num_valid;
+        if (p.label == static_cast<uint8_t>(Surface::kGround)) ++scan.num_ground;
+      }
+    }
+  }
+  return scan;
+}
+
+}  // namespace tiltcal::simulate

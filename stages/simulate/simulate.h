@@ -1,0 +1,61 @@
+#ifndef TILTCAL_STAGES_SIMULATE_SIMULATE_H_
+#define TILTCAL_STAGES_SIMULATE_SIMULATE_H_
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+
+#include <Eigen/Core>
+
+#include "common/status.h"
+#include "stages/simulate/scan_simulator.h"
+#include "stages/simulate/trajectory.h"
+#include "stages/simulate/world.h"
+#include "tiltcal/proto/simulate_params.pb.h"
+#include "tiltcal/proto/truth.pb.h"
+
+namespace tiltcal::simulate {
+
+struct SimulateOutputs {
+  std::string bag_path;    // required
+  std::string truth_path;  // required
+  std::string rig_path;    // optional ("" = none)
+  std::string command_line;
+  // Called after each written scan (done, total) when set.
+  std::function<void(int, int)> progress;
+};
+
+struct SimulateSummary {
+  int num_imu_samples = 0;
+  int num_scans = 0;
+  uint64_t num_points = 0;
+  uint64_t bag_bytes = 0;
+  double raycast_seconds = 0.0;  // wall time in ray casting + serialization
+  double total_seconds = 0.0;
+};
+
+// Simulates the scenario and writes the bag (IMU + LiDAR), the truth file and
+// optionally a rig file. The bag bytes depend only on `params` (same seed,
+// same bytes, for any num_threads). `params` must have passed LoadParams.
+Status Run(const proto::SimulateParams& params, const SimulateOutputs& outputs,
+           SimulateSummary* summary);
+
+// The scene, motion and sensors a params file describes (I/O-free; tests
+// use it to evaluate the true trajectory).
+struct Scenario {
+  std::unique_ptr<PlanarTrajectory> trajectory;
+  std::unique_ptr<World> world;
+  ScanConfig scan;
+  Eigen::Vector3d gravity_w;        // (0, 0, −g)
+  int num_imu_samples = 0;
+  int num_scans = 0;
+  int64_t time_offset_ns = 0;       // τ in ns
+};
+// Checks the params beyond their schema bounds (ranges, room size, sensor
+// above the ground, stamps representable) and builds the scenario.
+Status BuildScenario(const proto::SimulateParams& params, Scenario* scenario);
+
+}  // namespace tiltcal::simulate
+
+#endif  // TILTCAL_STAGES_SIMULATE_SIMULATE_H_

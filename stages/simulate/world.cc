@@ -1,0 +1,148 @@
+#include "stages/simulate/world.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace tiltcal::simulate {
+
+World::World(const Eigen::Vector3d& ground_normal_w, double room_half_size_m,
+             double wall_height_m)
+    : normal_(ground_normal_w.normalized()),
+      half_size_(room_half_size_m),
+      wall_height_(wall_height_m) {}
+
+double World::GroundZ(double x, double y) const {
+  return -(normal_.x() * x + normal_.y() * y) / normal_.z();
+}
+
+void World::AddBox(const Box& box) {
+  boxes_.push_back(box);
+  const double hx = 0.5 * (box.max_x - box.min_x), hy = 0.5 * (box.max_y - box.min_y);
+  box_bounds_.push_back({0.5 * (box.min_x + box.max_x), 0.5 * (box.min_y + box.max_y),
+                         std::sqrt(hx * hx + hy * hy), box.top_z});
+}
+
+void World::AddPillar(const Pillar& pillar) { pillars_.push_back(pillar); }
+
+namespace {
+
+// Entry parameter of the ray (o, d) in (x, y) into a circle (c, r), or +inf
+// when the infinite vertical cylinder is missed or lies behind.
+inline double CircleEntry(double ox, double oy, double dx, double dy, double cx, double cy,
+                          double r, double* exit) {
+  const double px = ox - cx, py = oy - cy;
+  const double a = dx * dx + dy * dy;
+  if (a < 1e-18) return std::numeric_limits<double>::infinity();
+  const double b = px * dx + py * dy;  // half of the linear coefficient
+  const double c = px * px + py * py - r * r;
+  const double disc = b * b - a * c;
+  if (disc < 0.0) return std::numeric_limits<double>::infinity();
+  const double sq = std::sqrt(disc);
+  *exit = (-b + sq) / a;
+  return (-b - sq) / a;
+}
+
+}  // namespace
+
+bool World::Cast(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double min_range,
+                 double max_range, RayHit* hit) const {
+  double best = max_range;
+  Surface surface = Surface::kNone;
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+
+  // Ground plane n · x = 0 (the sensor is above it, n · o > 0).
+  const double denom = normal_.dot(d);
+  if (denom < 0.0) {
+    const double s = -normal_.dot(o) / denom;
+    if (s >= min_range && s <= best) {
+      best = s;
+      surface = Surface::kGround;
+      normal = normal_;
+    }
+  }
+
+  // Room walls (from inside): planes x = ±h, y = ±h, up to wall_height above
+  // the local ground.
+  if (wall_height_ > 0.0) {
+    for (int axis = 0; axis < 2; ++axis) {
+      const double da = d[axis];
+      if (std::abs(da) < 1e-12) continue;
+      const double wall = da > 0.0 ? half_size_ : -half_size_;
+      const double s = (wall - o[axis]) / da;
+      if (s < min_range || s > best) continue;
+      const Eigen::Vector3d p = o + s * d;
+      const int other = 1 - axis;
+      if (std::abs(p[other]) > half_size_) continue;
+      if (p.z() > GroundZ(p.x(), p.y()) + wall_height_) continue;
+      best = s;
+      surface = Surface::kWall;
+      normal = Eigen::Vector3d::Zero();
+      normal[axis] = da > 0.0 ? -1.0 : 1.0;
+    }
+  }
+
+  // Boxes: early-out on the bounding circle, then the slab test.
+  for (size_t i = 0; i < boxes_.size(); ++i) {
+    const Bound& bound = box_bounds_[i];
+    double exit = 0.0;
+    const double entry = CircleEntry(o.x(), o.y(), d.x(), d.y(), bound.cx, bound.cy,
+                                     bound.radius, &exit);
+    if (!(entry < best) || exit < min_range) continue;
+    const Box& box = boxes_[i];
+    double t0 = -std::numeric_limits<double>::infinity();
+    double t1 = std::numeric_limits<double>::infinity();
+    int entry_axis = -1;
+    bool miss = false;
+    const double lo[3] = {box.min_x, box.min_y, -1e6};
+    const double hi[3] = {box.max_x, box.max_y, box.top_z};
+    for (int axis = 0; axis < 3; ++axis) {
+      if (std::abs(d[axis]) < 1e-15) {
+        if (o[axis] < lo[axis] || o[axis] > hi[axis]) {
+          miss = true;
+          break;
+        }
+        continue;
+      }
+      double ta = (lo[axis] - o[axis]) / d[axis];
+      double tb = (hi[axis] - o[axis]) / d[axis];
+      if (ta > tb) std::swap(ta, tb);
+      if (ta > t0) {
+        t0 = ta;
+        entry_axis = axis;
+      }
+      t1 = std::min(t1, tb);
+      if (t0 > t1) {
+        miss = true;
+        break;
+      }
+    }
+    if (miss || entry_axis < 0 || t0 < min_range || t0 > best) continue;
+    best = t0;
+    surface = Surface::kBox;
+    normal = Eigen::Vector3d::Zero();
+    normal[entry_axis] = d[entry_axis] > 0.0 ? -1.0 : 1.0;
+  }
+
+  // Pillars: vertical cylinders, side surface only.
+  for (const Pillar& pillar : pillars_) {
+    double exit = 0.0;
+    const double s = CircleEntry(o.x(), o.y(), d.x(), d.y(), pillar.center_x, pillar.center_y,
+                                 pillar.radius, &exit);
+    if (!(s < best) || s < min_range) continue;
+    const Eigen::Vector3d p = o + s * d;
+    if (p.z() > pillar.top_z) continue;
+    best = s;
+    surface = Surface::kPillar;
+    normal = Eigen::Vector3d(p.x() - pillar.center_x, p.y() - pillar.center_y, 0.0) /
+             pillar.radius;
+  }
+
+  if (surface == Surface::kNone) return false;
+  hit->range = best;
+  hit->surface = surface;
+  hit->normal = normal;
+  return true;
+}
+
+}  // namespace tiltcal::simulate
