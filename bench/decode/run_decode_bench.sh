@@ -57,6 +57,7 @@ DEBIAN_PYTHON=/usr/bin/python3
 BENCH_DIR="$REPO/bench/decode"
 WORK="$SCRATCH/tiltcal_decode_bench"
 LOGS="$WORK/logs"
+rm -rf "$LOGS"
 mkdir -p "$LOGS"
 log() { echo "run_decode_bench: $*" >&2; }
 
@@ -83,7 +84,14 @@ apt_install librosbag-storage-dev libsensor-msgs-dev ||
   { HAVE_ROS_CPP=0; log "C++ rosbag library not installable: no C++ anchor"; }
 
 # ---- Build (Release). ----
-cmake -S "$REPO" -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=Release >"$LOGS/cmake.log" 2>&1
+# Tests are not needed here (and a test directory being edited by someone
+# else must not stop the benchmark).
+if ! cmake -S "$REPO" -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=Release \
+    -DTILTCAL_BUILD_TESTS=OFF >"$LOGS/cmake.log" 2>&1; then
+  log "cmake configure failed, see $LOGS/cmake.log"
+  grep -A3 'CMake Error' "$LOGS/cmake.log" >&2 || true
+  exit 1
+fi
 HAVE_DECODE=1
 if ! cmake --build "$BUILD_DIR" --target tiltcal_decode -j2 >"$LOGS/build_decode.log" 2>&1; then
   HAVE_DECODE=0
@@ -124,24 +132,28 @@ SMALL_BAG=$(make_bag "$SMALL_GB")
 meta() { sed -n "s/^$2=//p" "$1.meta"; }
 
 # ---- Timed runs. ----
-# Results, one line per run: label bag wall_s max_rss_kb points_read exit
+# Results, one line per run: label bag wall_s max_rss_kb points_read exit cpu_s
 RESULTS="$LOGS/results.txt"
 : >"$RESULTS"
 # run_timed LABEL BAG POINTS_READ_CMD|- CMD...   (POINTS_READ "-" = all points of BAG)
 run_timed() {
   local label=$1 bag=$2 i=$3
   shift 3
-  local tlog="$LOGS/$label.$i.time" out="$LOGS/$label.$i.out"
+  local tag
+  tag="$label.$(basename "$bag" .bag).$i"
+  local tlog="$LOGS/$tag.time" out="$LOGS/$tag.out"
   local status=0
   /usr/bin/time -v -o "$tlog" "$@" >"$out" 2>&1 || status=$?
   local wall rss
   wall=$(awk -F': ' '/Elapsed \(wall clock\)/ { n = split($2, p, ":"); s = 0;
            for (k = 1; k <= n; ++k) s = s * 60 + p[k]; print s }' "$tlog")
   rss=$(awk -F': ' '/Maximum resident set size/ { print $2 }' "$tlog")
+  local cpu
+  cpu=$(awk -F': ' '/User time \(seconds\)|System time \(seconds\)/ { s += $2 } END { print s }' "$tlog")
   local points
   points=$(sed -n 's/.* points=\([0-9]*\).*/\1/p' "$out" | tail -1)
   [ -z "$points" ] && points=$(meta "$bag" points)
-  echo "$label $bag $wall $rss $points $status" >>"$RESULTS"
+  echo "$label $bag $wall $rss $points $status $cpu" >>"$RESULTS"
   if [ $status -ne 0 ]; then
     log "$label failed (exit $status), output in $out:"
     tail -5 "$out" >&2
@@ -156,10 +168,11 @@ run_decode() {  # LABEL BAG REPEAT
   mkdir -p "$outdir"
   run_timed "$1" "$2" "$3" "$DECODE" --bag="$2" --params="$PARAMS" \
     --out_imu="$outdir/imu.binpb" --out_scans="$outdir/scans.binpb.lz4"
-  ls -l "$outdir" >>"$LOGS/$1.$3.out" 2>&1 || true
+  ls -l "$outdir" >>"$LOGS/$1.$(basename "$2" .bag).$3.out" 2>&1 || true
   rm -rf "$outdir"
 }
 
+LOAD_BEFORE=$(cut -d' ' -f1-3 /proc/loadavg)
 warm "$BAG"
 for ((r = 1; r <= REPEATS; ++r)); do
   log "run $r/$REPEATS on $(basename "$BAG")"
@@ -193,8 +206,10 @@ for b in "$BAG" "$SMALL_BAG"; do
   echo "  $(basename "$b"): $(meta "$b" bytes) bytes, $(meta "$b" clouds) clouds," \
     "$(meta "$b" points) points, $(meta "$b" imu) imu messages"
 done
-echo "  MB = 1e6 bytes of the bag file; median wall of $REPEATS runs for tiltcal_decode and"
-echo "  the C++ reader, largest peak RSS; ratio = C++ rosbag wall / tool wall on the same bag."
+echo "  MB = 1e6 bytes of the bag file; median wall and cpu (user + sys) of $REPEATS runs for"
+echo "  tiltcal_decode and the C++ reader, largest peak RSS; vs C++ = C++ rosbag wall / tool wall"
+echo "  on the same bag (> 1: faster than the C++ rosbag library); cpu vs = the same on cpu s."
+echo "  Load average before the runs: $LOAD_BEFORE"
 awk -v big="$BAG" '
   function median(list, n,   a, i, j, t) {
     n = split(list, a, " ")
@@ -205,29 +220,33 @@ awk -v big="$BAG" '
     key = $1 SUBSEP $2
     if (!(key in walls)) { order[++n] = key }
     walls[key] = walls[key] " " $3
+    cpus[key] = cpus[key] " " $7
     if ($4 > rss[key]) rss[key] = $4
     points[key] = $5
     if ($6 != 0) failed[key] = 1
   }
   END {
-    printf "\n%-28s %-22s %8s %8s %10s %9s %10s\n", "tool", "bag", "wall s", "MB/s", "Mpoints/s", "RSS MB", "vs C++"
+    printf "\n%-40s %-21s %7s %7s %7s %9s %7s %7s %7s\n", "tool", "bag", "wall s", "cpu s", "MB/s", "Mpoints/s", "RSS MB", "vs C++", "cpu vs"
     anchor_key = "rosbag_cpp" SUBSEP big
     anchor = (anchor_key in walls) ? median(walls[anchor_key]) : 0
+    anchor_cpu = (anchor_key in cpus) ? median(cpus[anchor_key]) : 0
     for (k = 1; k <= n; ++k) {
       key = order[k]; split(key, parts, SUBSEP)
       w = median(walls[key])
       cmd = "stat -c %s " parts[2]; cmd | getline size; close(cmd)
       name = parts[1]
       if (failed[key]) name = name " (FAILED)"
+      c = median(cpus[key])
       ratio = (anchor > 0 && parts[2] == big && w > 0) ? sprintf("%.2fx", anchor / w) : "-"
+      cratio = (anchor_cpu > 0 && parts[2] == big && c > 0) ? sprintf("%.2fx", anchor_cpu / c) : "-"
       bn = parts[2]; sub(".*/", "", bn)
       # A prefix run (python read_points with --python_max_bytes) reads only
       # part of the bag: MB/s is scaled by the fraction of points it read.
       cmd = "sed -n s/^points=//p " parts[2] ".meta"; cmd | getline total; close(cmd)
       frac = (total > 0) ? points[key] / total : 1
-      if (frac < 0.999) { name = name sprintf(" [%.0f%% prefix]", 100 * frac); if (ratio != "-") ratio = sprintf("%.2fx", anchor * frac / w) }
-      printf "%-28s %-22s %8.2f %8.1f %10.2f %9.1f %10s\n", name, bn, w,
-             (w > 0 ? size * frac / w / 1e6 : 0), (w > 0 ? points[key] / w / 1e6 : 0), rss[key] / 1024, ratio
+      if (frac < 0.999) { name = name sprintf(" [%.0f%% prefix]", 100 * frac); if (ratio != "-") { ratio = sprintf("%.2fx", anchor * frac / w); cratio = sprintf("%.2fx", anchor_cpu * frac / c) } }
+      printf "%-40s %-21s %7.2f %7.2f %7.1f %9.2f %7.1f %7s %7s\n", name, bn, w, c,
+             (w > 0 ? size * frac / w / 1e6 : 0), (w > 0 ? points[key] / w / 1e6 : 0), rss[key] / 1024, ratio, cratio
     }
   }' "$RESULTS" | tee "$LOGS/table.txt"
 echo
