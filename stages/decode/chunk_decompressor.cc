@@ -1,0 +1,137 @@
+#include "stages/decode/chunk_decompressor.h"
+
+#include <bzlib.h>
+
+#include <cstring>
+#include <string>
+
+namespace tiltcal::ros1 {
+
+bool ParseChunkCompression(std::string_view name, ChunkCompression* compression) {
+  if (name == "none") {
+    *compression = ChunkCompression::kNone;
+  } else if (name == "bz2") {
+    *compression = ChunkCompression::kBz2;
+  } else if (name == "lz4") {
+    *compression = ChunkCompression::kLz4;
+  } else {
+    return false;
+  }
+  return true;
+}
+
+const char* ChunkCompressionName(ChunkCompression compression) {
+  switch (compression) {
+    case ChunkCompression::kNone: return "none";
+    case ChunkCompression::kBz2: return "bz2";
+    case ChunkCompression::kLz4: return "lz4";
+  }
+  return "?";
+}
+
+namespace {
+
+const char* Bz2ErrorName(int code) {
+  switch (code) {
+    case BZ_DATA_ERROR: return "corrupt data (CRC or stream error)";
+    case BZ_DATA_ERROR_MAGIC: return "no bzip2 magic";
+    case BZ_UNEXPECTED_EOF: return "compressed data ends early";
+    case BZ_OUTBUFF_FULL: return "decompresses to more than the chunk size";
+    case BZ_MEM_ERROR: return "out of memory";
+    case BZ_PARAM_ERROR: return "bad parameters";
+    case BZ_CONFIG_ERROR: return "libbz2 misconfigured";
+    default: return "error";
+  }
+}
+
+}  // namespace
+
+ChunkDecompressor::ChunkDecompressor() = default;
+
+ChunkDecompressor::~ChunkDecompressor() {
+  if (lz4_ != nullptr) LZ4F_freeDecompressionContext(lz4_);
+}
+
+Status ChunkDecompressor::Decompress(ChunkCompression compression, const uint8_t* src,
+                                     size_t src_size, uint8_t* dst, size_t dst_size) {
+  switch (compression) {
+    case ChunkCompression::kNone:
+      if (src_size != dst_size) {
+        return Status::Error("uncompressed chunk has " + std::to_string(src_size) +
+                             " data bytes but declares size " + std::to_string(dst_size));
+      }
+      if (src != dst && src_size > 0) std::memcpy(dst, src, src_size);
+      return Status::Ok();
+    case ChunkCompression::kBz2: {
+      if (src_size > UINT32_MAX || dst_size > UINT32_MAX) {
+        return Status::Error("bz2 chunk larger than 4 GiB");
+      }
+      unsigned int produced = static_cast<unsigned int>(dst_size);
+      const int rc = BZ2_bzBuffToBuffDecompress(
+          reinterpret_cast<char*>(dst), &produced,
+          const_cast<char*>(reinterpret_cast<const char*>(src)),
+          static_cast<unsigned int>(src_size), /*small=*/0, /*verbosity=*/0);
+      if (rc != BZ_OK) {
+        return Status::Error(std::string("bz2 decompression failed: ") + Bz2ErrorName(rc) +
+                             " (libbz2 code " + std::to_string(rc) + ")");
+      }
+      if (produced != dst_size) {
+        return Status::Error("bz2 data decompresses to " + std::to_string(produced) +
+                             " bytes, chunk size is " + std::to_string(dst_size));
+      }
+      return Status::Ok();
+    }
+    case ChunkCompression::kLz4:
+      return DecompressLz4(src, src_size, dst, dst_size);
+  }
+  return Status::Error("unknown chunk compression");
+}
+
+Status ChunkDecompressor::DecompressLz4(const uint8_t* src, size_t src_size, uint8_t* dst,
+                                        size_t dst_size) {
+  if (lz4_ == nullptr) {
+    const LZ4F_errorCode_t rc = LZ4F_createDecompressionContext(&lz4_, LZ4F_VERSION);
+    if (LZ4F_isError(rc)) {
+      lz4_ = nullptr;
+      return Status::Error(std::string("cannot create an LZ4 context: ") + LZ4F_getErrorName(rc));
+    }
+  }
+  size_t consumed = 0;
+  size_t produced = 0;
+  size_t hint = 1;
+  // One ROS1 lz4 chunk is one LZ4 frame; loop until the frame ends (hint 0).
+  while (hint != 0) {
+    size_t in = src_size - consumed;
+    size_t out = dst_size - produced;
+    if (in == 0) {
+      LZ4F_resetDecompressionContext(lz4_);
+      return Status::Error("lz4 frame ends early: " + std::to_string(produced) + " of " +
+                           std::to_string(dst_size) + " bytes decoded from all " +
+                           std::to_string(src_size) + " compressed bytes");
+    }
+    hint = LZ4F_decompress(lz4_, dst + produced, &out, src + consumed, &in, nullptr);
+    if (LZ4F_isError(hint)) {
+      LZ4F_resetDecompressionContext(lz4_);
+      return Status::Error(std::string("lz4 decompression failed: ") + LZ4F_getErrorName(hint) +
+                           " (at compressed byte " + std::to_string(consumed) + ")");
+    }
+    consumed += in;
+    produced += out;
+    if (hint != 0 && in == 0 && out == 0) {
+      LZ4F_resetDecompressionContext(lz4_);
+      return Status::Error("lz4 data decompresses to more than the chunk size " +
+                           std::to_string(dst_size));
+    }
+  }
+  if (produced != dst_size) {
+    return Status::Error("lz4 data decompresses to " + std::to_string(produced) +
+                         " bytes, chunk size is " + std::to_string(dst_size));
+  }
+  if (consumed != src_size) {
+    return Status::Error("lz4 frame ends " + std::to_string(src_size - consumed) +
+                         " bytes before the chunk data ends");
+  }
+  return Status::Ok();
+}
+
+}  // namespace tiltcal::ros1

@@ -1,0 +1,44 @@
+#ifndef TILTCAL_STAGES_DECODE_CHUNK_DECOMPRESSOR_H_
+#define TILTCAL_STAGES_DECODE_CHUNK_DECOMPRESSOR_H_
+
+#include <cstddef>
+#include <cstdint>
+#include <string_view>
+
+#include <lz4frame.h>
+
+#include "common/status.h"
+
+namespace tiltcal::ros1 {
+
+// Compression of a ROS1 chunk record (header field "compression").
+enum class ChunkCompression : uint8_t { kNone, kBz2, kLz4 };
+
+// Parses "none" / "bz2" / "lz4"; false for anything else.
+bool ParseChunkCompression(std::string_view name, ChunkCompression* compression);
+const char* ChunkCompressionName(ChunkCompression compression);
+
+// Decompresses chunk data into a buffer of exactly the chunk's `size` bytes.
+//   bz2: one bzip2 stream (libbz2 BZ2_bzBuffToBuffDecompress);
+//   lz4: one LZ4 frame as written by roslz4 (liblz4 LZ4F_decompress; the
+//        frame's content checksum is verified by liblz4).
+// The result must fill `dst_size` bytes exactly and consume all of `src`;
+// otherwise the error says what differed (the caller adds file and chunk).
+class ChunkDecompressor {
+ public:
+  ChunkDecompressor();
+  ~ChunkDecompressor();
+  ChunkDecompressor(const ChunkDecompressor&) = delete;
+  ChunkDecompressor& operator=(const ChunkDecompressor&) = delete;
+
+  Status Decompress(ChunkCompression compression, const uint8_t* src, size_t src_size,
+                    uint8_t* dst, size_t dst_size);
+
+ private:
+  Status DecompressLz4(const uint8_t* src, size_t src_size, uint8_t* dst, size_t dst_size);
+  LZ4F_dctx* lz4_ = nullptr;
+};
+
+}  // namespace tiltcal::ros1
+
+#endif  // TILTCAL_STAGES_DECODE_CHUNK_DECOMPRESSOR_H_

@@ -1,0 +1,62 @@
+#ifndef TILTCAL_STAGES_DECODE_DECODE_H_
+#define TILTCAL_STAGES_DECODE_DECODE_H_
+
+// The decode stage: a ROS1 bag -> imu.binpb (tiltcal.proto.ImuSample records)
+// and scans.binpb.lz4 (tiltcal.proto.Scan records, LZ4-framed), both with
+// provenance, both strictly increasing in stamp_ns.
+
+#include <cstdint>
+#include <cstdio>
+#include <map>
+#include <string>
+
+#include "common/status.h"
+#include "tiltcal/proto/decode_params.pb.h"
+
+namespace tiltcal {
+
+struct DecodeInputs {
+  std::string bag_path;
+  std::string rig_path;  // optional: topics from rig.txtpb
+  std::string out_imu_path;
+  std::string out_scans_path;
+  std::string command_line;  // recorded in the provenance
+  // Where the progress (only when it is a terminal) and the final summary
+  // go; nullptr = silent.
+  std::FILE* log = stderr;
+};
+
+// What a run did, for the summary and for tests.
+struct DecodeSummary {
+  std::string imu_topic;
+  std::string lidar_topic;
+  bool indexed = true;
+  int64_t salvaged_messages = 0;
+  std::string salvage_note;
+  int64_t imu_messages = 0;         // read from the bag (inside the window)
+  int64_t imu_written = 0;
+  int64_t imu_duplicates_dropped = 0;   // same stamp and same values
+  int64_t imu_conflicting_dropped = 0;  // same stamp, other values (first kept)
+  int64_t scan_messages = 0;
+  int64_t scans_written = 0;
+  int64_t scans_non_monotonic_dropped = 0;
+  int64_t scans_empty_dropped = 0;  // no valid point left
+  int64_t scans_without_point_time = 0;
+  int64_t points_written = 0;
+  int64_t points_dropped_invalid = 0;
+  int64_t points_dropped_range = 0;
+  int64_t imu_first_stamp_ns = 0, imu_last_stamp_ns = 0;
+  int64_t scan_first_stamp_ns = 0, scan_last_stamp_ns = 0;
+  uint64_t bag_bytes = 0;
+  uint64_t chunks_decompressed = 0;
+  double wall_s = 0.0;
+};
+
+// Runs the stage. Errors are one line naming the file and the record.
+// Outputs appear only when the whole run succeeded.
+Status Run(const DecodeInputs& inputs, const proto::DecodeParams& params,
+           DecodeSummary* summary = nullptr);
+
+}  // namespace tiltcal
+
+#endif  // TILTCAL_STAGES_DECODE_DECODE_H_

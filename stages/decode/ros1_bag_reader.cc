@@ -1,0 +1,768 @@
+#include "stages/decode/ros1_bag_reader.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <set>
+#include <tuple>
+#include <unordered_map>
+
+namespace tiltcal::ros1 {
+
+// A chunk record: where its data is and how to decompress it.
+struct Ros1BagReader::Chunk {
+  uint64_t pos = 0;        // file offset of the chunk record
+  uint64_t data_pos = 0;   // file offset of its (compressed) data
+  uint32_t data_len = 0;   // compressed bytes
+  uint32_t size = 0;       // uncompressed bytes
+  ChunkCompression compression = ChunkCompression::kNone;
+  uint64_t index_pos = 0;  // first index data record after the chunk (indexed bags)
+  // (connection slot, message count) from the chunk info record.
+  std::vector<std::pair<int, uint32_t>> connection_counts;
+};
+
+// Where one message record is: 16 bytes per message.
+struct Ros1BagReader::Entry {
+  int64_t time_ns;
+  uint32_t chunk;   // index into chunks_ (sorted by file position)
+  uint32_t offset;  // record offset in the uncompressed chunk
+};
+
+namespace {
+
+// A growable byte buffer that does not zero-fill.
+class ByteBuffer {
+ public:
+  uint8_t* Reserve(size_t size) {
+    if (size > capacity_) {
+      data_.reset(new uint8_t[size]);
+      capacity_ = size;
+    }
+    return data_.get();
+  }
+  uint8_t* data() { return data_.get(); }
+
+ private:
+  std::unique_ptr<uint8_t[]> data_;
+  size_t capacity_ = 0;
+};
+
+std::string Quoted(const std::string& s) { return "'" + s + "'"; }
+
+}  // namespace
+
+// LRU cache of decompressed chunks, keyed by chunk index.
+class Ros1BagReader::ChunkCache {
+ public:
+  explicit ChunkCache(size_t capacity) : slots_(std::max<size_t>(capacity, 1)) {}
+
+  // The decompressed bytes of chunk `chunk`, loading it on a miss.
+  Status Get(Ros1BagReader* reader, uint32_t chunk, const uint8_t** data) {
+    ++clock_;
+    Slot* victim = &slots_[0];
+    for (Slot& slot : slots_) {
+      if (slot.chunk == static_cast<int64_t>(chunk)) {
+        slot.last_use = clock_;
+        *data = slot.buffer.data();
+        return Status::Ok();
+      }
+      if (slot.last_use < victim->last_use) victim = &slot;
+    }
+    victim->chunk = -1;
+    uint8_t* dst = victim->buffer.Reserve(std::max<size_t>(reader->chunks_[chunk].size, 1));
+    TILTCAL_RETURN_IF_ERROR(reader->LoadChunk(chunk, &compressed_, dst));
+    victim->chunk = chunk;
+    victim->last_use = clock_;
+    *data = dst;
+    return Status::Ok();
+  }
+
+ private:
+  struct Slot {
+    int64_t chunk = -1;
+    uint64_t last_use = 0;
+    ByteBuffer buffer;
+  };
+  std::vector<Slot> slots_;
+  std::vector<uint8_t> compressed_;
+  uint64_t clock_ = 0;
+};
+
+Ros1BagReader::Ros1BagReader() = default;
+
+Ros1BagReader::~Ros1BagReader() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+Status Ros1BagReader::Error(uint64_t pos, const std::string& what) const {
+  return Status::Error(path_ + ": record at byte " + std::to_string(pos) + ": " + what);
+}
+
+Status Ros1BagReader::ReadAt(uint64_t pos, size_t size, void* dst) const {
+  if (pos > file_size_ || size > file_size_ - pos) {
+    return Status::Error(path_ + ": read of " + std::to_string(size) + " bytes at byte " +
+                         std::to_string(pos) + " runs past the end of the file (" +
+                         std::to_string(file_size_) + " bytes; truncated?)");
+  }
+  auto* out = static_cast<char*>(dst);
+  size_t done = 0;
+  while (done < size) {
+    const ssize_t n = ::pread(fd_, out + done, size - done, static_cast<off_t>(pos + done));
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      return Status::Error(path_ + ": read error at byte " + std::to_string(pos + done) + ": " +
+                           (n < 0 ? std::strerror(errno) : "unexpected end of file"));
+    }
+    done += static_cast<size_t>(n);
+  }
+  return Status::Ok();
+}
+
+Status Ros1BagReader::ReadRecordHeaderAt(uint64_t pos, std::string* buffer,
+                                         RecordHeader* header, uint64_t* data_pos,
+                                         uint32_t* data_len) const {
+  if (pos > file_size_ || file_size_ - pos < 8) {
+    return Error(pos, "record runs past the end of the file (" + std::to_string(file_size_) +
+                          " bytes; truncated?)");
+  }
+  uint32_t header_len = 0;
+  TILTCAL_RETURN_IF_ERROR(ReadAt(pos, 4, &header_len));
+  if (header_len > file_size_ - pos - 8) {
+    return Error(pos, "header length " + std::to_string(header_len) +
+                          " runs past the end of the file (" + std::to_string(file_size_) +
+                          " bytes; truncated?)");
+  }
+  buffer->resize(header_len + 4);
+  TILTCAL_RETURN_IF_ERROR(ReadAt(pos + 4, header_len + 4, buffer->data()));
+  *data_len = LoadU32Le(buffer->data() + header_len);
+  *data_pos = pos + 8 + header_len;
+  if (*data_len > file_size_ - *data_pos) {
+    return Error(pos, "data length " + std::to_string(*data_len) +
+                          " runs past the end of the file (" + std::to_string(file_size_) +
+                          " bytes; truncated?)");
+  }
+  Status status = header->Parse(buffer->data(), header_len);
+  if (!status.ok()) return Error(pos, status.message());
+  return Status::Ok();
+}
+
+int Ros1BagReader::ConnectionSlot(uint32_t id) const {
+  for (size_t i = 0; i < connections_.size(); ++i) {
+    if (connections_[i].id == id) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+Status Ros1BagReader::AddConnection(const RecordHeader& header, const uint8_t* data,
+                                    size_t size, uint64_t pos) {
+  Connection connection;
+  Status status = header.GetU32("conn", &connection.id);
+  if (status.ok()) status = header.GetString("topic", &connection.topic);
+  RecordHeader inner;
+  if (status.ok()) status = inner.Parse(data, size);
+  if (!status.ok()) return Error(pos, "connection record: " + status.message());
+  if (ConnectionSlot(connection.id) >= 0) return Status::Ok();  // seen in a chunk already
+  // The inner block may lack `topic` (recorded live); the outer one is authoritative.
+  if (inner.Has("type")) (void)inner.GetString("type", &connection.type);
+  if (inner.Has("md5sum")) (void)inner.GetString("md5sum", &connection.md5sum);
+  if (inner.Has("message_definition")) {
+    (void)inner.GetString("message_definition", &connection.message_definition);
+  }
+  if (inner.Has("callerid")) (void)inner.GetString("callerid", &connection.callerid);
+  connections_.push_back(std::move(connection));
+  message_counts_.push_back(0);
+  entries_.emplace_back();
+  entries_loaded_.push_back(!indexed_);
+  return Status::Ok();
+}
+
+Status Ros1BagReader::Open(const std::string& path) {
+  path_ = path;
+  fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd_ < 0) return Status::Error(path + ": cannot open: " + std::strerror(errno));
+  struct stat st;
+  if (::fstat(fd_, &st) != 0) return Status::Error(path + ": cannot stat: " + std::strerror(errno));
+  if (!S_ISREG(st.st_mode)) return Status::Error(path + ": not a regular file");
+  file_size_ = static_cast<uint64_t>(st.st_size);
+  if (file_size_ == 0) return Status::Error(path + ": empty file (0 bytes), not a ROS bag");
+
+  // Version line.
+  char magic[16] = {};
+  const size_t magic_size = static_cast<size_t>(std::min<uint64_t>(file_size_, sizeof(magic)));
+  TILTCAL_RETURN_IF_ERROR(ReadAt(0, magic_size, magic));
+  const std::string_view head(magic, magic_size);
+  if (head.substr(0, kVersionLine.size()) != kVersionLine) {
+    if (head.rfind("#ROSRECORD V1.2", 0) == 0 || head.rfind("#ROSBAG V1.", 0) == 0) {
+      return Status::Error(path + ": ROS bag format V1.2 is not supported (only V2.0, "
+                                  "written by ROS since 2010)");
+    }
+    if (head.rfind("#ROSBAG V", 0) == 0 || head.rfind("#ROSRECORD V", 0) == 0) {
+      return Status::Error(path + ": unsupported ROS bag version '" +
+                           std::string(head.substr(0, head.find('\n'))) + "' (only V2.0)");
+    }
+    if (head.rfind("SQLite format 3", 0) == 0) {
+      return Status::Error(path + ": a ROS 2 sqlite3 bag (.db3); only ROS1 .bag files are "
+                                  "supported");
+    }
+    if (head.rfind("\x89MCAP", 0) == 0) {
+      return Status::Error(path + ": an MCAP file; only ROS1 .bag files are supported");
+    }
+    return Status::Error(path + ": not a ROS1 bag: wrong magic (expected \"#ROSBAG V2.0\")");
+  }
+
+  // Bag header record.
+  const uint64_t header_pos = kVersionLine.size();
+  std::string buffer;
+  RecordHeader header;
+  uint64_t data_pos = 0;
+  uint32_t data_len = 0;
+  TILTCAL_RETURN_IF_ERROR(ReadRecordHeaderAt(header_pos, &buffer, &header, &data_pos, &data_len));
+  uint8_t op = 0;
+  uint64_t index_pos = 0;
+  uint32_t conn_count = 0;
+  uint32_t chunk_count = 0;
+  Status status = header.GetOp(&op);
+  if (status.ok() && op != static_cast<uint8_t>(Op::kBagHeader)) {
+    status = Status::Error(std::string("expected the bag header record, found op ") +
+                           std::to_string(op) + " (" + OpName(op) + ")");
+  }
+  if (status.ok()) status = header.GetU64("index_pos", &index_pos);
+  if (status.ok()) status = header.GetU32("conn_count", &conn_count);
+  if (status.ok()) status = header.GetU32("chunk_count", &chunk_count);
+  if (!status.ok()) return Error(header_pos, "bag header: " + status.message());
+  if (const std::string_view* encryptor = header.Find("encryptor");
+      encryptor != nullptr && !encryptor->empty()) {
+    return Status::Error(path + ": encrypted bag (encryptor=" + std::string(*encryptor) +
+                         ") is not supported");
+  }
+  const uint64_t first_record_pos = data_pos + data_len;
+  if (index_pos == 0) {
+    indexed_ = false;
+    return ScanUnindexed(first_record_pos);
+  }
+  if (index_pos < first_record_pos) {
+    return Error(header_pos, "bag header: index_pos " + std::to_string(index_pos) +
+                                 " points inside the bag header");
+  }
+  return ReadIndexed(index_pos, conn_count, chunk_count);
+}
+
+Status Ros1BagReader::ReadIndexed(uint64_t index_pos, uint32_t conn_count,
+                                  uint32_t chunk_count) {
+  if (index_pos > file_size_) {
+    return Status::Error(path_ + ": bag is truncated: its index at byte " +
+                         std::to_string(index_pos) + " lies past the end of the file (" +
+                         std::to_string(file_size_) + " bytes)");
+  }
+  std::string buffer;
+  std::string data;
+  RecordHeader header;
+  uint64_t pos = index_pos;
+  uint64_t data_pos = 0;
+  uint32_t data_len = 0;
+  uint8_t op = 0;
+  for (uint32_t i = 0; i < conn_count; ++i) {
+    TILTCAL_RETURN_IF_ERROR(ReadRecordHeaderAt(pos, &buffer, &header, &data_pos, &data_len));
+    Status status = header.GetOp(&op);
+    if (!status.ok()) return Error(pos, status.message());
+    if (op != static_cast<uint8_t>(Op::kConnection)) {
+      return Error(pos, "expected connection record " + std::to_string(i + 1) + " of " +
+                            std::to_string(conn_count) + ", found op " + std::to_string(op) +
+                            " (" + OpName(op) + ")");
+    }
+    data.resize(data_len);
+    TILTCAL_RETURN_IF_ERROR(ReadAt(data_pos, data_len, data.data()));
+    TILTCAL_RETURN_IF_ERROR(AddConnection(
+        header, reinterpret_cast<const uint8_t*>(data.data()), data.size(), pos));
+    pos = data_pos + data_len;
+  }
+  std::set<uint64_t> chunk_positions;
+  for (uint32_t i = 0; i < chunk_count; ++i) {
+    TILTCAL_RETURN_IF_ERROR(ReadRecordHeaderAt(pos, &buffer, &header, &data_pos, &data_len));
+    Chunk chunk;
+    uint32_t version = 0;
+    uint32_t count = 0;
+    RosTime start;
+    RosTime end;
+    Status status = header.GetOp(&op);
+    if (status.ok() && op != static_cast<uint8_t>(Op::kChunkInfo)) {
+      status = Status::Error("expected chunk info record " + std::to_string(i + 1) + " of " +
+                             std::to_string(chunk_count) + ", found op " + std::to_string(op) +
+                             " (" + OpName(op) + ")");
+    }
+    if (status.ok()) status = header.GetU32("ver", &version);
+    if (status.ok() && version != kChunkInfoVersion) {
+      status = Status::Error("chunk info version " + std::to_string(version) + " (expected 1)");
+    }
+    if (status.ok()) status = header.GetU64("chunk_pos", &chunk.pos);
+    if (status.ok()) status = header.GetTime("start_time", &start);
+    if (status.ok()) status = header.GetTime("end_time", &end);
+    if (status.ok()) status = header.GetU32("count", &count);
+    if (status.ok() && static_cast<uint64_t>(count) * 8 != data_len) {
+      status = Status::Error("chunk info lists " + std::to_string(count) +
+                             " connections but has " + std::to_string(data_len) +
+                             " data bytes (expected " + std::to_string(uint64_t{count} * 8) + ")");
+    }
+    if (status.ok() && !chunk_positions.insert(chunk.pos).second) {
+      status = Status::Error("chunk at byte " + std::to_string(chunk.pos) + " listed twice");
+    }
+    if (!status.ok()) return Error(pos, status.message());
+    data.resize(data_len);
+    TILTCAL_RETURN_IF_ERROR(ReadAt(data_pos, data_len, data.data()));
+    uint64_t messages_in_chunk = 0;
+    for (uint32_t k = 0; k < count; ++k) {
+      const uint32_t conn = LoadU32Le(data.data() + 8 * k);
+      const uint32_t messages = LoadU32Le(data.data() + 8 * k + 4);
+      const int slot = ConnectionSlot(conn);
+      if (slot < 0) {
+        return Error(pos, "chunk info refers to unknown connection " + std::to_string(conn));
+      }
+      chunk.connection_counts.emplace_back(slot, messages);
+      message_counts_[slot] += messages;
+      messages_in_chunk += messages;
+    }
+    if (messages_in_chunk > 0) {
+      start_ns_ = std::min(start_ns_, RosTimeToNs(start));
+      end_ns_ = std::max(end_ns_, RosTimeToNs(end));
+    }
+    chunks_.push_back(std::move(chunk));
+    pos = data_pos + data_len;
+  }
+  // Chunk headers: compression, sizes; index data records follow the data.
+  for (Chunk& chunk : chunks_) {
+    TILTCAL_RETURN_IF_ERROR(
+        ReadRecordHeaderAt(chunk.pos, &buffer, &header, &chunk.data_pos, &chunk.data_len));
+    std::string compression;
+    Status status = header.GetOp(&op);
+    if (status.ok() && op != static_cast<uint8_t>(Op::kChunk)) {
+      status = Status::Error("chunk info points to a record with op " + std::to_string(op) +
+                             " (" + OpName(op) + "), not a chunk");
+    }
+    if (status.ok()) status = header.GetString("compression", &compression);
+    if (status.ok()) status = header.GetU32("size", &chunk.size);
+    if (status.ok() && !ParseChunkCompression(compression, &chunk.compression)) {
+      status = Status::Error("unsupported chunk compression " + Quoted(compression) +
+                             " (supported: none, bz2, lz4)");
+    }
+    if (status.ok() && chunk.compression == ChunkCompression::kNone &&
+        chunk.size != chunk.data_len) {
+      status = Status::Error("uncompressed chunk of size " + std::to_string(chunk.size) +
+                             " has " + std::to_string(chunk.data_len) + " data bytes");
+    }
+    if (!status.ok()) return Error(chunk.pos, "chunk: " + status.message());
+    chunk.index_pos = chunk.data_pos + chunk.data_len;
+  }
+  std::sort(chunks_.begin(), chunks_.end(),
+            [](const Chunk& a, const Chunk& b) { return a.pos < b.pos; });
+  return Status::Ok();
+}
+
+Status Ros1BagReader::ReadChunkIndex(size_t chunk_index,
+                                     const std::vector<size_t>& connection_slots) {
+  const Chunk& chunk = chunks_[chunk_index];
+  std::string buffer;
+  RecordHeader header;
+  uint64_t pos = chunk.index_pos;
+  uint64_t data_pos = 0;
+  uint32_t data_len = 0;
+  std::string data;
+  for (size_t k = 0; k < chunk.connection_counts.size(); ++k) {
+    TILTCAL_RETURN_IF_ERROR(ReadRecordHeaderAt(pos, &buffer, &header, &data_pos, &data_len));
+    uint8_t op = 0;
+    uint32_t version = 0;
+    uint32_t conn = 0;
+    uint32_t count = 0;
+    Status status = header.GetOp(&op);
+    if (status.ok() && op != static_cast<uint8_t>(Op::kIndexData)) {
+      status = Status::Error("expected index data record " + std::to_string(k + 1) + " of " +
+                             std::to_string(chunk.connection_counts.size()) +
+                             " of the chunk at byte " + std::to_string(chunk.pos) +
+                             ", found op " + std::to_string(op) + " (" + OpName(op) + ")");
+    }
+    if (status.ok()) status = header.GetU32("ver", &version);
+    if (status.ok() && version != kIndexDataVersion) {
+      status = Status::Error("index data version " + std::to_string(version) + " (expected 1)");
+    }
+    if (status.ok()) status = header.GetU32("conn", &conn);
+    if (status.ok()) status = header.GetU32("count", &count);
+    if (status.ok() && uint64_t{count} * kIndexEntrySize != data_len) {
+      status = Status::Error("index data with " + std::to_string(count) + " entries has " +
+                             std::to_string(data_len) + " data bytes");
+    }
+    int slot = -1;
+    if (status.ok()) {
+      slot = ConnectionSlot(conn);
+      auto it = std::find_if(chunk.connection_counts.begin(), chunk.connection_counts.end(),
+                             [&](const auto& c) { return c.first == slot; });
+      if (slot < 0 || it == chunk.connection_counts.end()) {
+        status = Status::Error("index data for connection " + std::to_string(conn) +
+                               " which the chunk info of the chunk at byte " +
+                               std::to_string(chunk.pos) + " does not list");
+      } else if (it->second != count) {
+        status = Status::Error("index data of connection " + std::to_string(conn) + " has " +
+                               std::to_string(count) + " entries, the chunk info says " +
+                               std::to_string(it->second));
+      }
+    }
+    if (!status.ok()) return Error(pos, status.message());
+    if (std::find(connection_slots.begin(), connection_slots.end(), static_cast<size_t>(slot)) !=
+        connection_slots.end()) {
+      data.resize(data_len);
+      TILTCAL_RETURN_IF_ERROR(ReadAt(data_pos, data_len, data.data()));
+      std::vector<Entry>& entries = entries_[slot];
+      for (uint32_t i = 0; i < count; ++i) {
+        const char* e = data.data() + i * kIndexEntrySize;
+        const uint32_t offset = LoadU32Le(e + 8);
+        if (offset >= chunk.size) {
+          return Error(pos, "index entry " + std::to_string(i) + " has offset " +
+                                std::to_string(offset) + " past the chunk size " +
+                                std::to_string(chunk.size));
+        }
+        entries.push_back(
+            Entry{RosTimeToNs(LoadRosTime(e)), static_cast<uint32_t>(chunk_index), offset});
+      }
+    }
+    pos = data_pos + data_len;
+  }
+  return Status::Ok();
+}
+
+Status Ros1BagReader::LoadChunk(size_t chunk_index, std::vector<uint8_t>* compressed,
+                                uint8_t* dst) {
+  const Chunk& chunk = chunks_[chunk_index];
+  stats_.chunks_decompressed += 1;
+  stats_.compressed_bytes_read += chunk.data_len;
+  stats_.uncompressed_bytes += chunk.size;
+  if (chunk.compression == ChunkCompression::kNone) {
+    return ReadAt(chunk.data_pos, chunk.data_len, dst);
+  }
+  if (compressed->size() < chunk.data_len) compressed->resize(chunk.data_len);
+  TILTCAL_RETURN_IF_ERROR(ReadAt(chunk.data_pos, chunk.data_len, compressed->data()));
+  Status status = decompressor_.Decompress(chunk.compression, compressed->data(),
+                                           chunk.data_len, dst, chunk.size);
+  if (!status.ok()) {
+    return Error(chunk.pos, std::string(ChunkCompressionName(chunk.compression)) +
+                                " chunk (" + std::to_string(chunk.data_len) + " -> " +
+                                std::to_string(chunk.size) + " bytes): " + status.message());
+  }
+  return Status::Ok();
+}
+
+namespace {
+
+// One record inside a decompressed chunk buffer.
+struct BufferRecord {
+  RecordHeader header;
+  uint8_t op = 0;
+  const uint8_t* data = nullptr;
+  uint32_t data_len = 0;
+  size_t end = 0;  // offset just past the record
+};
+
+// Parses the record at `offset` of `buffer` (size `size`); every length must
+// stay inside the buffer.
+Status ParseBufferRecord(const uint8_t* buffer, size_t size, size_t offset, BufferRecord* r) {
+  if (offset > size || size - offset < 4) {
+    return Status::Error("record header length at chunk offset " + std::to_string(offset) +
+                         " runs past the chunk end " + std::to_string(size));
+  }
+  const uint32_t header_len = LoadU32Le(buffer + offset);
+  if (header_len > size - offset - 4 || size - offset - 4 - header_len < 4) {
+    return Status::Error("record header at chunk offset " + std::to_string(offset) +
+                         " (length " + std::to_string(header_len) +
+                         ") runs past the chunk end " + std::to_string(size));
+  }
+  const size_t data_pos = offset + 4 + header_len + 4;
+  r->data_len = LoadU32Le(buffer + data_pos - 4);
+  if (r->data_len > size - data_pos) {
+    return Status::Error("record data at chunk offset " + std::to_string(offset) + " (length " +
+                         std::to_string(r->data_len) + ") runs past the chunk end " +
+                         std::to_string(size));
+  }
+  r->data = buffer + data_pos;
+  r->end = data_pos + r->data_len;
+  Status status = r->header.Parse(buffer + offset + 4, header_len);
+  if (status.ok()) status = r->header.GetOp(&r->op);
+  if (!status.ok()) {
+    return Status::Error("record at chunk offset " + std::to_string(offset) + ": " +
+                         status.message());
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status Ros1BagReader::ScanUnindexed(uint64_t first_record_pos) {
+  std::string buffer;
+  RecordHeader header;
+  std::string data;
+  std::vector<uint8_t> compressed;
+  ByteBuffer decompressed;
+  uint64_t pos = first_record_pos;
+  auto note = [&](const std::string& what) { salvage_note_ = what; };
+  auto add_entry = [&](uint32_t conn, RosTime time, uint32_t chunk, uint32_t offset) {
+    const int slot = ConnectionSlot(conn);
+    if (slot < 0) return;  // message of a connection never described: unusable
+    const int64_t time_ns = RosTimeToNs(time);
+    entries_[slot].push_back(Entry{time_ns, chunk, offset});
+    message_counts_[slot] += 1;
+    start_ns_ = std::min(start_ns_, time_ns);
+    end_ns_ = std::max(end_ns_, time_ns);
+    ++num_salvaged_;
+  };
+  while (pos < file_size_) {
+    uint64_t data_pos = 0;
+    uint32_t data_len = 0;
+    Status status = ReadRecordHeaderAt(pos, &buffer, &header, &data_pos, &data_len);
+    if (!status.ok()) {
+      note("stopped at an incomplete record at byte " + std::to_string(pos) + " (" +
+           std::to_string(file_size_ - pos) + " bytes to the end of the file)");
+      break;
+    }
+    uint8_t op = 0;
+    if (!header.GetOp(&op).ok()) {
+      note("stopped at a record without op at byte " + std::to_string(pos));
+      break;
+    }
+    if (op == static_cast<uint8_t>(Op::kConnection)) {
+      data.resize(data_len);
+      TILTCAL_RETURN_IF_ERROR(ReadAt(data_pos, data_len, data.data()));
+      TILTCAL_RETURN_IF_ERROR(AddConnection(
+          header, reinterpret_cast<const uint8_t*>(data.data()), data.size(), pos));
+    } else if (op == static_cast<uint8_t>(Op::kChunk)) {
+      Chunk chunk;
+      chunk.pos = pos;
+      chunk.data_pos = data_pos;
+      chunk.data_len = data_len;
+      std::string compression;
+      status = header.GetString("compression", &compression);
+      if (status.ok()) status = header.GetU32("size", &chunk.size);
+      if (status.ok() && !ParseChunkCompression(compression, &chunk.compression)) {
+        status = Status::Error("unsupported chunk compression " + Quoted(compression));
+      }
+      if (!status.ok()) {
+        note("stopped at a bad chunk at byte " + std::to_string(pos) + ": " + status.message());
+        break;
+      }
+      const uint32_t chunk_index = static_cast<uint32_t>(chunks_.size());
+      if (chunk.size == 0 && data_len == 0) {
+        // A chunk still open when recording stopped: its records run to EOF.
+        if (chunk.compression != ChunkCompression::kNone) {
+          note(std::string("the open ") + ChunkCompressionName(chunk.compression) +
+               " chunk at byte " + std::to_string(pos) +
+               " cannot be recovered (its compressor kept the data)");
+          break;
+        }
+        uint64_t p = data_pos;
+        while (p < file_size_) {
+          uint64_t rec_data_pos = 0;
+          uint32_t rec_data_len = 0;
+          if (!ReadRecordHeaderAt(p, &buffer, &header, &rec_data_pos, &rec_data_len).ok()) break;
+          uint8_t rec_op = 0;
+          if (!header.GetOp(&rec_op).ok()) break;
+          if (rec_op == static_cast<uint8_t>(Op::kConnection)) {
+            data.resize(rec_data_len);
+            TILTCAL_RETURN_IF_ERROR(ReadAt(rec_data_pos, rec_data_len, data.data()));
+            if (!AddConnection(header, reinterpret_cast<const uint8_t*>(data.data()),
+                               data.size(), p).ok()) {
+              break;
+            }
+          } else if (rec_op == static_cast<uint8_t>(Op::kMessageData)) {
+            uint32_t conn = 0;
+            RosTime time;
+            if (!header.GetU32("conn", &conn).ok() || !header.GetTime("time", &time).ok()) break;
+            add_entry(conn, time, chunk_index, static_cast<uint32_t>(p - data_pos));
+          } else {
+            break;
+          }
+          p = rec_data_pos + rec_data_len;
+        }
+        chunk.data_len = static_cast<uint32_t>(p - data_pos);
+        chunk.size = chunk.data_len;
+        chunks_.push_back(std::move(chunk));
+        if (p < file_size_) {
+          note("the open chunk at byte " + std::to_string(pos) + " ends with " +
+               std::to_string(file_size_ - p) + " bytes of an incomplete record");
+        }
+        pos = file_size_;
+        break;
+      }
+      chunks_.push_back(chunk);
+      uint8_t* dst = decompressed.Reserve(std::max<uint32_t>(chunk.size, 1));
+      status = LoadChunk(chunk_index, &compressed, dst);
+      size_t offset = 0;
+      while (status.ok() && offset < chunk.size) {
+        BufferRecord record;
+        status = ParseBufferRecord(dst, chunk.size, offset, &record);
+        if (!status.ok()) break;
+        if (record.op == static_cast<uint8_t>(Op::kConnection)) {
+          status = AddConnection(record.header, record.data, record.data_len, pos);
+        } else if (record.op == static_cast<uint8_t>(Op::kMessageData)) {
+          uint32_t conn = 0;
+          RosTime time;
+          status = record.header.GetU32("conn", &conn);
+          if (status.ok()) status = record.header.GetTime("time", &time);
+          if (status.ok()) add_entry(conn, time, chunk_index, static_cast<uint32_t>(offset));
+        }
+        offset = record.end;
+      }
+      if (!status.ok()) {
+        note("stopped at the damaged chunk at byte " + std::to_string(pos) + ": " +
+             status.message());
+        break;
+      }
+    } else if (op == static_cast<uint8_t>(Op::kIndexData) ||
+               op == static_cast<uint8_t>(Op::kChunkInfo)) {
+      // Index records: the scan rebuilds the index from the chunks themselves.
+    } else {
+      note("stopped at an unexpected record (op " + std::to_string(op) + ", " + OpName(op) +
+           ") at byte " + std::to_string(pos));
+      break;
+    }
+    pos = data_pos + data_len;
+  }
+  for (auto& entries : entries_) {
+    std::sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) {
+      return std::tie(a.time_ns, a.chunk, a.offset) < std::tie(b.time_ns, b.chunk, b.offset);
+    });
+  }
+  return Status::Ok();
+}
+
+std::vector<std::string> Ros1BagReader::TopicsOfType(const std::string& type) const {
+  std::set<std::string> topics;
+  for (const Connection& c : connections_) {
+    if (c.type == type) topics.insert(c.topic);
+  }
+  return {topics.begin(), topics.end()};
+}
+
+std::vector<std::string> Ros1BagReader::Topics() const {
+  std::set<std::string> topics;
+  for (const Connection& c : connections_) topics.insert(c.topic);
+  return {topics.begin(), topics.end()};
+}
+
+std::string Ros1BagReader::TopicType(const std::string& topic) const {
+  for (const Connection& c : connections_) {
+    if (c.topic == topic) return c.type;
+  }
+  return "";
+}
+
+int64_t Ros1BagReader::MessageCount(const std::string& topic) const {
+  int64_t count = 0;
+  for (size_t i = 0; i < connections_.size(); ++i) {
+    if (connections_[i].topic == topic) count += message_counts_[i];
+  }
+  return count;
+}
+
+int64_t Ros1BagReader::TotalMessageCount() const {
+  int64_t count = 0;
+  for (int64_t c : message_counts_) count += c;
+  return count;
+}
+
+bool Ros1BagReader::TimeRange(int64_t* start_ns, int64_t* end_ns) const {
+  if (start_ns_ > end_ns_) return false;
+  *start_ns = start_ns_;
+  *end_ns = end_ns_;
+  return true;
+}
+
+Status Ros1BagReader::ReadMessages(const ReadOptions& options,
+                                   const std::function<Status(const MessageView&)>& fn) {
+  std::vector<size_t> slots;
+  for (size_t i = 0; i < connections_.size(); ++i) {
+    if (options.topics.empty() ||
+        std::find(options.topics.begin(), options.topics.end(), connections_[i].topic) !=
+            options.topics.end()) {
+      slots.push_back(i);
+    }
+  }
+  for (const std::string& topic : options.topics) {
+    if (MessageCount(topic) == 0 && TopicType(topic).empty()) {
+      return Status::Error(path_ + ": no topic '" + topic + "' in the bag");
+    }
+  }
+  // Load the index entries of the selected connections that are not loaded.
+  std::vector<size_t> to_load;
+  for (size_t slot : slots) {
+    if (!entries_loaded_[slot]) to_load.push_back(slot);
+  }
+  if (!to_load.empty()) {
+    for (size_t c = 0; c < chunks_.size(); ++c) {
+      const bool wanted = std::any_of(
+          chunks_[c].connection_counts.begin(), chunks_[c].connection_counts.end(),
+          [&](const auto& cc) {
+            return std::find(to_load.begin(), to_load.end(), static_cast<size_t>(cc.first)) !=
+                   to_load.end();
+          });
+      if (wanted) TILTCAL_RETURN_IF_ERROR(ReadChunkIndex(c, to_load));
+    }
+    for (size_t slot : to_load) entries_loaded_[slot] = true;
+  }
+
+  // Merge the selected connections and order by (time, chunk_pos, offset);
+  // chunks_ is sorted by file position, so the chunk index orders as chunk_pos.
+  struct Item {
+    int64_t time_ns;
+    uint32_t chunk;
+    uint32_t offset;
+    uint32_t slot;
+  };
+  std::vector<Item> items;
+  size_t total = 0;
+  for (size_t slot : slots) total += entries_[slot].size();
+  items.reserve(total);
+  for (size_t slot : slots) {
+    for (const Entry& e : entries_[slot]) {
+      if (e.time_ns >= options.start_ns && e.time_ns < options.end_ns) {
+        items.push_back(Item{e.time_ns, e.chunk, e.offset, static_cast<uint32_t>(slot)});
+      }
+    }
+  }
+  std::sort(items.begin(), items.end(), [](const Item& a, const Item& b) {
+    return std::tie(a.time_ns, a.chunk, a.offset) < std::tie(b.time_ns, b.chunk, b.offset);
+  });
+
+  ChunkCache cache(options.chunk_cache_size);
+  MessageView view;
+  for (size_t i = 0; i < items.size(); ++i) {
+    const Item& item = items[i];
+    const Chunk& chunk = chunks_[item.chunk];
+    const uint8_t* buffer = nullptr;
+    TILTCAL_RETURN_IF_ERROR(cache.Get(this, item.chunk, &buffer));
+    // Skip connection records placed before the message (ros_comm does too).
+    size_t offset = item.offset;
+    BufferRecord record;
+    for (;;) {
+      Status status = ParseBufferRecord(buffer, chunk.size, offset, &record);
+      if (!status.ok()) return Error(chunk.pos, "chunk: " + status.message());
+      if (record.op != static_cast<uint8_t>(Op::kConnection)) break;
+      offset = record.end;
+    }
+    if (record.op != static_cast<uint8_t>(Op::kMessageData)) {
+      return Error(chunk.pos, "chunk: the index points to a record with op " +
+                                  std::to_string(record.op) + " (" + OpName(record.op) +
+                                  ") at chunk offset " + std::to_string(offset) +
+                                  ", not a message");
+    }
+    view.connection = &connections_[item.slot];
+    view.time_ns = item.time_ns;
+    view.chunk_pos = chunk.pos;
+    view.offset = static_cast<uint32_t>(offset);
+    view.sequence = i;
+    view.data = record.data;
+    view.size = record.data_len;
+    TILTCAL_RETURN_IF_ERROR(fn(view));
+  }
+  return Status::Ok();
+}
+
+}  // namespace tiltcal::ros1

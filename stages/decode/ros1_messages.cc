@@ -1,0 +1,147 @@
+#include "stages/decode/ros1_messages.h"
+
+#include <cstring>
+
+namespace tiltcal::ros1 {
+
+namespace {
+
+// Bounds-checked cursor over a serialized message.
+class WireReader {
+ public:
+  WireReader(const uint8_t* data, size_t size) : data_(data), size_(size) {}
+
+  // Takes `n` bytes for `what`; an error when fewer remain.
+  Status Take(size_t n, const char* what, const uint8_t** out) {
+    if (n > size_ - pos_) {
+      return Status::Error(std::string("message runs past its record: ") + what + " needs " +
+                           std::to_string(n) + " bytes at byte " + std::to_string(pos_) +
+                           ", the record has " + std::to_string(size_));
+    }
+    *out = data_ + pos_;
+    pos_ += n;
+    return Status::Ok();
+  }
+  Status U8(const char* what, uint8_t* v) {
+    const uint8_t* p = nullptr;
+    TILTCAL_RETURN_IF_ERROR(Take(1, what, &p));
+    *v = *p;
+    return Status::Ok();
+  }
+  Status U32(const char* what, uint32_t* v) {
+    const uint8_t* p = nullptr;
+    TILTCAL_RETURN_IF_ERROR(Take(4, what, &p));
+    *v = LoadU32Le(p);
+    return Status::Ok();
+  }
+  Status F64s(const char* what, double* v, size_t n) {
+    const uint8_t* p = nullptr;
+    TILTCAL_RETURN_IF_ERROR(Take(8 * n, what, &p));
+    std::memcpy(v, p, 8 * n);
+    return Status::Ok();
+  }
+  Status String(const char* what, std::string* s) {
+    uint32_t len = 0;
+    TILTCAL_RETURN_IF_ERROR(U32(what, &len));
+    const uint8_t* p = nullptr;
+    TILTCAL_RETURN_IF_ERROR(Take(len, what, &p));
+    s->assign(reinterpret_cast<const char*>(p), len);
+    return Status::Ok();
+  }
+  Status Header(ros1::Header* h) {
+    TILTCAL_RETURN_IF_ERROR(U32("header.seq", &h->seq));
+    TILTCAL_RETURN_IF_ERROR(U32("header.stamp.sec", &h->stamp.sec));
+    TILTCAL_RETURN_IF_ERROR(U32("header.stamp.nsec", &h->stamp.nsec));
+    return String("header.frame_id", &h->frame_id);
+  }
+  Status ExpectEnd(const char* type) const {
+    if (pos_ != size_) {
+      return Status::Error(std::string("record has ") + std::to_string(size_ - pos_) +
+                           " bytes after the end of the " + type + " message (" +
+                           std::to_string(size_) + " bytes; another message type?)");
+    }
+    return Status::Ok();
+  }
+
+ private:
+  const uint8_t* data_;
+  size_t size_;
+  size_t pos_ = 0;
+};
+
+}  // namespace
+
+size_t PointFieldTypeSize(uint8_t datatype) {
+  switch (datatype) {
+    case kInt8:
+    case kUint8: return 1;
+    case kInt16:
+    case kUint16: return 2;
+    case kInt32:
+    case kUint32:
+    case kFloat32: return 4;
+    case kFloat64: return 8;
+    default: return 0;
+  }
+}
+
+std::string PointFieldTypeName(uint8_t datatype) {
+  switch (datatype) {
+    case kInt8: return "INT8";
+    case kUint8: return "UINT8";
+    case kInt16: return "INT16";
+    case kUint16: return "UINT16";
+    case kInt32: return "INT32";
+    case kUint32: return "UINT32";
+    case kFloat32: return "FLOAT32";
+    case kFloat64: return "FLOAT64";
+    default: return "type " + std::to_string(datatype);
+  }
+}
+
+Status DecodeImu(const uint8_t* data, size_t size, ImuMessage* imu) {
+  WireReader r(data, size);
+  TILTCAL_RETURN_IF_ERROR(r.Header(&imu->header));
+  TILTCAL_RETURN_IF_ERROR(r.F64s("orientation", imu->orientation, 4));
+  TILTCAL_RETURN_IF_ERROR(r.F64s("orientation_covariance", imu->orientation_covariance, 9));
+  TILTCAL_RETURN_IF_ERROR(r.F64s("angular_velocity", imu->angular_velocity, 3));
+  TILTCAL_RETURN_IF_ERROR(
+      r.F64s("angular_velocity_covariance", imu->angular_velocity_covariance, 9));
+  TILTCAL_RETURN_IF_ERROR(r.F64s("linear_acceleration", imu->linear_acceleration, 3));
+  TILTCAL_RETURN_IF_ERROR(
+      r.F64s("linear_acceleration_covariance", imu->linear_acceleration_covariance, 9));
+  return r.ExpectEnd("sensor_msgs/Imu");
+}
+
+Status DecodePointCloud2(const uint8_t* data, size_t size, PointCloud2View* cloud) {
+  WireReader r(data, size);
+  TILTCAL_RETURN_IF_ERROR(r.Header(&cloud->header));
+  TILTCAL_RETURN_IF_ERROR(r.U32("height", &cloud->height));
+  TILTCAL_RETURN_IF_ERROR(r.U32("width", &cloud->width));
+  uint32_t num_fields = 0;
+  TILTCAL_RETURN_IF_ERROR(r.U32("fields", &num_fields));
+  // Each PointField takes at least 13 bytes; refuse absurd counts before resizing.
+  if (num_fields > size / 13) {
+    return Status::Error("message runs past its record: " + std::to_string(num_fields) +
+                         " point fields cannot fit in " + std::to_string(size) + " bytes");
+  }
+  cloud->fields.resize(num_fields);
+  for (PointField& field : cloud->fields) {
+    TILTCAL_RETURN_IF_ERROR(r.String("fields.name", &field.name));
+    TILTCAL_RETURN_IF_ERROR(r.U32("fields.offset", &field.offset));
+    TILTCAL_RETURN_IF_ERROR(r.U8("fields.datatype", &field.datatype));
+    TILTCAL_RETURN_IF_ERROR(r.U32("fields.count", &field.count));
+  }
+  uint8_t flag = 0;
+  TILTCAL_RETURN_IF_ERROR(r.U8("is_bigendian", &flag));
+  cloud->is_bigendian = flag != 0;
+  TILTCAL_RETURN_IF_ERROR(r.U32("point_step", &cloud->point_step));
+  TILTCAL_RETURN_IF_ERROR(r.U32("row_step", &cloud->row_step));
+  TILTCAL_RETURN_IF_ERROR(r.U32("data", &cloud->data_size));
+  TILTCAL_RETURN_IF_ERROR(r.Take(cloud->data_size, "data", &cloud->data));
+  TILTCAL_RETURN_IF_ERROR(r.U8("is_dense", &flag));
+  cloud->is_dense = flag != 0;
+  return r.ExpectEnd("sensor_msgs/PointCloud2");
+}
+
+}  // namespace tiltcal::ros1

@@ -1,0 +1,206 @@
+// tiltcal_decode as a user runs it: bad input gives ONE error line naming the
+// file (and record), a non-zero exit and no output file; params are checked.
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "tests/stages/decode/decode_test_util.h"
+#include "tests/testing/test_env.h"
+
+namespace tiltcal {
+namespace {
+
+namespace fs = std::filesystem;
+
+class DecodeCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ASSERT_TRUE(testing::FileExists(testing::ToolPath("tiltcal_decode")))
+        << "build the tiltcal_decode target first";
+    fs::create_directories(tmp_.File("out"));
+    params_ = testing::SourceDir() + "/stages/decode/default_params.txtpb";
+  }
+
+  // Runs the tool on `bag` with `params`; returns the exit status.
+  int Decode(const std::string& bag, const std::string& params, std::string* output,
+             const std::string& extra = "") {
+    const std::string command = testing::ToolPath("tiltcal_decode") + " --bag='" + bag +
+                                "' --params='" + params + "' --out_imu=" +
+                                tmp_.File("out/imu.binpb") + " --out_scans=" +
+                                tmp_.File("out/scans.binpb.lz4") + " " + extra;
+    return testing::RunCommand(command, output);
+  }
+
+  // One line, naming `must_contain`, non-zero exit, nothing in out/.
+  void ExpectCleanFailure(int rc, const std::string& output,
+                          const std::vector<std::string>& must_contain) {
+    EXPECT_NE(rc, 0);
+    EXPECT_EQ(std::count(output.begin(), output.end(), '\n'), 1) << output;
+    for (const std::string& s : must_contain) {
+      EXPECT_NE(output.find(s), std::string::npos) << "'" << s << "' not in: " << output;
+    }
+    EXPECT_TRUE(fs::is_empty(tmp_.File("out"))) << "output left behind";
+  }
+
+  std::string WrittenBag(const std::string& name) {
+    std::string log;
+    const std::string dir = testing::WrittenBagsDir(&log);
+    if (dir.empty() && !testing::HaveRosbagPython()) return "";
+    EXPECT_FALSE(dir.empty()) << log;
+    return dir.empty() ? "" : dir + "/" + name;
+  }
+
+  void WriteFile(const std::string& path, const std::string& contents) {
+    std::ofstream out(path, std::ios::binary);
+    out << contents;
+  }
+
+  testing::TempDir tmp_;
+  std::string params_;
+};
+
+#define REQUIRE_WRITTEN_BAG(var, name)                                                  \
+  const std::string var = WrittenBag(name);                                             \
+  if (var.empty()) {                                                                    \
+    GTEST_SKIP() << "/usr/bin/python3 cannot import rosbag; no written test bags";      \
+  }
+
+TEST_F(DecodeCli, DecodesAWrittenBagWithRig) {
+  REQUIRE_WRITTEN_BAG(bag, "velodyne_bz2.bag");
+  const std::string rig = tmp_.File("rig.txtpb");
+  WriteFile(rig, "imu_topic: \"/imu/data\"\nlidar_topic: \"/points\"\n");
+  std::string output;
+  EXPECT_EQ(Decode(bag, params_, &output, "--rig=" + rig), 0) << output;
+  EXPECT_TRUE(testing::FileExists(tmp_.File("out/imu.binpb")));
+  EXPECT_TRUE(testing::FileExists(tmp_.File("out/scans.binpb.lz4")));
+  // The summary (no progress: stderr is not a terminal here).
+  EXPECT_NE(output.find("imu   '/imu/data': 201 msgs, 200 written"), std::string::npos) << output;
+  EXPECT_NE(output.find("MB/s"), std::string::npos) << output;
+  EXPECT_EQ(output.find('\r'), std::string::npos);
+}
+
+TEST_F(DecodeCli, EmptyFile) {
+  const std::string bag = tmp_.File("empty.bag");
+  WriteFile(bag, "");
+  std::string output;
+  const int rc = Decode(bag, params_, &output);
+  ExpectCleanFailure(rc, output, {bag, "empty file"});
+}
+
+TEST_F(DecodeCli, WrongMagic) {
+  const std::string bag = tmp_.File("notabag.bag");
+  WriteFile(bag, "This is a text file, not a bag.\n" + std::string(5000, 'x'));
+  std::string output;
+  const int rc = Decode(bag, params_, &output);
+  ExpectCleanFailure(rc, output, {bag, "wrong magic"});
+}
+
+TEST_F(DecodeCli, Version12BagIsRejected) {
+  const std::string bag = tmp_.File("old.bag");
+  WriteFile(bag, "#ROSRECORD V1.2\n" + std::string(100, '\0'));
+  std::string output;
+  const int rc = Decode(bag, params_, &output);
+  ExpectCleanFailure(rc, output, {bag, "V1.2 is not supported"});
+}
+
+TEST_F(DecodeCli, TruncatedBag) {
+  REQUIRE_WRITTEN_BAG(source, "velodyne_lz4.bag");
+  const std::string bytes = testing::ReadFileOrEmpty(source);
+  const std::string bag = tmp_.File("truncated.bag");
+  WriteFile(bag, bytes.substr(0, bytes.size() * 6 / 10));
+  std::string output;
+  const int rc = Decode(bag, params_, &output);
+  ExpectCleanFailure(rc, output, {bag, "truncated"});
+}
+
+void FlipBytes(std::string* bytes, size_t at, size_t n) {
+  for (size_t i = at; i < at + n && i < bytes->size(); ++i) (*bytes)[i] ^= 0x5A;
+}
+
+TEST_F(DecodeCli, CorruptedBz2Chunk) {
+  REQUIRE_WRITTEN_BAG(source, "ouster_bz2.bag");
+  std::string bytes = testing::ReadFileOrEmpty(source);
+  FlipBytes(&bytes, 4117 + 400, 16);  // inside the compressed data of the first chunk
+  const std::string bag = tmp_.File("corrupt_bz2.bag");
+  WriteFile(bag, bytes);
+  std::string output;
+  const int rc = Decode(bag, params_, &output);
+  ExpectCleanFailure(rc, output, {bag, "record at byte 4117", "bz2"});
+}
+
+TEST_F(DecodeCli, CorruptedLz4Chunk) {
+  REQUIRE_WRITTEN_BAG(source, "hesai_lz4.bag");
+  std::string bytes = testing::ReadFileOrEmpty(source);
+  FlipBytes(&bytes, 4117 + 400, 16);
+  const std::string bag = tmp_.File("corrupt_lz4.bag");
+  WriteFile(bag, bytes);
+  std::string output;
+  const int rc = Decode(bag, params_, &output);
+  ExpectCleanFailure(rc, output, {bag, "record at byte 4117", "lz4"});
+}
+
+TEST_F(DecodeCli, BagWithoutPointCloud2) {
+  REQUIRE_WRITTEN_BAG(bag, "imu_only.bag");
+  std::string output;
+  const int rc = Decode(bag, params_, &output);
+  ExpectCleanFailure(rc, output, {bag, "no sensor_msgs/PointCloud2 topic", "/imu/data"});
+}
+
+TEST_F(DecodeCli, RealBagWithoutPointCloud2) {
+  const std::string dir = testing::SharedFixturesDir();
+  if (dir.empty()) GTEST_SKIP() << "../shared/fixtures absent";
+  const std::string bag = dir + "/bags/ros1/robot_localization_test2_bz2_imu.bag";
+  std::string output;
+  const int rc = Decode(bag, params_, &output);
+  ExpectCleanFailure(rc, output, {bag, "no sensor_msgs/PointCloud2 topic"});
+}
+
+TEST_F(DecodeCli, BagWithoutMessages) {
+  const std::string dir = testing::SharedFixturesDir();
+  if (dir.empty()) GTEST_SKIP() << "../shared/fixtures absent";
+  const std::string bag = dir + "/bags/ros1/rosbagjs_no-messages.bag";
+  std::string output;
+  const int rc = Decode(bag, params_, &output);
+  ExpectCleanFailure(rc, output, {bag, "holds no messages"});
+}
+
+TEST_F(DecodeCli, MessageRunningPastItsRecord) {
+  REQUIRE_WRITTEN_BAG(bag, "truncated_message.bag");
+  std::string output;
+  const int rc = Decode(bag, params_, &output);
+  ExpectCleanFailure(rc, output,
+                     {bag, "topic '/imu/data' message 3", "runs past its record"});
+}
+
+TEST_F(DecodeCli, ParamsOutOfRange) {
+  const std::string params = tmp_.File("bad.txtpb");
+  WriteFile(params, testing::ReadFileOrEmpty(params_) + "\nmin_range_m: -1\n");
+  std::string output;
+  const int rc = Decode("/nonexistent.bag", params, &output);
+  ExpectCleanFailure(rc, output, {params, "min_range_m"});
+}
+
+TEST_F(DecodeCli, ParamsUnknownField) {
+  const std::string params = tmp_.File("bad.txtpb");
+  WriteFile(params, "chunk_cache_size: 4\nmin_rang_m: 1\n");
+  std::string output;
+  const int rc = Decode("/nonexistent.bag", params, &output);
+  ExpectCleanFailure(rc, output, {params, "min_rang_m"});
+}
+
+TEST_F(DecodeCli, ParamsMissing) {
+  std::string output;
+  const int rc = Decode("/nonexistent.bag", "", &output);
+  ExpectCleanFailure(rc, output, {"--params"});
+}
+
+TEST_F(DecodeCli, MissingBag) {
+  std::string output;
+  const int rc = Decode(tmp_.File("missing.bag"), params_, &output);
+  ExpectCleanFailure(rc, output, {tmp_.File("missing.bag"), "cannot open"});
+}
+
+}  // namespace
+}  // namespace tiltcal
