@@ -96,6 +96,10 @@ Status ChunkDecompressor::DecompressLz4(const uint8_t* src, size_t src_size, uin
       return Status::Error(std::string("cannot create an LZ4 context: ") + LZ4F_getErrorName(rc));
     }
   }
+  // The whole frame is decoded into one buffer that stays put, so liblz4 may
+  // decode straight into it (stableDst) instead of through its own window.
+  LZ4F_decompressOptions_t options = {};
+  options.stableDst = 1;
   size_t consumed = 0;
   size_t produced = 0;
   size_t hint = 1;
@@ -109,7 +113,7 @@ Status ChunkDecompressor::DecompressLz4(const uint8_t* src, size_t src_size, uin
                            std::to_string(dst_size) + " bytes decoded from all " +
                            std::to_string(src_size) + " compressed bytes");
     }
-    hint = LZ4F_decompress(lz4_, dst + produced, &out, src + consumed, &in, nullptr);
+    hint = LZ4F_decompress(lz4_, dst + produced, &out, src + consumed, &in, &options);
     if (LZ4F_isError(hint)) {
       LZ4F_resetDecompressionContext(lz4_);
       return Status::Error(std::string("lz4 decompression failed: ") + LZ4F_getErrorName(hint) +

@@ -11,6 +11,7 @@
 #include "common/io/provenance.h"
 #include "common/io/record_stream.h"
 #include "common/io/text_proto.h"
+#include "stages/decode/async_record_writer.h"
 #include "stages/decode/point_cloud_conversion.h"
 #include "stages/decode/ros1_bag_reader.h"
 #include "stages/decode/ros1_messages.h"
@@ -214,7 +215,8 @@ Status Run(const DecodeInputs& in, const proto::DecodeParams& params, DecodeSumm
   const proto::Provenance provenance =
       MakeProvenance("tiltcal_decode", params, input_paths, in.command_line);
 
-  RecordWriter scans_writer;
+  // Scans are compressed and written on a second thread, 4 scans in flight.
+  AsyncRecordWriter scans_writer(proto::Scan::default_instance(), 4);
   TILTCAL_RETURN_IF_ERROR(scans_writer.Open(in.out_scans_path,
                                             proto::Scan::descriptor()->full_name(), provenance,
                                             /*compress=*/true));
@@ -229,7 +231,6 @@ Status Run(const DecodeInputs& in, const proto::DecodeParams& params, DecodeSumm
   imu.reserve(static_cast<size_t>(std::max<int64_t>(reader.MessageCount(s.imu_topic), 0)));
   ros1::ImuMessage imu_message;
   ros1::PointCloud2View cloud;
-  proto::Scan scan;
   int64_t last_scan_stamp_ns = INT64_MIN;
 
   auto on_message = [&](const ros1::MessageView& m) -> Status {
@@ -267,6 +268,18 @@ Status Run(const DecodeInputs& in, const proto::DecodeParams& params, DecodeSumm
       imu.push_back(r);
       return Status::Ok();
     }
+    auto* scan_ptr = static_cast<proto::Scan*>(scans_writer.Acquire());
+    proto::Scan& scan = *scan_ptr;
+    bool submitted = false;
+    // Gives the record back unless it was handed to the writer.
+    struct Releaser {
+      AsyncRecordWriter* writer;
+      proto::Scan* scan;
+      const bool* submitted;
+      ~Releaser() {
+        if (!*submitted) writer->Release(scan);
+      }
+    } releaser{&scans_writer, scan_ptr, &submitted};
     Status status = ros1::DecodePointCloud2(m.data, m.size, &cloud);
     if (status.ok()) status = ConvertPointCloud2ToScan(cloud, conversion, &scan);
     if (!status.ok()) return status.WithContext(context() + ": sensor_msgs/PointCloud2");
@@ -297,12 +310,12 @@ Status Run(const DecodeInputs& in, const proto::DecodeParams& params, DecodeSumm
     last_scan_stamp_ns = scan.stamp_ns();
     scan.set_index(static_cast<uint32_t>(s.scans_written));
     scan.set_record_stamp_ns(m.time_ns);
-    TILTCAL_RETURN_IF_ERROR(scans_writer.Write(scan));
     if (s.scans_written == 0) s.scan_first_stamp_ns = scan.stamp_ns();
     s.scan_last_stamp_ns = scan.stamp_ns();
     ++s.scans_written;
     s.points_written += scan.x_size();
-    return Status::Ok();
+    submitted = true;
+    return scans_writer.Submit(scan_ptr);
   };
   Status status = reader.ReadMessages(options, on_message);
   if (progress) std::fprintf(in.log, "\r\033[K");

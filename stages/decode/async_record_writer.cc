@@ -1,0 +1,86 @@
+#include "stages/decode/async_record_writer.h"
+
+namespace tiltcal {
+
+AsyncRecordWriter::AsyncRecordWriter(const google::protobuf::Message& prototype,
+                                     size_t depth) {
+  for (size_t i = 0; i < std::max<size_t>(depth, 1); ++i) {
+    storage_.emplace_back(prototype.New());
+    free_.push_back(storage_.back().get());
+  }
+}
+
+AsyncRecordWriter::~AsyncRecordWriter() { Stop(); }
+
+void AsyncRecordWriter::Stop() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stopping_ = true;
+  }
+  changed_.notify_all();
+  if (thread_.joinable()) thread_.join();
+}
+
+Status AsyncRecordWriter::Open(const std::string& path, const std::string& payload_type,
+                               const proto::Provenance& provenance, bool compress) {
+  TILTCAL_RETURN_IF_ERROR(writer_.Open(path, payload_type, provenance, compress));
+  thread_ = std::thread([this] { Work(); });
+  return Status::Ok();
+}
+
+void AsyncRecordWriter::Work() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  for (;;) {
+    changed_.wait(lock, [this] { return stopping_ || !queue_.empty(); });
+    if (queue_.empty()) return;  // stopping and drained
+    google::protobuf::Message* record = queue_.front();
+    queue_.pop_front();
+    busy_ = true;
+    const bool failed = !error_.ok() || stopping_;  // stopping before Close(): an error path
+    lock.unlock();
+    Status status = failed ? Status::Ok() : writer_.Write(*record);
+    lock.lock();
+    busy_ = false;
+    if (!status.ok() && error_.ok()) error_ = status;
+    free_.push_back(record);
+    changed_.notify_all();
+  }
+}
+
+google::protobuf::Message* AsyncRecordWriter::Acquire() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  changed_.wait(lock, [this] { return !free_.empty(); });
+  google::protobuf::Message* record = free_.back();
+  free_.pop_back();
+  return record;
+}
+
+void AsyncRecordWriter::Release(google::protobuf::Message* record) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    free_.push_back(record);
+  }
+  changed_.notify_all();
+}
+
+Status AsyncRecordWriter::Submit(google::protobuf::Message* record) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    queue_.push_back(record);
+    if (!error_.ok()) return error_;
+  }
+  changed_.notify_all();
+  return Status::Ok();
+}
+
+Status AsyncRecordWriter::Close() {
+  {
+    std::unique_lock<std::mutex> lock(mutex_);
+    changed_.wait(lock, [this] { return queue_.empty() && !busy_; });
+  }
+  Stop();
+  TILTCAL_RETURN_IF_ERROR(error_);
+  return writer_.Close();
+}
+
+}  // namespace tiltcal
