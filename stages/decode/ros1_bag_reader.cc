@@ -438,6 +438,10 @@ Status Ros1BagReader::LoadChunk(size_t chunk_index, std::vector<uint8_t>* compre
   stats_.compressed_bytes_read += chunk.data_len;
   stats_.uncompressed_bytes += chunk.size;
   if (chunk.compression == ChunkCompression::kNone) {
+    if (chunk.data_len != chunk.size) {
+      return Error(chunk.pos, "uncompressed chunk of size " + std::to_string(chunk.size) +
+                                  " has " + std::to_string(chunk.data_len) + " data bytes");
+    }
     return ReadAt(chunk.data_pos, chunk.data_len, dst);
   }
   if (compressed->size() < chunk.data_len) compressed->resize(chunk.data_len);
