@@ -171,13 +171,18 @@ Status ConvertPointCloud2ToScan(const PointCloud2View& cloud,
                          " is smaller than width * point_step = " +
                          std::to_string(width * cloud.point_step));
   }
-  const uint64_t needed = (height - 1) * cloud.row_step + width * cloud.point_step;
+  // 128 bits: (2^32 - 1)^2 twice does not fit in 64.
+  const unsigned __int128 needed =
+      static_cast<unsigned __int128>(height - 1) * cloud.row_step +
+      static_cast<unsigned __int128>(width) * cloud.point_step;
   if (needed > cloud.data_size) {
     return Status::Error("PointCloud2 data has " + std::to_string(cloud.data_size) +
                          " bytes, " + std::to_string(height) + " rows of " +
                          std::to_string(width) + " points (point_step " +
                          std::to_string(cloud.point_step) + ", row_step " +
-                         std::to_string(cloud.row_step) + ") need " + std::to_string(needed));
+                         std::to_string(cloud.row_step) + ") need " +
+                         (needed > UINT64_MAX ? std::string("more than 2^64")
+                                              : std::to_string(static_cast<uint64_t>(needed))));
   }
   if (num_points > static_cast<uint64_t>(std::numeric_limits<int>::max())) {
     return Status::Error("PointCloud2 has too many points: " + std::to_string(num_points));

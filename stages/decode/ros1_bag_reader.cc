@@ -34,6 +34,12 @@ struct Ros1BagReader::Entry {
 
 namespace {
 
+// Sanity limits that keep a corrupted length from allocating gigabytes. Real
+// record headers are tens of bytes; real chunks ~1 MB (a chunk holds at least
+// one message, so a few hundred MB for a huge message at most).
+constexpr uint32_t kMaxHeaderBytes = 1 << 20;
+constexpr uint32_t kMaxChunkBytes = 1u << 30;
+
 // A growable byte buffer that does not zero-fill.
 class ByteBuffer {
  public:
@@ -131,6 +137,10 @@ Status Ros1BagReader::ReadRecordHeaderAt(uint64_t pos, std::string* buffer,
   }
   uint32_t header_len = 0;
   TILTCAL_RETURN_IF_ERROR(ReadAt(pos, 4, &header_len));
+  if (header_len > kMaxHeaderBytes) {
+    return Error(pos, "header length " + std::to_string(header_len) + " is implausible (> " +
+                          std::to_string(kMaxHeaderBytes) + " bytes; corrupt bag?)");
+  }
   if (header_len > file_size_ - pos - 8) {
     return Error(pos, "header length " + std::to_string(header_len) +
                           " runs past the end of the file (" + std::to_string(file_size_) +
@@ -348,6 +358,10 @@ Status Ros1BagReader::ReadIndexed(uint64_t index_pos, uint32_t conn_count,
       status = Status::Error("unsupported chunk compression " + Quoted(compression) +
                              " (supported: none, bz2, lz4)");
     }
+    if (status.ok() && chunk.size > kMaxChunkBytes) {
+      status = Status::Error("implausible uncompressed size " + std::to_string(chunk.size) +
+                             " (> 1 GiB; corrupt bag?)");
+    }
     if (status.ok() && chunk.compression == ChunkCompression::kNone &&
         chunk.size != chunk.data_len) {
       status = Status::Error("uncompressed chunk of size " + std::to_string(chunk.size) +
@@ -547,6 +561,9 @@ Status Ros1BagReader::ScanUnindexed(uint64_t first_record_pos) {
       if (status.ok()) status = header.GetU32("size", &chunk.size);
       if (status.ok() && !ParseChunkCompression(compression, &chunk.compression)) {
         status = Status::Error("unsupported chunk compression " + Quoted(compression));
+      }
+      if (status.ok() && chunk.size > kMaxChunkBytes) {
+        status = Status::Error("implausible uncompressed size " + std::to_string(chunk.size));
       }
       if (!status.ok()) {
         note("stopped at a bad chunk at byte " + std::to_string(pos) + ": " + status.message());
