@@ -6,6 +6,8 @@
 #   - real time: the sequence's 60 s (real-time factor = 60 s / wall);
 #   - I/O floor: copying the produced bag (cp, warm cache) — the cost of just
 #     moving that many bytes (ratio = wall / copy wall).
+# cpu_s (user + sys) is shown too: on a shared, loaded machine it is the
+# steadier figure (wall ≈ cpu_s / threads on idle cores).
 #
 # Usage: bench/simulate/run_simulate_bench.sh [options]
 #   --build_dir DIR   build with tiltcal_simulate (default <repo>/build-bench)
@@ -44,7 +46,7 @@ SCENARIO="$REPO/stages/simulate/scenarios/tilted_husky_vlp16.txtpb"
 
 now() { date +%s.%N; }
 
-printf '%-6s %-7s %9s %10s %9s %10s %11s %9s\n' compr threads wall_s "x_realtime" bag_MB Mpoints_s copy_wall_s "x_copy"
+printf '%-6s %-7s %9s %8s %10s %9s %10s %11s %9s\n' compr threads wall_s cpu_s "x_realtime" bag_MB Mpoints_s copy_wall_s "x_copy"
 for compression in $COMPRESSIONS; do
   for threads in $THREADS; do
     params="$WORK/scenario_${compression}_${threads}.txtpb"
@@ -53,8 +55,10 @@ for compression in $COMPRESSIONS; do
         -e "s/^  compression: .*/  compression: $compression/" "$SCENARIO" > "$params"
     bag="$WORK/sim_${compression}.bag"
     t0=$(now)
-    "$SIM" --params="$params" --out_bag="$bag" --out_truth="$WORK/truth.txtpb" 2> "$WORK/log.txt"
+    /usr/bin/time -f "%U %S" -o "$WORK/time.txt" \
+      "$SIM" --params="$params" --out_bag="$bag" --out_truth="$WORK/truth.txtpb" 2> "$WORK/log.txt"
     t1=$(now)
+    cpu=$(awk '{print $1 + $2}' "$WORK/time.txt")
     points=$(sed -n 's/.* scans, \([0-9]*\) points.*/\1/p' "$WORK/log.txt")
     cat "$bag" > /dev/null
     c0=$(now)
@@ -63,10 +67,10 @@ for compression in $COMPRESSIONS; do
     c1=$(now)
     rm -f "$WORK/copy.bag"
     awk -v c="$compression" -v th="$threads" -v t0="$t0" -v t1="$t1" -v c0="$c0" -v c1="$c1" \
-        -v d="$DURATION" -v bytes="$(stat -c %s "$bag")" -v pts="$points" 'BEGIN {
+        -v d="$DURATION" -v bytes="$(stat -c %s "$bag")" -v pts="$points" -v cpu="$cpu" 'BEGIN {
       w = t1 - t0; cw = c1 - c0;
-      printf "%-6s %-7s %9.2f %10.1f %9.1f %10.2f %11.2f %9.1f\n",
-             c, th, w, d / w, bytes / 1e6, pts / w / 1e6, cw, w / cw }'
+      printf "%-6s %-7s %9.2f %8.2f %10.1f %9.1f %10.2f %11.2f %9.1f\n",
+             c, th, w, cpu, d / w, bytes / 1e6, pts / w / 1e6, cw, w / cw }'
   done
 done
 rm -rf "$WORK"

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <thread>
 
 #include "stages/decode/ros1_format.h"
 
@@ -71,8 +72,9 @@ const char* Ros1BagWriter::CompressionName(Compression compression) {
 }
 
 Status Ros1BagWriter::Open(const std::string& path, Compression compression,
-                           uint32_t chunk_threshold_bytes) {
+                           uint32_t chunk_threshold_bytes, unsigned compression_threads) {
   path_ = path;
+  compression_threads_ = std::max(1u, compression_threads);
   compression_ = compression;
   chunk_threshold_ = chunk_threshold_bytes;
   TILTCAL_RETURN_IF_ERROR(file_.Open(path));
@@ -156,53 +158,74 @@ Status Ros1BagWriter::Write(uint32_t connection, int64_t time_ns, std::string_vi
 
 Status Ros1BagWriter::FlushChunk() {
   if (chunk_index_.empty()) return Status::Ok();
-  std::string compressed;
-  std::string_view data = chunk_;
-  if (compression_ == Compression::kLz4) {
-    TILTCAL_RETURN_IF_ERROR(CompressLz4(chunk_, &compressed).WithContext(path_));
-    data = compressed;
-  } else if (compression_ == Compression::kBz2) {
-    TILTCAL_RETURN_IF_ERROR(CompressBz2(chunk_, &compressed).WithContext(path_));
-    data = compressed;
-  }
-  ChunkInfo info;
-  info.position = position_;
-  info.start_ns = chunk_start_ns_;
-  info.end_ns = chunk_end_ns_;
-  HeaderFields fields;
-  fields["op"] = ros1::OpValue(Op::kChunk);
-  fields["compression"] = CompressionName(compression_);
-  fields["size"] = ros1::U32Value(static_cast<uint32_t>(chunk_.size()));
-  std::string record;
-  ros1::AppendRecord(&record, fields, data);
-  TILTCAL_RETURN_IF_ERROR(WriteBytes(record));
-  // Index data: one record per connection of the chunk, ascending ids.
-  for (const auto& [conn, entries] : chunk_index_) {
-    HeaderFields index;
-    index["op"] = ros1::OpValue(Op::kIndexData);
-    index["ver"] = ros1::U32Value(ros1::kIndexDataVersion);
-    index["conn"] = ros1::U32Value(conn);
-    index["count"] = ros1::U32Value(static_cast<uint32_t>(entries.size()));
-    std::string body;
-    body.reserve(entries.size() * ros1::kIndexEntrySize);
-    for (const IndexEntry& e : entries) {
-      body += TimeValueOrZero(e.time_ns);
-      ros1::AppendU32Le(&body, e.offset);
-    }
-    record.clear();
-    ros1::AppendRecord(&record, index, body);
-    TILTCAL_RETURN_IF_ERROR(WriteBytes(record));
-    info.counts[conn] = static_cast<uint32_t>(entries.size());
-  }
-  chunk_infos_.push_back(std::move(info));
+  pending_.push_back({std::move(chunk_), std::move(chunk_index_), chunk_start_ns_, chunk_end_ns_});
   chunk_.clear();
   chunk_index_.clear();
+  if (pending_.size() >= compression_threads_) return WritePendingChunks();
+  return Status::Ok();
+}
+
+Status Ros1BagWriter::WritePendingChunks() {
+  // Compress the pending chunks in parallel, then write them in order.
+  const size_t n = pending_.size();
+  std::vector<std::string> compressed(n);
+  std::vector<Status> status(n);
+  if (compression_ != Compression::kNone) {
+    auto work = [&](size_t first) {
+      for (size_t i = first; i < n; i += compression_threads_) {
+        status[i] = compression_ == Compression::kLz4 ? CompressLz4(pending_[i].data, &compressed[i])
+                                                      : CompressBz2(pending_[i].data, &compressed[i]);
+      }
+    };
+    std::vector<std::thread> pool;
+    for (size_t t = 1; t < std::min<size_t>(compression_threads_, n); ++t) pool.emplace_back(work, t);
+    work(0);
+    for (auto& th : pool) th.join();
+  }
+  for (size_t i = 0; i < n; ++i) {
+    TILTCAL_RETURN_IF_ERROR(status[i].WithContext(path_));
+    const PendingChunk& chunk = pending_[i];
+    const std::string_view data =
+        compression_ == Compression::kNone ? std::string_view(chunk.data) : compressed[i];
+    ChunkInfo info;
+    info.position = position_;
+    info.start_ns = chunk.start_ns;
+    info.end_ns = chunk.end_ns;
+    HeaderFields fields;
+    fields["op"] = ros1::OpValue(Op::kChunk);
+    fields["compression"] = CompressionName(compression_);
+    fields["size"] = ros1::U32Value(static_cast<uint32_t>(chunk.data.size()));
+    std::string record;
+    ros1::AppendRecord(&record, fields, data);
+    TILTCAL_RETURN_IF_ERROR(WriteBytes(record));
+    // Index data: one record per connection of the chunk, ascending ids.
+    for (const auto& [conn, entries] : chunk.index) {
+      HeaderFields index;
+      index["op"] = ros1::OpValue(Op::kIndexData);
+      index["ver"] = ros1::U32Value(ros1::kIndexDataVersion);
+      index["conn"] = ros1::U32Value(conn);
+      index["count"] = ros1::U32Value(static_cast<uint32_t>(entries.size()));
+      std::string body;
+      body.reserve(entries.size() * ros1::kIndexEntrySize);
+      for (const IndexEntry& e : entries) {
+        body += TimeValueOrZero(e.time_ns);
+        ros1::AppendU32Le(&body, e.offset);
+      }
+      record.clear();
+      ros1::AppendRecord(&record, index, body);
+      TILTCAL_RETURN_IF_ERROR(WriteBytes(record));
+      info.counts[conn] = static_cast<uint32_t>(entries.size());
+    }
+    chunk_infos_.push_back(std::move(info));
+  }
+  pending_.clear();
   return Status::Ok();
 }
 
 Status Ros1BagWriter::Close() {
   if (!open_) return Status::Error(path_ + ": bag is not open");
   TILTCAL_RETURN_IF_ERROR(FlushChunk());
+  TILTCAL_RETURN_IF_ERROR(WritePendingChunks());
   const uint64_t index_position = position_;
   for (uint32_t id = 0; id < connections_.size(); ++id) {
     TILTCAL_RETURN_IF_ERROR(WriteBytes(ConnectionRecord(id)));

@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -30,7 +31,10 @@ class Ros1BagWriter {
   Ros1BagWriter(const Ros1BagWriter&) = delete;
   Ros1BagWriter& operator=(const Ros1BagWriter&) = delete;
 
-  Status Open(const std::string& path, Compression compression, uint32_t chunk_threshold_bytes);
+  // `compression_threads` chunks are compressed in parallel (bz2 is slow);
+  // the bytes do not depend on it.
+  Status Open(const std::string& path, Compression compression, uint32_t chunk_threshold_bytes,
+              unsigned compression_threads = 1);
   // Registers a connection (topic, message type); returns its id.
   uint32_t AddConnection(const std::string& topic, const std::string& type,
                          const std::string& md5sum, const std::string& definition);
@@ -54,6 +58,11 @@ class Ros1BagWriter {
     int64_t time_ns;
     uint32_t offset;
   };
+  struct PendingChunk {  // closed, not yet compressed and written
+    std::string data;
+    std::map<uint32_t, std::vector<IndexEntry>> index;
+    int64_t start_ns, end_ns;
+  };
   struct ChunkInfo {
     uint64_t position;
     int64_t start_ns, end_ns;
@@ -62,6 +71,7 @@ class Ros1BagWriter {
 
   Status WriteBytes(std::string_view bytes);
   Status FlushChunk();
+  Status WritePendingChunks();
   std::string BagHeaderRecord(uint64_t index_position) const;
   std::string ConnectionRecord(uint32_t id) const;
 
@@ -75,6 +85,8 @@ class Ros1BagWriter {
   std::map<uint32_t, std::vector<IndexEntry>> chunk_index_;
   int64_t chunk_start_ns_ = 0, chunk_end_ns_ = 0;
   std::vector<ChunkInfo> chunk_infos_;
+  std::vector<PendingChunk> pending_;
+  unsigned compression_threads_ = 1;
   bool open_ = false;
 };
 

@@ -238,9 +238,11 @@ Status Run(const proto::SimulateParams& params, const SimulateOutputs& outputs,
   const int64_t start_ns = params.start_stamp_ns();
   const bool ouster = sc.model.kind == LidarModel::Kind::kOuster;
 
+  unsigned threads = params.num_threads();
+  if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
   Ros1BagWriter writer;
   TILTCAL_RETURN_IF_ERROR(writer.Open(outputs.bag_path, ToCompression(params.bag().compression()),
-                                      params.bag().chunk_threshold_bytes()));
+                                      params.bag().chunk_threshold_bytes(), threads));
   const RosMessageType& imu_type = ImuMessageType();
   const RosMessageType& cloud_type = PointCloud2MessageType();
   const uint32_t imu_conn =
@@ -304,8 +306,6 @@ Status Run(const proto::SimulateParams& params, const SimulateOutputs& outputs,
   // Scans in batches: ray casting and serialization in worker threads (one
   // random stream per sweep, so the result does not depend on the threads),
   // writing in order on this thread.
-  unsigned threads = params.num_threads();
-  if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
   const int batch = static_cast<int>(threads) * 2;
   const int num_scans = scenario.num_scans;
   const uint64_t seed = params.seed();

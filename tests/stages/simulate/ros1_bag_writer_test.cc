@@ -35,9 +35,9 @@ struct Written {
 // Writes a bag with an IMU topic, a topic without a leading slash and a
 // PointCloud2 topic larger than the chunk threshold; returns what was written.
 std::vector<Written> WriteTestBag(const std::string& path, Ros1BagWriter::Compression compression,
-                                  uint32_t chunk_threshold) {
+                                  uint32_t chunk_threshold, unsigned compression_threads = 1) {
   Ros1BagWriter writer;
-  EXPECT_TRUE(writer.Open(path, compression, chunk_threshold).ok());
+  EXPECT_TRUE(writer.Open(path, compression, chunk_threshold, compression_threads).ok());
   const RosMessageType& imu = ImuMessageType();
   const RosMessageType& cloud = PointCloud2MessageType();
   const uint32_t c_imu = writer.AddConnection("/imu/data", imu.type, imu.md5sum, imu.definition);
@@ -81,7 +81,7 @@ TEST_P(BagWriterRosbagTest, RealRosLibraryReadsEveryMessage) {
   }
   TempDir dir;
   const std::string bag = dir.File("writer.bag");
-  const std::vector<Written> written = WriteTestBag(bag, GetParam(), 4096);
+  const std::vector<Written> written = WriteTestBag(bag, GetParam(), 4096, 3);
   BagDump dump;
   std::string error;
   ASSERT_TRUE(DumpBagWithRosbag(bag, dir.File("dump.txt"), {}, &dump, &error)) << error;
@@ -137,6 +137,18 @@ TEST(BagWriterTest, LayoutOfTheFileStart) {
   EXPECT_EQ(d[3], 0x18);
   EXPECT_EQ(d[4], 0x64);
   EXPECT_EQ(d[5], 0x60);
+}
+
+TEST(BagWriterTest, CompressionThreadsDoNotChangeTheBytes) {
+  TempDir dir;
+  for (const auto c : {Ros1BagWriter::Compression::kBz2, Ros1BagWriter::Compression::kLz4}) {
+    WriteTestBag(dir.File("one.bag"), c, 4096, 1);
+    WriteTestBag(dir.File("four.bag"), c, 4096, 4);
+    std::string one, four;
+    ASSERT_TRUE(ReadFileToString(dir.File("one.bag"), &one).ok());
+    ASSERT_TRUE(ReadFileToString(dir.File("four.bag"), &four).ok());
+    EXPECT_TRUE(one == four) << Ros1BagWriter::CompressionName(c);
+  }
 }
 
 TEST(BagWriterTest, NothingIsLeftWithoutClose) {
