@@ -61,6 +61,7 @@ std::string Quote(const std::string& text) {
 
 std::string FormatScalar(const Message& message, const FieldDescriptor* field) {
   const auto* r = message.GetReflection();
+  if (field->has_presence() && !r->HasField(message, field)) return "";  // unknown
   switch (field->cpp_type()) {
     case FieldDescriptor::CPPTYPE_INT32: return std::to_string(r->GetInt32(message, field));
     case FieldDescriptor::CPPTYPE_INT64: return std::to_string(r->GetInt64(message, field));

@@ -12,7 +12,7 @@ namespace tiltcal::inspect {
 // singular sub-messages, into CSV columns named by dotted paths
 // (`normal_in_lidar.x`). Repeated fields are left out, except that a Scan
 // gets a computed `num_points` column. Enums print by name, doubles in their
-// shortest round-trip form.
+// shortest round-trip form, unset `optional` fields as empty cells.
 class CsvTable {
  public:
   explicit CsvTable(const google::protobuf::Descriptor* type);

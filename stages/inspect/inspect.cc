@@ -81,23 +81,27 @@ std::string ToText(const Message& message, bool single_line) {
   return text;
 }
 
-// The repeated message field of a text file that `csv` tabulates.
+// The repeated message field of a text file that `csv` tabulates: `requested`,
+// or else the longest one (the per-scan list of gravity.txtpb / truth.txtpb).
 Status FindTableField(const AnyFile& file, const std::string& requested,
                       const FieldDescriptor** field) {
   const Message& message = *file.message;
   const auto* type = message.GetDescriptor();
+  int longest = 0;
   for (int i = 0; i < type->field_count(); ++i) {
     const FieldDescriptor* candidate = type->field(i);
     if (!candidate->is_repeated() ||
         candidate->cpp_type() != FieldDescriptor::CPPTYPE_MESSAGE) {
       continue;
     }
-    if (requested.empty() ? message.GetReflection()->FieldSize(message, candidate) > 0
-                          : candidate->name() == requested) {
+    const int size = message.GetReflection()->FieldSize(message, candidate);
+    if (requested.empty() ? size > longest : candidate->name() == requested) {
       *field = candidate;
-      return Status::Ok();
+      longest = size;
+      if (!requested.empty()) return Status::Ok();
     }
   }
+  if (requested.empty() && longest > 0) return Status::Ok();
   return Status::Error(file.path + ": " + type->full_name() + " has no " +
                        (requested.empty() ? "non-empty repeated message field to tabulate"
                                           : "repeated message field '" + requested + "'"));

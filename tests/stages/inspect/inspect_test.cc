@@ -103,6 +103,7 @@ TEST(InspectCsv, TextFileTabulatesItsRepeatedField) {
   testing::TempDir dir;
   proto::GravityReference gravity;
   gravity.mutable_gravity_flat_in_imu()->set_z(-9.81);
+  gravity.add_static_windows()->set_begin_ns(7);  // shorter list: not the default table
   for (int i = 0; i < 4; ++i) {
     auto* sample = gravity.add_inclination();
     sample->set_stamp_ns(i);
@@ -113,8 +114,13 @@ TEST(InspectCsv, TextFileTabulatesItsRepeatedField) {
   ASSERT_TRUE(RunCsv(dir.File("gravity.txtpb"), {}, out).ok());
   const auto lines = Lines(out.str());
   ASSERT_EQ(lines.size(), 5u);
-  EXPECT_EQ(lines[0], "stamp_ns,inclination_deg,up_in_imu.x,up_in_imu.y,up_in_imu.z");
-  EXPECT_EQ(lines[4], "3,1.5,0,0,0");
+  EXPECT_EQ(lines[0],
+            "stamp_ns,inclination_deg,up_in_imu.x,up_in_imu.y,up_in_imu.z,ground_slope_deg");
+  EXPECT_EQ(lines[4], "3,1.5,0,0,0,");  // unknown slope: empty cell
+
+  std::ostringstream windows;
+  ASSERT_TRUE(RunCsv(dir.File("gravity.txtpb"), {false, 0, "static_windows"}, windows).ok());
+  EXPECT_EQ(Lines(windows.str()).size(), 2u);
 }
 
 TEST(InspectInfo, CountsRecordsReasonsAndSpan) {
