@@ -1,0 +1,119 @@
+#ifndef TILTCAL_STAGES_CALIBRATE_CALIBRATION_STATE_H_
+#define TILTCAL_STAGES_CALIBRATE_CALIBRATION_STATE_H_
+
+// The estimated quantities of the calibrator (DESIGN §5), stored as the
+// parameter blocks of the ceres::Problem. Every pointer handed to Ceres points
+// into this struct (or into the SplineTrajectory it owns), so the struct must
+// not move while a Problem refers to it.
+//
+// Frames: IMU b, LiDAR l, world a = the IMU frame at the first IMU sample.
+// Times: double seconds relative to the first IMU stamp (IMU clock). A LiDAR
+// time t_l happened at IMU time t = t_l + tau.
+//
+// Blocks (all owned here) and their manifolds, as set by the problem builder
+// (problem_builder.h) BEFORE any residual is added:
+//   trajectory.rotation_knot(i)  4 doubles (x, y, z, w), C_ab at knot i,
+//                                spline::RightQuaternionManifold;
+//   trajectory.position_knot(i)  3 doubles, r_a^{ba} at knot i, m;
+//   imu_from_lidar_rotation      4 doubles (x, y, z, w), C_bl,
+//                                spline::RightQuaternionManifold;
+//   imu_from_lidar_translation   3 doubles, r_b^{lb}, m;
+//   time_offset_s                1 double, tau, s, bounded (lower/upper bound
+//                                set on the block);
+//   gravity_direction            3 doubles, unit vector n_g in a pointing DOWN
+//                                (g_a = gravity_norm_mps2 * n_g),
+//                                ceres::SphereManifold<3>;
+//   gyro_bias_radps              3 doubles, b_g, rad/s;
+//   accel_bias_mps2              3 doubles, b_a, m/s^2.
+// Gauge (DESIGN §5: C_ab(t0) = 1, r_a^{ba}(t0) = 0): the builder holds the
+// first knots constant (see problem_builder.h).
+//
+// Residuals that use the time offset pick their knot window from the CURRENT
+// tau when they are added (TimeWindow below) and keep it frozen; u may then
+// leave [0, 1) by at most time_offset_bound / dt while tau moves (see
+// point_to_plane_cost_function.h). The problem is rebuilt, and the windows
+// re-chosen, at every outer iteration.
+//
+// Code that adds more residuals (e.g. the ground residuals of issue 6) only
+// calls problem->AddResidualBlock with these pointers; it must not add the
+// blocks itself, change their manifolds or bounds, or hold the pointers
+// beyond the life of the Problem.
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "common/spline/knot_grid.h"
+#include "common/spline/spline_trajectory.h"
+
+namespace tiltcal::calibrate {
+
+struct CalibrationState {
+  explicit CalibrationState(const spline::UniformKnotGrid& grid) : trajectory(grid) {}
+  CalibrationState(const CalibrationState&) = default;
+  CalibrationState& operator=(const CalibrationState&) = default;
+
+  spline::SplineTrajectory trajectory;
+  double imu_from_lidar_rotation[4] = {0.0, 0.0, 0.0, 1.0};  // C_bl (x, y, z, w)
+  double imu_from_lidar_translation[3] = {0.0, 0.0, 0.0};    // r_b^{lb}, m
+  double time_offset_s[1] = {0.0};                           // tau, s
+  double gravity_direction[3] = {0.0, 0.0, -1.0};            // n_g, unit, frame a, down
+  double gravity_norm_mps2 = 9.81;                           // |g_a|, fixed
+  double gyro_bias_radps[3] = {0.0, 0.0, 0.0};               // b_g
+  double accel_bias_mps2[3] = {0.0, 0.0, 0.0};               // b_a
+
+  // Convenience accessors (copies).
+  Eigen::Quaterniond ImuFromLidarRotation() const {
+    return Eigen::Quaterniond(imu_from_lidar_rotation[3], imu_from_lidar_rotation[0],
+                              imu_from_lidar_rotation[1], imu_from_lidar_rotation[2])
+        .normalized();
+  }
+  Eigen::Vector3d ImuFromLidarTranslation() const {
+    return Eigen::Vector3d(imu_from_lidar_translation[0], imu_from_lidar_translation[1],
+                           imu_from_lidar_translation[2]);
+  }
+  // g_a = |g| n_g, m/s^2, frame a.
+  Eigen::Vector3d GravityInWorld() const {
+    return gravity_norm_mps2 *
+           Eigen::Vector3d(gravity_direction[0], gravity_direction[1], gravity_direction[2])
+               .normalized();
+  }
+  Eigen::Vector3d GyroBias() const {
+    return Eigen::Vector3d(gyro_bias_radps[0], gyro_bias_radps[1], gyro_bias_radps[2]);
+  }
+  Eigen::Vector3d AccelBias() const {
+    return Eigen::Vector3d(accel_bias_mps2[0], accel_bias_mps2[1], accel_bias_mps2[2]);
+  }
+
+  void SetImuFromLidarRotation(const Eigen::Quaterniond& q) {
+    const Eigen::Quaterniond n = q.normalized();
+    imu_from_lidar_rotation[0] = n.x();
+    imu_from_lidar_rotation[1] = n.y();
+    imu_from_lidar_rotation[2] = n.z();
+    imu_from_lidar_rotation[3] = n.w();
+  }
+  void SetImuFromLidarTranslation(const Eigen::Vector3d& r) {
+    for (int i = 0; i < 3; ++i) imu_from_lidar_translation[i] = r[i];
+  }
+  // Sets n_g = g_a / |g_a| (the norm stays gravity_norm_mps2).
+  void SetGravityDirection(const Eigen::Vector3d& gravity_in_world) {
+    const Eigen::Vector3d n = gravity_in_world.normalized();
+    for (int i = 0; i < 3; ++i) gravity_direction[i] = n[i];
+  }
+  void SetGyroBias(const Eigen::Vector3d& b) {
+    for (int i = 0; i < 3; ++i) gyro_bias_radps[i] = b[i];
+  }
+  void SetAccelBias(const Eigen::Vector3d& b) {
+    for (int i = 0; i < 3; ++i) accel_bias_mps2[i] = b[i];
+  }
+
+  // The frozen knot window of a residual at LiDAR time t_lidar_s, chosen with
+  // the current tau: Locate(t_lidar_s + tau). Returns false when that time is
+  // outside the spline (the residual is then skipped).
+  bool TimeWindow(double t_lidar_s, spline::KnotWindow* window) const {
+    return trajectory.grid().Locate(t_lidar_s + time_offset_s[0], window);
+  }
+};
+
+}  // namespace tiltcal::calibrate
+
+#endif  // TILTCAL_STAGES_CALIBRATE_CALIBRATION_STATE_H_
