@@ -35,6 +35,10 @@ struct BagOptions {
   uint32_t chunk_info_version = 1;
   int index_count_delta = 0;  // added to the count of the first index data record
   bool indexed = true;        // false: index_pos 0 and no index section
+  // Non-empty: the last chunk is still open (size 0, data_len 0), as a killed
+  // recorder leaves it; "none" keeps its records after the header, any other
+  // compression keeps only a 7-byte frame start.
+  std::string open_last_chunk_compression;
 };
 
 std::string Time(int64_t ns) {
@@ -81,6 +85,14 @@ std::string BuildBag(const std::vector<Conn>& conns, const std::vector<std::vect
       ++info.counts[m.conn];
       info.start = std::min(info.start, m.time_ns);
       info.end = std::max(info.end, m.time_ns);
+    }
+    if (!options.open_last_chunk_compression.empty() && &chunk == &chunks.back()) {
+      const std::string& compression = options.open_last_chunk_compression;
+      AppendRecord(&body, {{"op", OpValue(Op::kChunk)}, {"compression", compression},
+                           {"size", U32Value(0)}},
+                   "");
+      body += compression == "none" ? data : std::string("\x04\x22\x4d\x18\x64\x60\x85", 7);
+      break;
     }
     AppendRecord(&body, {{"op", OpValue(Op::kChunk)}, {"compression", options.compression},
                          {"size", U32Value(static_cast<uint32_t>(data.size()))}},
@@ -239,6 +251,34 @@ TEST_F(Ros1BagReaderTest, UnindexedBagIsScanned) {
   EXPECT_EQ(seen[0].data, "z");
   EXPECT_EQ(seen[1].data, "a");
   EXPECT_EQ(seen[2].topic, "points");
+}
+
+TEST_F(Ros1BagReaderTest, OpenChunksOfAnInterruptedRecording) {
+  BagOptions options;
+  options.indexed = false;
+  options.open_last_chunk_compression = "none";
+  const std::vector<std::vector<Msg>> chunks = {{{1, 1000, "a"}}, {{1, 2000, "b"}, {5, 2100, "p"}}};
+  // Open uncompressed chunk: its records are read up to the end of the file,
+  // an incomplete last record is left out.
+  const std::string bag = BuildBag(kTwoImuConns, chunks, options);
+  Ros1BagReader reader;
+  ASSERT_TRUE(reader.Open(Write(bag, "a.bag")).ok());
+  EXPECT_EQ(reader.num_salvaged_messages(), 3);
+  EXPECT_EQ(reader.salvage_note(), "");
+  Ros1BagReader cut;
+  ASSERT_TRUE(cut.Open(Write(bag.substr(0, bag.size() - 2), "b.bag")).ok());
+  EXPECT_EQ(cut.num_salvaged_messages(), 2);
+  EXPECT_NE(cut.salvage_note().find("incomplete record"), std::string::npos) << cut.salvage_note();
+  std::vector<Seen> seen;
+  ASSERT_TRUE(ReadAll(&cut, &seen).ok());
+  ASSERT_EQ(seen.size(), 2u);
+  EXPECT_EQ(seen[1].data, "b");
+  // Open lz4 chunk: nothing to recover, and the note says so.
+  options.open_last_chunk_compression = "lz4";
+  Ros1BagReader lz4;
+  ASSERT_TRUE(lz4.Open(Write(BuildBag(kTwoImuConns, chunks, options), "c.bag")).ok());
+  EXPECT_EQ(lz4.num_salvaged_messages(), 1);
+  EXPECT_NE(lz4.salvage_note().find("open lz4 chunk"), std::string::npos) << lz4.salvage_note();
 }
 
 TEST_F(Ros1BagReaderTest, EncryptedBagIsRejected) {
