@@ -73,9 +73,9 @@ std::vector<Written> WriteTestBag(const std::string& path, Ros1BagWriter::Compre
   return written;
 }
 
-class BagWriterRosbagTest : public ::testing::TestWithParam<Ros1BagWriter::Compression> {};
+class Ros1BagWriterRosbagTest : public ::testing::TestWithParam<Ros1BagWriter::Compression> {};
 
-TEST_P(BagWriterRosbagTest, RealRosLibraryReadsEveryMessage) {
+TEST_P(Ros1BagWriterRosbagTest, RealRosLibraryReadsEveryMessage) {
   if (!tiltcal::testing::HaveRosbagPython()) {
     GTEST_SKIP() << "Debian python3-rosbag (/usr/bin/python3) is not installed";
   }
@@ -105,7 +105,7 @@ TEST_P(BagWriterRosbagTest, RealRosLibraryReadsEveryMessage) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Compressions, BagWriterRosbagTest,
+INSTANTIATE_TEST_SUITE_P(Compressions, Ros1BagWriterRosbagTest,
                          ::testing::Values(Ros1BagWriter::Compression::kNone,
                                            Ros1BagWriter::Compression::kBz2,
                                            Ros1BagWriter::Compression::kLz4),
@@ -113,7 +113,7 @@ INSTANTIATE_TEST_SUITE_P(Compressions, BagWriterRosbagTest,
                            return std::string(Ros1BagWriter::CompressionName(info.param));
                          });
 
-TEST(BagWriterTest, LayoutOfTheFileStart) {
+TEST(Ros1BagWriterTest, LayoutOfTheFileStart) {
   TempDir dir;
   const std::string bag = dir.File("layout.bag");
   WriteTestBag(bag, Ros1BagWriter::Compression::kLz4, 1 << 20);
@@ -139,7 +139,7 @@ TEST(BagWriterTest, LayoutOfTheFileStart) {
   EXPECT_EQ(d[5], 0x60);
 }
 
-TEST(BagWriterTest, CompressionThreadsDoNotChangeTheBytes) {
+TEST(Ros1BagWriterTest, CompressionThreadsDoNotChangeTheBytes) {
   TempDir dir;
   for (const auto c : {Ros1BagWriter::Compression::kBz2, Ros1BagWriter::Compression::kLz4}) {
     WriteTestBag(dir.File("one.bag"), c, 4096, 1);
@@ -151,7 +151,7 @@ TEST(BagWriterTest, CompressionThreadsDoNotChangeTheBytes) {
   }
 }
 
-TEST(BagWriterTest, NothingIsLeftWithoutClose) {
+TEST(Ros1BagWriterTest, NothingIsLeftWithoutClose) {
   TempDir dir;
   const std::string bag = dir.File("unfinished.bag");
   {
@@ -167,7 +167,7 @@ TEST(BagWriterTest, NothingIsLeftWithoutClose) {
   EXPECT_FALSE(tiltcal::testing::FileExists(bag));
 }
 
-TEST(BagWriterTest, RejectsTimesOutsideRosTime) {
+TEST(Ros1BagWriterTest, RejectsTimesOutsideRosTime) {
   TempDir dir;
   Ros1BagWriter writer;
   ASSERT_TRUE(writer.Open(dir.File("bad.bag"), Ros1BagWriter::Compression::kNone, 4096).ok());

@@ -20,14 +20,14 @@ namespace {
 
 constexpr double kDeg = M_PI / 180.0;
 
-TEST(EulerAnglesTest, HuskyRigHasTheImuUpsideDownRelativeToTheLidar) {
+TEST(SimEulerAnglesTest, HuskyRigHasTheImuUpsideDownRelativeToTheLidar) {
   const Eigen::Matrix3d c_bl = RotationFromEulerDeg(Eigen::Vector3d(180, 0, -90));
   EXPECT_TRUE((c_bl * Eigen::Vector3d::UnitZ()).isApprox(-Eigen::Vector3d::UnitZ(), 1e-12));
   // Yaw −90 applied last: the LiDAR x axis maps to the IMU's −y.
   EXPECT_TRUE((c_bl * Eigen::Vector3d::UnitX()).isApprox(-Eigen::Vector3d::UnitY(), 1e-12));
 }
 
-TEST(EulerAnglesTest, RoundTrip) {
+TEST(SimEulerAnglesTest, RoundTrip) {
   Rng rng(3);
   for (int i = 0; i < 100; ++i) {
     const Eigen::Vector3d e(rng.Uniform(-179, 179), rng.Uniform(-89, 89), rng.Uniform(-179, 179));
@@ -66,7 +66,7 @@ Eigen::Vector3d SmallLog(const Eigen::Matrix3d& r) {
   return axis_sin * (std::asin(sin_angle) / sin_angle);
 }
 
-TEST(TrajectoryTest, DerivativesMatchFiniteDifferences) {
+TEST(SimTrajectoryTest, DerivativesMatchFiniteDifferences) {
   for (bool vibration : {false, true}) {
     const PlanarTrajectory trajectory(TiltedConfig(vibration));
     const double h = 1e-5;
@@ -91,7 +91,7 @@ TEST(TrajectoryTest, DerivativesMatchFiniteDifferences) {
   }
 }
 
-TEST(TrajectoryTest, PlanarMotionOnTheTiltedPlane) {
+TEST(SimTrajectoryTest, PlanarMotionOnTheTiltedPlane) {
   const TrajectoryConfig config = TiltedConfig(false);
   const PlanarTrajectory trajectory(config);
   const Eigen::Vector3d n = trajectory.NormalInWorld();
@@ -119,7 +119,7 @@ TEST(TrajectoryTest, PlanarMotionOnTheTiltedPlane) {
   EXPECT_GT(max_yaw_rate, 0.3);
 }
 
-TEST(WorldTest, SimpleHits) {
+TEST(SimWorldTest, SimpleHits) {
   World world(Eigen::Vector3d::UnitZ(), 10.0, 3.0);
   world.AddBox({4, 5, -0.5, 0.5, 2.0});
   world.AddPillar({-4, 0, 0.5, 2.0});
@@ -159,7 +159,7 @@ bool InsideSolid(const World& world, double half, double wall_height, const Eige
   return false;
 }
 
-TEST(WorldTest, CastAgreesWithBruteForceRayMarch) {
+TEST(SimWorldTest, CastAgreesWithBruteForceRayMarch) {
   const Eigen::Vector3d n = (RotationFromEulerDeg(Eigen::Vector3d(3, 8, 0)) *
                              Eigen::Vector3d::UnitZ());
   const double half = 12, wall = 3;
@@ -201,7 +201,7 @@ TEST(WorldTest, CastAgreesWithBruteForceRayMarch) {
   EXPECT_GT(hits, 200);
 }
 
-TEST(LidarModelTest, RingsAndFiring) {
+TEST(SimLidarModelTest, RingsAndFiring) {
   for (const LidarModel& m : {Vlp16Model(), Vlp32cModel(), Os132Model(1024)}) {
     SCOPED_TRACE(m.name);
     std::vector<int> seen(m.num_lasers(), 0);
@@ -228,7 +228,7 @@ TEST(LidarModelTest, RingsAndFiring) {
   EXPECT_EQ(SweepStartNs(config, 3), std::llround((0.1 + 0.3) * 1e9));
 }
 
-TEST(ScanSimulatorTest, PointTimesFollowTheStampConvention) {
+TEST(SimScanSimulatorTest, PointTimesFollowTheStampConvention) {
   TrajectoryConfig tc = TiltedConfig(false);
   const PlanarTrajectory trajectory(tc);
   World world(trajectory.NormalInWorld(), 20, 3);
@@ -273,7 +273,7 @@ TEST(ScanSimulatorTest, PointTimesFollowTheStampConvention) {
   EXPECT_EQ(same, a.points.size());
 }
 
-TEST(RngTest, DeterministicAndNormal) {
+TEST(SimRngTest, DeterministicAndNormal) {
   Rng a(9, 2), b(9, 2), c(9, 3);
   EXPECT_EQ(a.NextU64(), b.NextU64());
   EXPECT_NE(b.NextU64(), c.NextU64());

@@ -240,6 +240,39 @@ TEST(SimulateTest, GyroIntegrationTracksTheTrueAttitude) {
       EXPECT_GT(max_error, 5e-3) << "rad";
     }
   }
+  // Every sample minus the exact model value and the bias is white noise of
+  // the configured level: ω_b(t) and f_b(t) = C_wb^T (r̈_w − g_w) of the
+  // scenario's trajectory.
+  Scenario scenario;
+  ASSERT_TRUE(BuildScenario(params, &scenario).ok());
+  const double rate = params.imu().rate_hz();
+  const double gyro_sigma = params.imu().gyro_noise_density_radps_sqrthz() * std::sqrt(rate);
+  const double accel_sigma = params.imu().accel_noise_density_mps2_sqrthz() * std::sqrt(rate);
+  Eigen::Array3d gyro_sum = Eigen::Array3d::Zero(), gyro_sum2 = Eigen::Array3d::Zero();
+  Eigen::Array3d accel_sum = Eigen::Array3d::Zero(), accel_sum2 = Eigen::Array3d::Zero();
+  for (const DumpedMessage* m : imu) {
+    const ImuState state = scenario.trajectory->Evaluate((m->stamp_ns - t0) * 1e-9);
+    const Eigen::Vector3d f =
+        state.world_from_imu.transpose() * (state.acceleration_w - scenario.gravity_w);
+    const Eigen::Array3d eg =
+        (Eigen::Vector3d(m->imu[0], m->imu[1], m->imu[2]) - state.angular_velocity_b - gyro_bias)
+            .array() / gyro_sigma;
+    const Eigen::Array3d ea = (Eigen::Vector3d(m->imu[3], m->imu[4], m->imu[5]) - f -
+                               ToVector(truth.accel_bias_mps2()))
+                                  .array() / accel_sigma;
+    gyro_sum += eg;
+    gyro_sum2 += eg * eg;
+    accel_sum += ea;
+    accel_sum2 += ea * ea;
+  }
+  const double count = static_cast<double>(imu.size());
+  for (int axis = 0; axis < 3; ++axis) {
+    EXPECT_NEAR(gyro_sum[axis] / count, 0.0, 5.0 / std::sqrt(count));
+    EXPECT_NEAR(accel_sum[axis] / count, 0.0, 5.0 / std::sqrt(count));
+    EXPECT_NEAR(std::sqrt(gyro_sum2[axis] / count), 1.0, 0.08);
+    EXPECT_NEAR(std::sqrt(accel_sum2[axis] / count), 1.0, 0.08);
+  }
+
   // Static start: the mean specific force is −g_a + b_a (C_ab = 1 at rest).
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   int n = 0;
@@ -393,6 +426,31 @@ TEST(SimulateTest, BadParamsAreAClearErrorAndLeaveNoOutput) {
     EXPECT_NE(output.find("duration_s"), std::string::npos) << output;
     EXPECT_FALSE(tiltcal::testing::FileExists(outputs.bag_path));
   }
+}
+
+TEST(SimulateTest, CommandLineWritesAllOutputs) {
+  const std::string tool = tiltcal::testing::ToolPath("tiltcal_simulate");
+  if (!tiltcal::testing::FileExists(tool)) GTEST_SKIP() << "build the tiltcal_simulate target";
+  TempDir dir;
+  proto::SimulateParams params = ShortScenario();
+  params.set_duration_s(0.5);
+  ASSERT_TRUE(WriteTextProto(dir.File("s.txtpb"), params).ok());
+  std::string output;
+  ASSERT_EQ(tiltcal::testing::RunCommand(tool + " --params=" + dir.File("s.txtpb") +
+                                             " --out_bag=" + dir.File("s.bag") +
+                                             " --out_truth=" + dir.File("t.txtpb") +
+                                             " --out_rig=" + dir.File("r.txtpb"),
+                                         &output),
+            0)
+      << output;
+  proto::SimulationTruth truth;
+  ASSERT_TRUE(ReadTextProto(dir.File("t.txtpb"), &truth).ok());
+  EXPECT_EQ(truth.provenance().producer(), "tiltcal_simulate");
+  EXPECT_NE(truth.provenance().params_txtpb().find("duration_s: 0.5"), std::string::npos);
+  EXPECT_EQ(truth.scans_size(), 4);  // sweeps at 0.05 + k/10 s ending before 0.5 s
+  EXPECT_TRUE(tiltcal::testing::FileExists(dir.File("s.bag")));
+  EXPECT_TRUE(tiltcal::testing::FileExists(dir.File("r.txtpb")));
+  EXPECT_NE(output.find("4 scans"), std::string::npos) << output;
 }
 
 // OS1-32 (organized, `t` uint32 ns from the first column) and VLP-32C, as
