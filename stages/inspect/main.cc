@@ -7,12 +7,15 @@
 #include <gflags/gflags.h>
 
 #include "stages/inspect/inspect.h"
+#include "stages/inspect/pcd_export.h"
 
 DEFINE_int64(from, 0, "cat: first record to print");
 DEFINE_int64(count, -1, "cat: number of records to print (-1: all)");
 DEFINE_bool(single_line, false, "cat: one record per line");
 DEFINE_bool(points, false, "csv: print the points of scan --record");
-DEFINE_int64(record, 0, "csv --points: index of the scan");
+DEFINE_int64(record, 0, "csv --points / pcd: index of the scan");
+DEFINE_string(ground, "", "pcd: ground.binpb whose point masks label the points");
+DEFINE_string(out, "", "pcd: the PCD file to write");
 DEFINE_string(field, "", "csv of a text file: the repeated field to tabulate");
 
 int main(int argc, char** argv) {
@@ -20,10 +23,11 @@ int main(int argc, char** argv) {
       "looks into any tiltcal file\n"
       "  tiltcal_inspect info FILE\n"
       "  tiltcal_inspect cat FILE [--from=N] [--count=K] [--single_line]\n"
-      "  tiltcal_inspect csv FILE [--points --record=N] [--field=NAME]");
+      "  tiltcal_inspect csv FILE [--points --record=N] [--field=NAME]\n"
+      "  tiltcal_inspect pcd SCANS --record=N [--ground=ground.binpb] --out=scan.pcd");
   gflags::ParseCommandLineFlags(&argc, &argv, /*remove_flags=*/true);
   if (argc != 3) {
-    std::cerr << "usage: tiltcal_inspect info|cat|csv FILE (see --help)\n";
+    std::cerr << "usage: tiltcal_inspect info|cat|csv|pcd FILE (see --help)\n";
     return 2;
   }
   const std::string command = argv[1];
@@ -37,8 +41,10 @@ int main(int argc, char** argv) {
                                       std::cout);
   } else if (command == "csv") {
     status = tiltcal::inspect::RunCsv(path, {FLAGS_points, FLAGS_record, FLAGS_field}, std::cout);
+  } else if (command == "pcd") {
+    status = tiltcal::inspect::RunPcd(path, {FLAGS_record, FLAGS_ground, FLAGS_out}, std::cerr);
   } else {
-    std::cerr << "tiltcal_inspect: unknown command '" << command << "' (info, cat, csv)\n";
+    std::cerr << "tiltcal_inspect: unknown command '" << command << "' (info, cat, csv, pcd)\n";
     return 2;
   }
   std::cout.flush();

@@ -1,0 +1,340 @@
+#include "stages/ground/ground_segmentation.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "common/geometry/plane_fit.h"
+
+namespace tiltcal::ground {
+
+namespace {
+
+constexpr double kDegToRad = M_PI / 180.0;
+constexpr float kTwoPi = 6.28318530717958647692f;
+
+// Zone boundaries b0..b4 (m) from the params.
+void ZoneBounds(const proto::GroundParams& p, double bound[5]) {
+  const double lo = p.min_range_m(), hi = p.max_range_m();
+  bound[0] = lo;
+  bound[4] = hi;
+  if (p.zone_boundaries_m_size() == 3) {
+    for (int k = 0; k < 3; ++k) bound[k + 1] = p.zone_boundaries_m(k);
+  } else {
+    bound[1] = (7.0 * lo + hi) / 8.0;
+    bound[2] = (3.0 * lo + hi) / 4.0;
+    bound[3] = (lo + hi) / 2.0;
+  }
+}
+
+}  // namespace
+
+Status ValidateGroundParams(const proto::GroundParams& p) {
+  if (!(p.max_range_m() > p.min_range_m())) {
+    return Status::Error("field max_range_m must be greater than min_range_m");
+  }
+  if (p.zone_rings_size() != 4) {
+    return Status::Error("field zone_rings must have exactly 4 values (one per zone), has " +
+                         std::to_string(p.zone_rings_size()));
+  }
+  if (p.zone_sectors_size() != 4) {
+    return Status::Error("field zone_sectors must have exactly 4 values (one per zone), has " +
+                         std::to_string(p.zone_sectors_size()));
+  }
+  if (p.zone_boundaries_m_size() != 0 && p.zone_boundaries_m_size() != 3) {
+    return Status::Error("field zone_boundaries_m must have 0 or 3 values, has " +
+                         std::to_string(p.zone_boundaries_m_size()));
+  }
+  double bound[5];
+  ZoneBounds(p, bound);
+  for (int k = 0; k < 4; ++k) {
+    if (!(bound[k + 1] > bound[k])) {
+      return Status::Error(
+          "field zone_boundaries_m must increase strictly between min_range_m and max_range_m");
+    }
+  }
+  if (p.num_rings_of_interest() > 0 && p.near_elevation_m_size() == 0) {
+    return Status::Error("field near_elevation_m needs at least one value when "
+                         "num_rings_of_interest > 0");
+  }
+  if (p.fit_radius_m() == 0.0 && !(p.fit_radius_max_m() >= p.fit_radius_min_m())) {
+    return Status::Error("field fit_radius_max_m must be >= fit_radius_min_m");
+  }
+  if (p.fit_radius_m() == 0.0 && !(p.fit_radius_max_m() > 0.0)) {
+    return Status::Error("field fit_radius_max_m must be > 0 when fit_radius_m is 0 (automatic)");
+  }
+  if (p.min_inliers() < 3) return Status::Error("field min_inliers must be >= 3");
+  return Status::Ok();
+}
+
+float Azimuth02Pi(float y, float x) {
+  const float ax = std::fabs(x), ay = std::fabs(y);
+  const float mx = std::max(ax, ay), mn = std::min(ax, ay);
+  if (!(mx > 0.0f)) return 0.0f;
+  const float a = mn / mx;
+  const float s = a * a;
+  // Minimax polynomial for atan on [0, 1], |error| < 1e-5 rad.
+  float r = ((-0.0464964749f * s + 0.15931422f) * s - 0.327622764f) * s * a + a;
+  if (ay > ax) r = 1.57079632679f - r;
+  if (x < 0.0f) r = 3.14159265359f - r;
+  if (y < 0.0f) r = kTwoPi - r;
+  return r >= kTwoPi ? 0.0f : r;
+}
+
+GroundSegmenter::GroundSegmenter(const proto::GroundParams& p) {
+  ZoneBounds(p, bound_);
+  num_rings_ = 0;
+  num_bins_ = 0;
+  for (int k = 0; k < 4; ++k) {
+    rings_[k] = static_cast<int>(p.zone_rings(k));
+    sectors_[k] = static_cast<int>(p.zone_sectors(k));
+    inv_ring_width_[k] = rings_[k] / (bound_[k + 1] - bound_[k]);
+    sector_scale_[k] = static_cast<float>(sectors_[k] / (2.0 * M_PI));
+    first_ring_[k] = num_rings_;
+    for (int r = 0; r < rings_[k]; ++r) {
+      ring_first_bin_.push_back(num_bins_);
+      num_bins_ += sectors_[k];
+    }
+    num_rings_ += rings_[k];
+  }
+  ring_first_bin_.push_back(num_bins_);
+  num_iterations_ = static_cast<int>(p.num_iterations());
+  num_seed_points_ = p.num_seed_points();
+  seed_margin_ = static_cast<float>(p.seed_height_margin_m());
+  plane_distance_ = static_cast<float>(p.plane_distance_m());
+  min_points_per_bin_ = std::max<uint32_t>(3, p.min_points_per_bin());
+  cos_max_tilt_ = static_cast<float>(std::cos(p.max_bin_tilt_deg() * kDegToRad));
+  max_flatness_ = static_cast<float>(p.max_flatness());
+  max_elongation_ = static_cast<float>(p.max_bin_elongation());
+  far_max_elevation_ = static_cast<float>(p.max_elevation_m());
+  num_rings_of_interest_ = static_cast<int>(p.num_rings_of_interest());
+  for (double e : p.near_elevation_m()) near_elevation_.push_back(static_cast<float>(e));
+  reject_vertical_ = p.reject_vertical();
+  vertical_seed_margin_ = static_cast<float>(p.vertical_seed_margin_m());
+  vertical_distance_ = static_cast<float>(p.vertical_distance_m());
+  seed_floor_ratio_ = p.seed_floor_height_ratio();
+  reference_window_ = p.reference_prior_window_m();
+  min_range2_ = bound_[0] * bound_[0];
+  max_range2_ = bound_[4] * bound_[4];
+  bin_start_.resize(num_bins_ + 1);
+  bins_.resize(num_bins_);
+}
+
+float GroundSegmenter::SeedHeight(uint32_t begin, uint32_t end, double floor_z) {
+  scratch_z_.clear();
+  const float floor_f = static_cast<float>(floor_z);
+  for (uint32_t i = begin; i < end; ++i) {
+    if (active_[i] && bz_[i] >= floor_f) scratch_z_.push_back(bz_[i]);
+  }
+  if (scratch_z_.empty()) {
+    for (uint32_t i = begin; i < end; ++i) {
+      if (active_[i]) scratch_z_.push_back(bz_[i]);
+    }
+  }
+  if (scratch_z_.empty()) return std::numeric_limits<float>::quiet_NaN();
+  const size_t k = std::min<size_t>(num_seed_points_, scratch_z_.size());
+  if (k < scratch_z_.size()) {
+    std::nth_element(scratch_z_.begin(), scratch_z_.begin() + (k - 1), scratch_z_.end());
+  }
+  double sum = 0.0;
+  for (size_t i = 0; i < k; ++i) sum += scratch_z_[i];
+  return static_cast<float>(sum / static_cast<double>(k));
+}
+
+void GroundSegmenter::ProcessBin(int bin, uint32_t begin, uint32_t end, bool zone0,
+                                 double seed_floor_z) {
+  Bin& b = bins_[bin];
+  const Eigen::Vector3d origin(bx_[begin], by_[begin], bz_[begin]);
+  geometry::PlaneMoments moments(origin);
+  geometry::PlaneFit fit;
+  const double floor_z = zone0 ? seed_floor_z : -std::numeric_limits<double>::infinity();
+
+  // Vertical-structure rejection (zone 0 only).
+  if (zone0 && reject_vertical_) {
+    for (int iter = 0; iter < num_iterations_; ++iter) {
+      const float lpr = SeedHeight(begin, end, floor_z);
+      if (!std::isfinite(lpr)) return;
+      const float top = lpr + vertical_seed_margin_;
+      moments.Clear();
+      for (uint32_t i = begin; i < end; ++i) {
+        if (active_[i] && bz_[i] < top) moments.Add(bx_[i], by_[i], bz_[i]);
+      }
+      fit = geometry::FitPlane(moments);
+      if (!fit.ok || fit.normal.z() >= cos_max_tilt_) break;
+      const float nx = fit.normal.x(), ny = fit.normal.y(), nz = fit.normal.z();
+      const float d = static_cast<float>(fit.offset);
+      uint32_t removed = 0;
+      for (uint32_t i = begin; i < end; ++i) {
+        if (active_[i] && std::fabs(nx * bx_[i] + ny * by_[i] + nz * bz_[i] + d) <
+                              vertical_distance_) {
+          active_[i] = 0;
+          ++removed;
+        }
+      }
+      if (removed == 0) break;
+    }
+  }
+
+  // Ground plane from the lowest points, then refits on two-sided inliers.
+  const float lpr = SeedHeight(begin, end, floor_z);
+  if (!std::isfinite(lpr)) return;
+  const float top = lpr + seed_margin_;
+  moments.Clear();
+  for (uint32_t i = begin; i < end; ++i) {
+    if (active_[i] && bz_[i] < top) moments.Add(bx_[i], by_[i], bz_[i]);
+  }
+  fit = geometry::FitPlane(moments);
+  for (int iter = 0; iter < num_iterations_ && fit.ok; ++iter) {
+    const float nx = fit.normal.x(), ny = fit.normal.y(), nz = fit.normal.z();
+    const float d = static_cast<float>(fit.offset);
+    moments.Clear();
+    const bool last = iter + 1 == num_iterations_;
+    for (uint32_t i = begin; i < end; ++i) {
+      const bool in =
+          active_[i] && std::fabs(nx * bx_[i] + ny * by_[i] + nz * bz_[i] + d) < plane_distance_;
+      if (in) moments.Add(bx_[i], by_[i], bz_[i]);
+      if (last) bground_[i] = in ? 1 : 0;
+    }
+    fit = geometry::FitPlane(moments);
+  }
+  if (!fit.ok) {
+    for (uint32_t i = begin; i < end; ++i) bground_[i] = 0;
+    return;
+  }
+  b.ok = true;
+  b.normal = fit.normal.cast<float>();
+  b.centroid = fit.centroid.cast<float>();
+  b.offset = static_cast<float>(fit.offset);
+  b.flatness = static_cast<float>(fit.eigenvalues(0));
+  b.elongation = static_cast<float>(fit.eigenvalues(2) / fit.eigenvalues(1));
+}
+
+SegmentationSummary GroundSegmenter::Segment(const float* x, const float* y, const float* z,
+                                             size_t n, double height_prior_m) {
+  SegmentationSummary summary;
+  summary.num_points = static_cast<uint32_t>(n);
+  bin_of_.resize(n);
+  std::fill(bin_start_.begin(), bin_start_.end(), 0u);
+
+  // 1. Bin index of every point and per-bin counts.
+  uint32_t* count = bin_start_.data() + 1;
+  size_t binned = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const float xi = x[i], yi = y[i], zi = z[i];
+    bin_of_[i] = -1;
+    if (!std::isfinite(xi) || !std::isfinite(yi) || !std::isfinite(zi)) continue;
+    const double r2 = static_cast<double>(xi) * xi + static_cast<double>(yi) * yi;
+    if (r2 <= min_range2_ || r2 > max_range2_) continue;
+    const double r = std::sqrt(r2);
+    const int zone = r < bound_[1] ? 0 : r < bound_[2] ? 1 : r < bound_[3] ? 2 : 3;
+    const int ring_local =
+        std::min(static_cast<int>((r - bound_[zone]) * inv_ring_width_[zone]), rings_[zone] - 1);
+    const int sector = std::min(static_cast<int>(Azimuth02Pi(yi, xi) * sector_scale_[zone]),
+                                sectors_[zone] - 1);
+    const int bin = ring_first_bin_[first_ring_[zone] + ring_local] + sector;
+    bin_of_[i] = bin;
+    ++count[bin];
+    ++binned;
+  }
+  // 2. Counting sort into contiguous per-bin columns.
+  for (int b = 0; b < num_bins_; ++b) bin_start_[b + 1] += bin_start_[b];
+  num_binned_ = binned;
+  bx_.resize(binned);
+  by_.resize(binned);
+  bz_.resize(binned);
+  bsrc_.resize(binned);
+  bground_.assign(binned, 0);
+  active_.assign(binned, 1);
+  {
+    // bin_start_[b] is the write cursor of bin b; restored afterwards.
+    for (size_t i = 0; i < n; ++i) {
+      const int b = bin_of_[i];
+      if (b < 0) continue;
+      const uint32_t pos = bin_start_[b]++;
+      bx_[pos] = x[i];
+      by_[pos] = y[i];
+      bz_[pos] = z[i];
+      bsrc_[pos] = static_cast<uint32_t>(i);
+    }
+    for (int b = num_bins_; b > 0; --b) bin_start_[b] = bin_start_[b - 1];
+    bin_start_[0] = 0;
+  }
+  summary.num_binned = static_cast<uint32_t>(binned);
+
+  // 3. Per-bin plane fits.
+  const bool have_prior = height_prior_m > 0.0;
+  const double seed_floor_z = (have_prior && seed_floor_ratio_ > 0.0)
+                                  ? -seed_floor_ratio_ * height_prior_m
+                                  : -std::numeric_limits<double>::infinity();
+  for (int ring = 0; ring < num_rings_; ++ring) {
+    const bool zone0 = ring < rings_[0];
+    for (int b = ring_first_bin_[ring]; b < ring_first_bin_[ring + 1]; ++b) {
+      bins_[b] = Bin();
+      bins_[b].ring = ring;
+      const uint32_t begin = bin_start_[b], end = bin_start_[b + 1];
+      if (end - begin < min_points_per_bin_) continue;
+      ProcessBin(b, begin, end, zone0, seed_floor_z);
+      if (bins_[b].ok) ++summary.num_bins_fitted;
+    }
+  }
+
+  // 4. Ground reference height: median centroid z of upright, sensor-facing,
+  //    non-elongated bins in the rings of interest (ring 0 when none).
+  reference_samples_.clear();
+  const int reference_rings = std::min(std::max(1, num_rings_of_interest_), num_rings_);
+  for (int pass = 0; pass < 2 && reference_samples_.empty(); ++pass) {
+    // Pass 0 keeps bins near the height prior; pass 1 (no prior, or a prior
+    // that matches nothing) takes all of them, so a wrong prior shows up as a
+    // height-prior rejection rather than as missing ground.
+    const bool windowed = pass == 0 && have_prior;
+    if (pass == 1 && !have_prior) break;
+    for (int b = 0; b < ring_first_bin_[reference_rings]; ++b) {
+      const Bin& bin = bins_[b];
+      if (!bin.ok || bin.normal.z() < cos_max_tilt_ || bin.offset <= 0.0f) continue;
+      if (bin.elongation > max_elongation_) continue;
+      if (windowed && std::fabs(bin.centroid.z() + height_prior_m) > reference_window_) continue;
+      reference_samples_.push_back(bin.centroid.z());
+    }
+  }
+  if (!reference_samples_.empty()) {
+    const size_t mid = reference_samples_.size() / 2;
+    std::nth_element(reference_samples_.begin(), reference_samples_.begin() + mid,
+                     reference_samples_.end());
+    summary.has_reference = true;
+    summary.reference_z_m = reference_samples_[mid];
+  }
+
+  // 5. Ground likelihood per bin; clear the labels of rejected bins.
+  const float ref = static_cast<float>(summary.reference_z_m);
+  for (int b = 0; b < num_bins_; ++b) {
+    Bin& bin = bins_[b];
+    // Upright, sensor above the plane (rejects ceilings), and in the rings of
+    // interest not a single-beam line.
+    bool ground = bin.ok && bin.normal.z() >= cos_max_tilt_ && bin.offset > 0.0f;
+    if (ground && bin.ring < num_rings_of_interest_ && bin.elongation > max_elongation_) {
+      ground = false;
+    }
+    if (ground && summary.has_reference) {
+      const float elevation = bin.centroid.z() - ref;
+      if (bin.ring < num_rings_of_interest_) {
+        const float limit =
+            near_elevation_[std::min<size_t>(bin.ring, near_elevation_.size() - 1)];
+        if (elevation > limit && bin.flatness >= max_flatness_) ground = false;
+      } else if (elevation > far_max_elevation_) {
+        ground = false;
+      }
+    }
+    bin.ground = ground;
+    const uint32_t begin = bin_start_[b], end = bin_start_[b + 1];
+    if (!ground) {
+      for (uint32_t i = begin; i < end; ++i) bground_[i] = 0;
+    } else {
+      ++summary.num_bins_ground;
+      for (uint32_t i = begin; i < end; ++i) summary.num_ground += bground_[i];
+    }
+  }
+  return summary;
+}
+
+}  // namespace tiltcal::ground

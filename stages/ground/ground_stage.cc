@@ -1,0 +1,183 @@
+#include "stages/ground/ground_stage.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <vector>
+
+#include "common/io/provenance.h"
+#include "common/io/record_stream.h"
+#include "common/io/text_proto.h"
+#include "stages/ground/deskew.h"
+#include "stages/ground/ground_segmentation.h"
+#include "stages/ground/scan_plane.h"
+#include "stages/ground/scan_processor.h"
+#include "tiltcal/proto/imu.pb.h"
+#include "tiltcal/proto/rig.pb.h"
+#include "tiltcal/proto/scan.pb.h"
+
+namespace tiltcal::ground {
+
+namespace {
+
+bool Finite(const proto::Vector3& v) {
+  return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z());
+}
+
+Status CheckImu(const std::string& path, const std::vector<proto::ImuSample>& samples) {
+  for (size_t i = 0; i < samples.size(); ++i) {
+    const proto::ImuSample& s = samples[i];
+    if (!Finite(s.angular_velocity_radps()) || !Finite(s.linear_acceleration_mps2())) {
+      return Status::Error(path + ": record " + std::to_string(i) + ": non-finite IMU reading");
+    }
+    if (i > 0 && s.stamp_ns() <= samples[i - 1].stamp_ns()) {
+      return Status::Error(path + ": record " + std::to_string(i) + ": stamp " +
+                           std::to_string(s.stamp_ns()) + " ns does not increase (previous " +
+                           std::to_string(samples[i - 1].stamp_ns()) + ")");
+    }
+  }
+  return Status::Ok();
+}
+
+Status CheckScan(const std::string& path, int64_t record, const proto::Scan& scan) {
+  const int n = scan.x_size();
+  const std::string where = path + ": record " + std::to_string(record) + ": ";
+  if (scan.y_size() != n || scan.z_size() != n) {
+    return Status::Error(where + "point columns x, y, z have different lengths");
+  }
+  if (scan.intensity_size() != 0 && scan.intensity_size() != n) {
+    return Status::Error(where + "intensity column length differs from x");
+  }
+  if (scan.ring_size() != 0 && scan.ring_size() != n) {
+    return Status::Error(where + "ring column length differs from x");
+  }
+  if (scan.time_offset_ns_size() != 0 && scan.time_offset_ns_size() != n) {
+    return Status::Error(where + "time_offset_ns column length differs from x");
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
+std::string ReasonName(proto::GroundRejectReason reason) {
+  std::string name = proto::GroundRejectReason_Name(reason);
+  if (name.rfind("GROUND_", 0) == 0) name = name.substr(7);
+  std::transform(name.begin(), name.end(), name.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return name;
+}
+
+Status Run(const GroundPaths& paths, const proto::GroundParams& params,
+           GroundRunSummary* summary_out, std::ostream* log) {
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  GroundRunSummary summary;
+  TILTCAL_RETURN_IF_ERROR(ValidateGroundParams(params).WithContext("params"));
+  if (paths.scans.empty() || paths.rig.empty() || paths.out_ground.empty() ||
+      paths.imu.empty()) {
+    return Status::Error("--imu, --scans, --rig and --out_ground are required");
+  }
+
+  proto::Rig rig;
+  TILTCAL_RETURN_IF_ERROR(ReadTextProto(paths.rig, &rig));
+  const auto& q = rig.imu_from_lidar().rotation();
+  const double q_norm = std::sqrt(q.w() * q.w() + q.x() * q.x() + q.y() * q.y() + q.z() * q.z());
+  if (!(std::fabs(q_norm - 1.0) < 1e-3)) {
+    return Status::Error(paths.rig + ": imu_from_lidar.rotation is not a unit quaternion (norm " +
+                         std::to_string(q_norm) + ")");
+  }
+  if (!Finite(rig.imu_from_lidar().translation()) || !Finite(rig.gravity_flat_in_imu()) ||
+      !std::isfinite(rig.imu_height_m())) {
+    return Status::Error(paths.rig + ": non-finite value");
+  }
+
+  std::vector<proto::ImuSample> imu;
+  TILTCAL_RETURN_IF_ERROR(ReadAllRecords<proto::ImuSample>(paths.imu, &imu));
+  TILTCAL_RETURN_IF_ERROR(CheckImu(paths.imu, imu));
+  const StaticStart static_start = EstimateStaticGyroBias(
+      imu, params.static_gyro_max_radps(), params.static_min_duration_s());
+  summary.static_start = static_start.found;
+  summary.static_duration_s = static_start.duration_s;
+  GyroIntegrator integrator(imu, static_start.gyro_bias_radps);
+  const Eigen::Quaterniond c_bl_q(q.w(), q.x(), q.y(), q.z());
+  Deskewer deskewer(&integrator, c_bl_q.normalized().toRotationMatrix(),
+                    std::llround(params.time_offset_s() * 1e9), params.deskew_node_spacing_s());
+
+  const GroundFrame frame = MakeGroundFrame(rig, params);
+  ScanProcessor processor(params, frame, &deskewer);
+
+  RecordReader reader;
+  TILTCAL_RETURN_IF_ERROR(reader.Open(paths.scans, proto::Scan::descriptor()->full_name()));
+  const proto::Provenance provenance = MakeProvenance(
+      "tiltcal_ground", params,
+      {{"imu", paths.imu}, {"scans", paths.scans}, {"rig", paths.rig}}, paths.command_line);
+  std::unique_ptr<RecordWriter> scan_writer;
+  if (!paths.out_scans.empty()) {
+    scan_writer = std::make_unique<RecordWriter>();
+    TILTCAL_RETURN_IF_ERROR(scan_writer->Open(paths.out_scans,
+                                              proto::Scan::descriptor()->full_name(), provenance,
+                                              /*compress=*/true));
+  }
+
+  std::vector<proto::GroundPlane> planes;
+  proto::Scan scan;
+  for (int64_t record = 0;; ++record) {
+    bool end = false;
+    scan.Clear();
+    TILTCAL_RETURN_IF_ERROR(reader.Read(&scan, &end));
+    if (end) break;
+    TILTCAL_RETURN_IF_ERROR(CheckScan(paths.scans, record, scan));
+    planes.push_back(processor.Process(&scan));
+    summary.deskew_s += processor.last_deskew_s();
+    summary.segment_s += processor.last_segment_s();
+    summary.fit_s += processor.last_fit_s();
+    if (planes.back().deskewed()) ++summary.num_deskewed;
+    if (scan_writer) TILTCAL_RETURN_IF_ERROR(scan_writer->Write(scan));
+  }
+  ApplyTiltJumpGate(params.max_tilt_jump_deg(), static_cast<int>(params.tilt_jump_window()),
+                    &planes);
+
+  RecordWriter writer;
+  TILTCAL_RETURN_IF_ERROR(writer.Open(paths.out_ground,
+                                      proto::GroundPlane::descriptor()->full_name(), provenance,
+                                      /*compress=*/false));
+  for (const proto::GroundPlane& plane : planes) {
+    TILTCAL_RETURN_IF_ERROR(writer.Write(plane));
+    ++summary.num_scans;
+    if (plane.valid()) {
+      ++summary.num_valid;
+    } else {
+      ++summary.rejected[plane.reject_reason()];
+    }
+  }
+  if (scan_writer) TILTCAL_RETURN_IF_ERROR(scan_writer->Close());
+  TILTCAL_RETURN_IF_ERROR(writer.Close());
+  summary.total_s = std::chrono::duration<double>(Clock::now() - start).count();
+
+  if (log != nullptr) {
+    const double per_scan = summary.num_scans > 0 ? 1e3 / summary.num_scans : 0.0;
+    char line[256];
+    std::snprintf(line, sizeof(line),
+                  "tiltcal_ground: %d scans, %d valid, %d deskewed; gyro bias from static start: "
+                  "%s (%.2f s); per scan: deskew %.2f ms, segment %.2f ms, fit %.2f ms; "
+                  "total %.2f s\n",
+                  summary.num_scans, summary.num_valid, summary.num_deskewed,
+                  summary.static_start ? "yes" : "no", summary.static_duration_s,
+                  summary.deskew_s * per_scan, summary.segment_s * per_scan,
+                  summary.fit_s * per_scan, summary.total_s);
+    *log << line;
+    if (!summary.rejected.empty()) {
+      *log << "tiltcal_ground: rejected:";
+      for (const auto& [reason, count] : summary.rejected) {
+        *log << " " << ReasonName(reason) << "=" << count;
+      }
+      *log << "\n";
+    }
+  }
+  if (summary_out != nullptr) *summary_out = summary;
+  return Status::Ok();
+}
+
+}  // namespace tiltcal::ground

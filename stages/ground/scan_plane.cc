@@ -1,0 +1,191 @@
+#include "stages/ground/scan_plane.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace tiltcal::ground {
+
+namespace {
+
+constexpr double kRadToDeg = 180.0 / M_PI;
+
+std::string Format(const char* format, double a, double b = 0.0) {
+  char buffer[160];
+  std::snprintf(buffer, sizeof(buffer), format, a, b);
+  return buffer;
+}
+
+}  // namespace
+
+ScanPlaneFitter::ScanPlaneFitter(const proto::GroundParams& params) : params_(params) {}
+
+ScanPlane ScanPlaneFitter::Fit(const GroundSegmenter& segmenter,
+                               const SegmentationSummary& summary, double height_prior_m,
+                               std::vector<uint8_t>* inlier) {
+  ScanPlane out;
+  const size_t n = segmenter.num_binned();
+  inlier->assign(n, 0);
+  const float* x = segmenter.binned_x();
+  const float* y = segmenter.binned_y();
+  const float* z = segmenter.binned_z();
+  const uint8_t* ground = segmenter.binned_ground();
+
+  if (summary.num_binned == 0) {
+    out.reason = proto::GROUND_EMPTY_SCAN;
+    out.detail = Format("no finite point within %.1f..%.1f m", params_.min_range_m(),
+                        params_.max_range_m());
+    return out;
+  }
+
+  // Fit radius: fixed, or sized to where the lowest beam meets the ground.
+  double radius = params_.fit_radius_m();
+  if (radius <= 0.0) {
+    radii_.clear();
+    for (size_t i = 0; i < n; ++i) {
+      if (ground[i]) radii_.push_back(std::sqrt(x[i] * x[i] + y[i] * y[i]));
+    }
+    double first_ring = params_.fit_radius_min_m();
+    if (!radii_.empty()) {
+      const size_t k = std::min(radii_.size() - 1,
+                                static_cast<size_t>(params_.fit_first_ring_quantile() *
+                                                    static_cast<double>(radii_.size())));
+      std::nth_element(radii_.begin(), radii_.begin() + k, radii_.end());
+      first_ring = radii_[k];
+    }
+    radius = std::clamp(params_.fit_radius_first_ring_ratio() * first_ring,
+                        params_.fit_radius_min_m(), params_.fit_radius_max_m());
+  }
+  out.fit_radius_m = radius;
+  const float radius2 = static_cast<float>(radius * radius);
+  candidates_.clear();
+  for (size_t i = 0; i < n; ++i) {
+    if (ground[i] && x[i] * x[i] + y[i] * y[i] <= radius2) {
+      candidates_.push_back(static_cast<uint32_t>(i));
+    }
+  }
+  out.num_candidates = static_cast<uint32_t>(candidates_.size());
+  if (candidates_.size() < params_.min_inliers()) {
+    out.reason = proto::GROUND_TOO_FEW_POINTS;
+    out.detail = Format("%.0f ground points within %.2f m, need min_inliers", candidates_.size(),
+                        radius);
+    return out;
+  }
+
+  geometry::RobustPlaneOptions options;
+  options.inlier_distance_m = params_.inlier_distance_m();
+  options.max_iterations = static_cast<int>(params_.fit_iterations());
+  out.fit = geometry::FitPlaneRobust(x, y, z, candidates_.data(), candidates_.size(), options,
+                                     &fit_inlier_);
+  if (!out.fit.ok) {
+    out.reason = proto::GROUND_FIT_FAILED;
+    out.detail = Format("degenerate plane from %.0f points", candidates_.size());
+    return out;
+  }
+  // Sign rule: the normal points towards the sensor (origin), d > 0.
+  geometry::OrientTowards(Eigen::Vector3d::Zero(), &out.fit);
+  uint32_t num_inliers = 0;
+  const uint32_t sectors = params_.azimuth_sectors();
+  sector_count_.assign(sectors, 0);
+  const float sector_scale = static_cast<float>(sectors / (2.0 * M_PI));
+  for (size_t k = 0; k < candidates_.size(); ++k) {
+    if (!fit_inlier_[k]) continue;
+    const uint32_t i = candidates_[k];
+    (*inlier)[i] = 1;
+    ++num_inliers;
+    const uint32_t s = std::min<uint32_t>(
+        static_cast<uint32_t>(Azimuth02Pi(y[i], x[i]) * sector_scale), sectors - 1);
+    ++sector_count_[s];
+  }
+  out.num_inliers = num_inliers;
+  // Radial spread of the inliers: 90th / 10th percentile of the ranges.
+  radii_.clear();
+  for (size_t k = 0; k < candidates_.size(); ++k) {
+    if (!fit_inlier_[k]) continue;
+    const uint32_t i = candidates_[k];
+    radii_.push_back(std::sqrt(x[i] * x[i] + y[i] * y[i]));
+  }
+  if (radii_.size() >= 10) {
+    const size_t lo = radii_.size() / 10, hi = radii_.size() - 1 - radii_.size() / 10;
+    std::nth_element(radii_.begin(), radii_.begin() + lo, radii_.end());
+    const float r_lo = radii_[lo];
+    std::nth_element(radii_.begin() + lo, radii_.begin() + hi, radii_.end());
+    const float r_hi = radii_[hi];
+    out.radial_spread = r_lo > 0.0f ? static_cast<double>(r_hi) / r_lo : 0.0;
+  }
+  uint32_t covered = 0;
+  for (uint32_t c : sector_count_) covered += c >= params_.min_points_per_sector() ? 1 : 0;
+  out.coverage = static_cast<double>(covered) / sectors;
+  const double noise_variance = geometry::PlaneNoiseVariance(out.fit);
+  out.rms_m = std::sqrt(std::max(0.0, out.fit.eigenvalues(0)));
+  out.covariance = geometry::PlaneCovariance(out.fit, noise_variance);
+  out.tilt_from_up_deg =
+      std::acos(std::clamp(out.fit.normal.z(), -1.0, 1.0)) * kRadToDeg;
+  const double height = out.fit.offset;
+
+  // Gates, in order of severity.
+  if (num_inliers < params_.min_inliers()) {
+    out.reason = proto::GROUND_TOO_FEW_POINTS;
+    out.detail = Format("%.0f inliers < min_inliers %.0f", num_inliers, params_.min_inliers());
+  } else if (!(height > 0.0)) {
+    out.reason = proto::GROUND_FIT_FAILED;
+    out.detail = Format("plane through the sensor (d = %.3f m)", height);
+  } else if (out.tilt_from_up_deg > params_.max_normal_tilt_deg()) {
+    out.reason = proto::GROUND_NORMAL_NOT_UP;
+    out.detail = Format("normal %.2f deg from up > %.2f deg", out.tilt_from_up_deg,
+                        params_.max_normal_tilt_deg());
+  } else if (out.coverage < params_.min_azimuth_coverage()) {
+    out.reason = proto::GROUND_POOR_COVERAGE;
+    out.detail = Format("azimuth coverage %.3f < %.3f", out.coverage,
+                        params_.min_azimuth_coverage());
+  } else if (out.radial_spread < params_.min_radial_spread_ratio()) {
+    out.reason = proto::GROUND_POOR_COVERAGE;
+    out.detail = Format("radial spread %.3f < %.3f (ground seen by a single beam?)",
+                        out.radial_spread, params_.min_radial_spread_ratio());
+  } else if (out.rms_m > params_.max_rms_m()) {
+    out.reason = proto::GROUND_HIGH_RMS;
+    out.detail = Format("rms %.4f m > %.4f m", out.rms_m, params_.max_rms_m());
+  } else if (height_prior_m > 0.0 &&
+             std::fabs(height - height_prior_m) > params_.max_height_deviation_m()) {
+    out.reason = proto::GROUND_HEIGHT_PRIOR;
+    out.detail = Format("height %.3f m vs prior %.3f m", height, height_prior_m);
+  }
+  return out;
+}
+
+void ApplyTiltJumpGate(double max_tilt_jump_deg, int window,
+                       std::vector<proto::GroundPlane>* planes) {
+  const int n = static_cast<int>(planes->size());
+  std::vector<Eigen::Vector3d> normals(n, Eigen::Vector3d::Zero());
+  std::vector<bool> valid(n, false);
+  for (int i = 0; i < n; ++i) {
+    const proto::GroundPlane& p = (*planes)[i];
+    valid[i] = p.valid();
+    normals[i] = Eigen::Vector3d(p.normal_in_lidar().x(), p.normal_in_lidar().y(),
+                                 p.normal_in_lidar().z());
+  }
+  // Decisions use the validity before this pass only.
+  for (int i = 0; i < n; ++i) {
+    if (!valid[i]) continue;
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    int count = 0;
+    for (int j = std::max(0, i - window); j <= std::min(n - 1, i + window); ++j) {
+      if (j == i || !valid[j]) continue;
+      sum += normals[j];
+      ++count;
+    }
+    if (count < 2 || !(sum.norm() > 0.0)) continue;
+    const double cos_angle = std::clamp(sum.normalized().dot(normals[i]), -1.0, 1.0);
+    const double jump_deg = std::acos(cos_angle) * kRadToDeg;
+    proto::GroundPlane& p = (*planes)[i];
+    p.set_tilt_jump_deg(jump_deg);
+    if (max_tilt_jump_deg > 0.0 && jump_deg > max_tilt_jump_deg) {
+      p.set_valid(false);
+      p.set_reject_reason(proto::GROUND_TILT_JUMP);
+      p.set_reject_detail(Format("normal %.2f deg from its neighbours' mean > %.2f deg",
+                                 jump_deg, max_tilt_jump_deg));
+    }
+  }
+}
+
+}  // namespace tiltcal::ground

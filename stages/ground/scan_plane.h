@@ -1,0 +1,65 @@
+#ifndef TILTCAL_STAGES_GROUND_SCAN_PLANE_H_
+#define TILTCAL_STAGES_GROUND_SCAN_PLANE_H_
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "common/geometry/plane_fit.h"
+#include "stages/ground/ground_segmentation.h"
+#include "tiltcal/proto/ground.pb.h"
+#include "tiltcal/proto/ground_params.pb.h"
+
+namespace tiltcal::ground {
+
+// One plane per scan from the segmented ground points, in frame s.
+struct ScanPlane {
+  proto::GroundRejectReason reason = proto::GROUND_OK;
+  std::string detail;               // numbers behind a rejection
+  geometry::PlaneFit fit;           // oriented towards the sensor (d > 0) when ok
+  Eigen::Matrix4d covariance = Eigen::Matrix4d::Zero();  // of (n_x, n_y, n_z, d), frame s
+  double rms_m = 0.0;               // inlier point-to-plane RMS
+  double coverage = 0.0;            // fraction of azimuth sectors with inliers
+  double radial_spread = 0.0;       // 90th / 10th percentile of inlier ranges
+  double tilt_from_up_deg = 0.0;    // angle between n and the s-frame z axis
+  double fit_radius_m = 0.0;
+  uint32_t num_candidates = 0;      // ground points inside the fit radius
+  uint32_t num_inliers = 0;
+  bool has_plane() const { return fit.ok; }
+};
+
+// Near-field robust plane fit with the sign rule and the quality gates of the
+// params (gates: too few points, degenerate fit, normal not up, azimuthal
+// coverage, radial spread, RMS, height prior; the tilt-jump gate is a sequence pass, see
+// ApplyTiltJumpGate). Buffers are reused between scans.
+class ScanPlaneFitter {
+ public:
+  explicit ScanPlaneFitter(const proto::GroundParams& params);
+
+  // Fits the plane to the ground points of the segmenter's last scan.
+  // `inlier` receives, per binned point (segmenter order), 1 when the point
+  // is used by the final fit. height_prior_m > 0 enables the height gate.
+  ScanPlane Fit(const GroundSegmenter& segmenter, const SegmentationSummary& summary,
+                double height_prior_m, std::vector<uint8_t>* inlier);
+
+ private:
+  proto::GroundParams params_;
+  std::vector<uint32_t> candidates_;
+  std::vector<float> radii_;
+  std::vector<uint8_t> fit_inlier_;
+  std::vector<uint32_t> sector_count_;
+};
+
+// Sequence gate: a valid plane whose normal is more than max_tilt_jump_deg
+// from the normalised mean normal of the valid planes within ±window records
+// (excluding itself; at least 2 needed) is rejected with GROUND_TILT_JUMP.
+// Uses only the values in `planes`, so the result does not depend on the
+// order in which scans were processed. Fills tilt_jump_deg.
+void ApplyTiltJumpGate(double max_tilt_jump_deg, int window,
+                       std::vector<proto::GroundPlane>* planes);
+
+}  // namespace tiltcal::ground
+
+#endif  // TILTCAL_STAGES_GROUND_SCAN_PLANE_H_

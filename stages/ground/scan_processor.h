@@ -1,0 +1,72 @@
+#ifndef TILTCAL_STAGES_GROUND_SCAN_PROCESSOR_H_
+#define TILTCAL_STAGES_GROUND_SCAN_PROCESSOR_H_
+
+#include <vector>
+
+#include <Eigen/Core>
+#include <google/protobuf/repeated_field.h>
+
+#include "stages/ground/deskew.h"
+#include "stages/ground/ground_segmentation.h"
+#include "stages/ground/scan_plane.h"
+#include "tiltcal/proto/ground.pb.h"
+#include "tiltcal/proto/ground_params.pb.h"
+#include "tiltcal/proto/rig.pb.h"
+#include "tiltcal/proto/scan.pb.h"
+
+namespace tiltcal::ground {
+
+// What the per-scan pipeline needs to know about the sequence.
+struct GroundFrame {
+  // C_sl: rotates LiDAR coordinates into the segmentation frame s whose z axis
+  // is the expected up direction (identity when up is the LiDAR z axis).
+  Eigen::Matrix3d s_from_lidar = Eigen::Matrix3d::Identity();
+  // Expected LiDAR height above ground (m), 0 = none.
+  double height_prior_m = 0.0;
+};
+
+// The frame and height prior from the rig and the params (see
+// GroundParams.use_rig_up_direction and sensor_height_guess_m).
+GroundFrame MakeGroundFrame(const proto::Rig& rig, const proto::GroundParams& params);
+
+// Deskew + segmentation + plane fit of one scan at a time; buffers are reused.
+class ScanProcessor {
+ public:
+  // `deskewer` may be null (no deskewing).
+  ScanProcessor(const proto::GroundParams& params, const GroundFrame& frame, Deskewer* deskewer);
+
+  // Processes one scan. When deskewing applies, the scan's points are moved
+  // in place and scan->deskewed() is set. The returned plane has no NaN.
+  proto::GroundPlane Process(proto::Scan* scan);
+
+  // Seconds spent in the last Process() call, per step.
+  double last_deskew_s() const { return deskew_s_; }
+  double last_segment_s() const { return segment_s_; }
+  double last_fit_s() const { return fit_s_; }
+
+ private:
+  proto::GroundParams params_;
+  GroundFrame frame_;
+  bool level_ = false;
+  Deskewer* deskewer_;
+  GroundSegmenter segmenter_;
+  ScanPlaneFitter fitter_;
+  std::vector<float> sx_, sy_, sz_;
+  std::vector<uint8_t> inlier_;
+  double deskew_s_ = 0, segment_s_ = 0, fit_s_ = 0;
+};
+
+// Packs a per-binned-point flag into a per-source-point bit mask: bit
+// (i % 64) of word i / 64 is point i.
+void PackMask(const uint8_t* binned_flag, const uint32_t* binned_source, size_t num_binned,
+              size_t num_points, google::protobuf::RepeatedField<uint64_t>* mask);
+
+// Bit of point i in a mask packed by PackMask (false beyond its end).
+inline bool MaskBit(const google::protobuf::RepeatedField<uint64_t>& mask, size_t i) {
+  const size_t word = i >> 6;
+  return word < static_cast<size_t>(mask.size()) && ((mask.Get(word) >> (i & 63u)) & 1u);
+}
+
+}  // namespace tiltcal::ground
+
+#endif  // TILTCAL_STAGES_GROUND_SCAN_PROCESSOR_H_

@@ -1,0 +1,179 @@
+// tiltcal_ground as a program: synthetic IMU + scans written as our streams,
+// the executable run on them, its outputs read back and compared with the
+// ray-cast truth; bad inputs give one error line and no output.
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "common/io/atomic_file.h"
+#include "common/io/provenance.h"
+#include "common/io/record_stream.h"
+#include "common/io/text_proto.h"
+#include "tests/stages/ground/ground_test_util.h"
+#include "tests/stages/ground/synthetic_lidar.h"
+#include "tiltcal/proto/ground.pb.h"
+#include "tiltcal/proto/imu.pb.h"
+#include "tiltcal/proto/rig.pb.h"
+#include "tiltcal/proto/scan.pb.h"
+
+namespace tiltcal {
+namespace {
+
+using testing::AngleDeg;
+using testing::NormalOf;
+using testing::RollPitchYaw;
+using testing::SyntheticPose;
+using testing::TempDir;
+
+constexpr int kNumScans = 10;
+constexpr int64_t kFirstStampNs = 1500000000LL;
+
+Eigen::Matrix3d Exp(const Eigen::Vector3d& phi) {
+  const double a = phi.norm();
+  return a < 1e-15 ? Eigen::Matrix3d::Identity()
+                   : Eigen::AngleAxisd(a, phi / a).toRotationMatrix();
+}
+
+struct Dataset {
+  std::string imu, scans, rig, params;
+  std::vector<SyntheticPose> poses;
+};
+
+// Static for 1 s (gyro bias only), then a constant LiDAR body rate; scans at
+// 10 Hz from 1.5 s. C_bl is a small rotation; the rig's height prior comes
+// from imu_height_m and the lever arm.
+Dataset WriteDataset(const TempDir& dir, bool corrupt_scan, bool bad_imu_stamp) {
+  Dataset data;
+  data.imu = dir.File("imu.binpb");
+  data.scans = dir.File("scans.binpb.lz4");
+  data.rig = dir.File("rig.txtpb");
+  data.params = testing::SourceDir() + "/stages/ground/default_params.txtpb";
+  const Eigen::Matrix3d c_bl = RollPitchYaw(0.01, -0.02, 0.05);
+  const Eigen::Vector3d omega_l(0.05, -0.04, 0.6), bias(0.003, -0.002, 0.004);
+  const Eigen::Vector3d omega_b = c_bl * omega_l;
+  const Eigen::Matrix3d r0 = RollPitchYaw(0.02, 0.03, 0.0);  // R_gl at t = 1 s
+
+  proto::Rig rig;
+  const Eigen::Quaterniond q(c_bl);
+  rig.mutable_imu_from_lidar()->mutable_rotation()->set_w(q.w());
+  rig.mutable_imu_from_lidar()->mutable_rotation()->set_x(q.x());
+  rig.mutable_imu_from_lidar()->mutable_rotation()->set_y(q.y());
+  rig.mutable_imu_from_lidar()->mutable_rotation()->set_z(q.z());
+  rig.mutable_imu_from_lidar()->mutable_translation()->set_z(0.4);
+  rig.set_imu_height_m(0.5);
+  EXPECT_TRUE(WriteTextProto(data.rig, rig).ok());
+
+  proto::Provenance provenance;
+  provenance.set_producer("ground_cli_test");
+  RecordWriter imu_writer;
+  EXPECT_TRUE(imu_writer.Open(data.imu, "tiltcal.proto.ImuSample", provenance, false).ok());
+  for (int64_t t = 0; t <= 3000000000LL; t += 2500000) {
+    proto::ImuSample s;
+    s.set_stamp_ns(bad_imu_stamp && t == 500000000LL ? 1000 : t);
+    const Eigen::Vector3d w = (t < 1000000000LL ? Eigen::Vector3d::Zero() : omega_b) + bias;
+    s.mutable_angular_velocity_radps()->set_x(w.x());
+    s.mutable_angular_velocity_radps()->set_y(w.y());
+    s.mutable_angular_velocity_radps()->set_z(w.z());
+    s.mutable_linear_acceleration_mps2()->set_z(9.81);
+    EXPECT_TRUE(imu_writer.Write(s).ok());
+  }
+  EXPECT_TRUE(imu_writer.Close().ok());
+
+  RecordWriter scan_writer;
+  EXPECT_TRUE(scan_writer.Open(data.scans, "tiltcal.proto.Scan", provenance, true).ok());
+  for (int k = 0; k < kNumScans; ++k) {
+    const int64_t stamp = kFirstStampNs + k * 100000000LL;
+    SyntheticPose pose;
+    pose.position_g = Eigen::Vector3d(0.3 * k, 0.0, 0.9);
+    pose.g_from_lidar = r0 * Exp(omega_l * (1e-9 * stamp - 1.0));
+    pose.omega_lidar_radps = omega_l;
+    proto::Scan scan = testing::CastScan(testing::StreetScene(k), testing::SyntheticLidar::Vlp16(),
+                                         pose, stamp, 20 + k);
+    scan.set_index(k);
+    if (corrupt_scan && k == 3) scan.mutable_z()->RemoveLast();
+    EXPECT_TRUE(scan_writer.Write(scan).ok());
+    data.poses.push_back(pose);
+  }
+  EXPECT_TRUE(scan_writer.Close().ok());
+  return data;
+}
+
+std::string Command(const Dataset& data, const TempDir& dir, const std::string& params) {
+  return testing::ToolPath("tiltcal_ground") + " --imu=" + data.imu + " --scans=" + data.scans +
+         " --rig=" + data.rig + " --params=" + params + " --out_ground=" +
+         dir.File("ground.binpb") + " --out_scans=" + dir.File("deskewed.binpb.lz4");
+}
+
+TEST(GroundCli, PlanesMatchTheTruthAndDeskewedScansAreWritten) {
+  TempDir dir;
+  const Dataset data = WriteDataset(dir, false, false);
+  std::string output;
+  ASSERT_EQ(testing::RunCommand(Command(data, dir, data.params), &output), 0) << output;
+  EXPECT_NE(output.find("10 scans, 10 valid, 10 deskewed"), std::string::npos) << output;
+  EXPECT_NE(output.find("static start: yes"), std::string::npos) << output;
+
+  std::vector<proto::GroundPlane> planes;
+  proto::StreamHeader header;
+  const Status status =
+      ReadAllRecords<proto::GroundPlane>(dir.File("ground.binpb"), &planes, &header);
+  ASSERT_TRUE(status.ok()) << status.message();
+  EXPECT_EQ(header.provenance().producer(), "tiltcal_ground");
+  EXPECT_NE(header.provenance().params_txtpb().find("fit_radius_first_ring_ratio"),
+            std::string::npos);
+  ASSERT_EQ(planes.size(), static_cast<size_t>(kNumScans));
+  for (int k = 0; k < kNumScans; ++k) {
+    const proto::GroundPlane& p = planes[k];
+    EXPECT_TRUE(p.valid()) << k << ": " << p.reject_detail();
+    EXPECT_TRUE(p.deskewed());
+    EXPECT_TRUE(testing::NoNan(p));
+    EXPECT_EQ(p.stamp_ns(), kFirstStampNs + k * 100000000LL);
+    EXPECT_NEAR(p.height_prior_m(), 0.9, 0.01);  // 0.5 m + 0.4 m lever arm
+    EXPECT_LT(AngleDeg(NormalOf(p), testing::TrueNormal(data.poses[k])), 0.1) << k;
+    EXPECT_NEAR(p.height_m(), 0.9, 0.005) << k;
+  }
+  std::vector<proto::Scan> deskewed;
+  ASSERT_TRUE(ReadAllRecords<proto::Scan>(dir.File("deskewed.binpb.lz4"), &deskewed).ok());
+  ASSERT_EQ(deskewed.size(), static_cast<size_t>(kNumScans));
+  for (const proto::Scan& scan : deskewed) EXPECT_TRUE(scan.deskewed());
+}
+
+TEST(GroundCli, MismatchedColumnsAreOneErrorLineAndNoOutput) {
+  TempDir dir;
+  const Dataset data = WriteDataset(dir, true, false);
+  std::string output;
+  EXPECT_EQ(testing::RunCommand(Command(data, dir, data.params), &output), 1);
+  EXPECT_NE(output.find("record 3"), std::string::npos) << output;
+  EXPECT_NE(output.find("scans.binpb.lz4"), std::string::npos) << output;
+  EXPECT_EQ(std::count(output.begin(), output.end(), '\n'), 1) << output;
+  EXPECT_FALSE(testing::FileExists(dir.File("ground.binpb")));
+  EXPECT_FALSE(testing::FileExists(dir.File("deskewed.binpb.lz4")));
+}
+
+TEST(GroundCli, NonMonotonicImuIsAnError) {
+  TempDir dir;
+  const Dataset data = WriteDataset(dir, false, true);
+  std::string output;
+  EXPECT_EQ(testing::RunCommand(Command(data, dir, data.params), &output), 1);
+  EXPECT_NE(output.find("imu.binpb: record 200"), std::string::npos) << output;
+  EXPECT_FALSE(testing::FileExists(dir.File("ground.binpb")));
+}
+
+TEST(GroundCli, BadParamsNameTheField) {
+  TempDir dir;
+  const Dataset data = WriteDataset(dir, false, false);
+  const std::string params = dir.File("params.txtpb");
+  ASSERT_TRUE(WriteTextProto(params, testing::DefaultGroundParams()).ok());
+  std::string text;
+  ASSERT_TRUE(ReadFileToString(params, &text).ok());
+  ASSERT_TRUE(WriteFileAtomically(params, text + "zone_rings: 5\n").ok());
+  std::string output;
+  EXPECT_EQ(testing::RunCommand(Command(data, dir, params), &output), 1);
+  EXPECT_NE(output.find("zone_rings"), std::string::npos) << output;
+  EXPECT_FALSE(testing::FileExists(dir.File("ground.binpb")));
+}
+
+}  // namespace
+}  // namespace tiltcal
