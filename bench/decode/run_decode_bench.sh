@@ -209,7 +209,7 @@ done
 echo "  MB = 1e6 bytes of the bag file; median wall and cpu (user + sys) of $REPEATS runs for"
 echo "  tiltcal_decode and the C++ reader, largest peak RSS; vs C++ = C++ rosbag wall / tool wall"
 echo "  on the same bag (> 1: faster than the C++ rosbag library); cpu vs = the same on cpu s."
-echo "  Load average before the runs: $LOAD_BEFORE"
+echo "  Load average before the runs: $LOAD_BEFORE, after: $(cut -d' ' -f1-3 /proc/loadavg)"
 awk -v big="$BAG" '
   function median(list, n,   a, i, j, t) {
     n = split(list, a, " ")
