@@ -5,6 +5,7 @@
 #include "stages/simulate/simulate.h"
 
 #include <cmath>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -197,18 +198,47 @@ INSTANTIATE_TEST_SUITE_P(Compressions, SimulateRosbagTest,
                            return proto::SimBagParams::Compression_Name(info.param);
                          });
 
+// One 4 s run of the short scenario shared by the tests below: bag, truth
+// and what the real ROS library reads from it (with the points of a few
+// clouds).
+struct ShortRun {
+  std::unique_ptr<TempDir> dir;
+  proto::SimulateParams params;
+  proto::SimulationTruth truth;
+  BagDump dump;
+  std::string error;  // non-empty when the oracle failed
+};
+
+class ShortRunTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    if (!NeedRosbag()) return;
+    run_ = new ShortRun;
+    run_->dir = std::make_unique<TempDir>();
+    run_->params = ShortScenario();
+    run_->truth = Simulate(run_->params, *run_->dir, "short");
+    DumpBagWithRosbag(run_->dir->File("short.bag"), run_->dir->File("dump.txt"), {2, 20, 35},
+                      &run_->dump, &run_->error);
+  }
+  static void TearDownTestSuite() {
+    delete run_;
+    run_ = nullptr;
+  }
+  void SetUp() override {
+    if (!NeedRosbag()) GTEST_SKIP() << "Debian python3-rosbag (/usr/bin/python3) is not installed";
+    ASSERT_TRUE(run_->error.empty()) << run_->error;
+  }
+  static ShortRun* run_;
+};
+ShortRun* ShortRunTest::run_ = nullptr;
+
 // Integrating the gyro of the bag (as the ROS library reads it) minus the
 // true bias gives the true attitude C_ab at every scan's true time; without
 // removing the bias it does not (so the check can fail).
-TEST(SimulateTest, GyroIntegrationTracksTheTrueAttitude) {
-  SKIP_WITHOUT_ROSBAG();
-  TempDir dir;
-  const proto::SimulateParams params = ShortScenario();
-  const proto::SimulationTruth truth = Simulate(params, dir, "short");
-  BagDump dump;
-  std::string error;
-  ASSERT_TRUE(DumpBagWithRosbag(dir.File("short.bag"), dir.File("dump.txt"), {}, &dump, &error))
-      << error;
+TEST_F(ShortRunTest, GyroIntegrationTracksTheTrueAttitude) {
+  const proto::SimulateParams& params = run_->params;
+  const proto::SimulationTruth& truth = run_->truth;
+  const BagDump& dump = run_->dump;
   const auto imu = dump.Topic(params.imu().topic());
   ASSERT_GT(imu.size(), 100u);
   const Eigen::Vector3d gyro_bias = ToVector(truth.gyro_bias_radps());
@@ -294,17 +324,11 @@ TEST(SimulateTest, GyroIntegrationTracksTheTrueAttitude) {
 // Points labelled ground, as the ROS library decodes them, lie on the true
 // plane of the truth file (n_l · p + d_l = 0) within the range noise
 // projected on the normal, σ |d̂ · n_l| (d̂ = the ray direction).
-TEST(SimulateTest, GroundPointsFitTheTruePlane) {
-  SKIP_WITHOUT_ROSBAG();
-  TempDir dir;
-  const proto::SimulateParams params = ShortScenario();
-  const proto::SimulationTruth truth = Simulate(params, dir, "short");
+TEST_F(ShortRunTest, GroundPointsFitTheTruePlane) {
+  const proto::SimulateParams& params = run_->params;
+  const proto::SimulationTruth& truth = run_->truth;
+  const BagDump& dump = run_->dump;
   const std::vector<int> dumped = {2, 20, 35};
-  BagDump dump;
-  std::string error;
-  ASSERT_TRUE(
-      DumpBagWithRosbag(dir.File("short.bag"), dir.File("dump.txt"), dumped, &dump, &error))
-      << error;
   const auto clouds = dump.Topic(params.lidar().topic());
   const double sigma = params.lidar().range_noise_m();
   for (int k : dumped) {
@@ -342,6 +366,54 @@ TEST(SimulateTest, GroundPointsFitTheTruePlane) {
     EXPECT_NEAR(d, truth.imu_height_m() + n.dot(c_bl.transpose() * r_bl), 1e-9);
     EXPECT_NEAR(ts.inclination_deg(), std::acos(std::cos(3 * M_PI / 180) * std::cos(8 * M_PI / 180)) *
                                           180 / M_PI, 1e-9);
+  }
+}
+
+// Each point, taken at its own time (stamp + time field + τ, IMU clock) with
+// the true LiDAR pose of that time, lands on the surface it hit: wall points
+// on |x| = h or |y| = h. This checks the per-point times, the stamp
+// convention (end of sweep) and the sign of τ: with t − τ instead, or without
+// the per-point times, the points miss the walls.
+TEST_F(ShortRunTest, PointsLandOnTheWallsAtTheirTrueTimes) {
+  const proto::SimulateParams& params = run_->params;
+  const proto::SimulationTruth& truth = run_->truth;
+  const BagDump& dump = run_->dump;
+  Scenario scenario;
+  ASSERT_TRUE(BuildScenario(params, &scenario).ok());
+  const std::vector<int> dumped = {20, 35};
+  const auto clouds = dump.Topic(params.lidar().topic());
+  const double half = params.world().room_half_size_m();
+  const double sigma = params.lidar().range_noise_m();
+  const Eigen::Matrix3d c_bl = ToRotation(truth.imu_from_lidar());
+  const Eigen::Vector3d r_bl = ToVector(truth.imu_from_lidar().translation());
+  const double tau = truth.time_offset_s();
+  // RMS distance of the wall points to the room walls, with point times
+  // stamp + time_scale * time + tau_sign * τ.
+  auto wall_rms = [&](const DumpedMessage& m, double time_scale, double tau_sign) {
+    double sum = 0.0;
+    int n = 0;
+    for (const std::vector<double>& q : m.points) {
+      if (q[6] != 2) continue;  // SURFACE_WALL
+      const double t = (m.stamp_ns - params.start_stamp_ns()) * 1e-9 + time_scale * q[5] +
+                       tau_sign * tau;
+      Eigen::Matrix3d c_wb;
+      Eigen::Vector3d r_wb;
+      scenario.trajectory->Pose(t, &c_wb, &r_wb);
+      const Eigen::Vector3d p = c_wb * (c_bl * Eigen::Vector3d(q[0], q[1], q[2]) + r_bl) + r_wb;
+      const double d = std::min(std::abs(half - std::abs(p.x())), std::abs(half - std::abs(p.y())));
+      sum += d * d;
+      ++n;
+    }
+    EXPECT_GT(n, 500);
+    return std::sqrt(sum / n);
+  };
+  for (int k : dumped) {
+    SCOPED_TRACE("scan " + std::to_string(k));
+    const double rms = wall_rms(*clouds[k], 1.0, 1.0);
+    EXPECT_LT(rms, 1.2 * sigma);
+    EXPECT_GT(rms, 0.3 * sigma);
+    EXPECT_GT(wall_rms(*clouds[k], 1.0, -1.0), 3 * rms);  // τ with the wrong sign
+    EXPECT_GT(wall_rms(*clouds[k], 0.0, 1.0), 3 * rms);   // no per-point times
   }
 }
 
@@ -518,6 +590,38 @@ TEST(SimulateTest, OusterAndVlp32cLayouts) {
       EXPECT_EQ(max_ring, 31);
     }
     EXPECT_EQ(static_cast<uint32_t>(valid), truth.scans(1).num_points());
+  }
+}
+
+// The C++ rosbag library of ros_comm (Debian librosbag-storage-dev, with the
+// strict roslz4 decoder) reads the bags too: the decode benchmark's anchor
+// reader, when built (cmake --build BUILD --target tiltcal_bench_rosbag_cpp_reader).
+TEST(SimulateTest, CppRosbagLibraryReadsTheBags) {
+  const std::string reader = tiltcal::testing::ToolPath("tiltcal_bench_rosbag_cpp_reader");
+  if (!tiltcal::testing::FileExists(reader)) {
+    GTEST_SKIP() << "build the tiltcal_bench_rosbag_cpp_reader target to run this test";
+  }
+  for (const auto compression : {proto::SimBagParams::NONE, proto::SimBagParams::BZ2,
+                                 proto::SimBagParams::LZ4}) {
+    SCOPED_TRACE(proto::SimBagParams::Compression_Name(compression));
+    TempDir dir;
+    proto::SimulateParams params = ShortScenario();
+    params.set_duration_s(1.0);
+    params.mutable_bag()->set_compression(compression);
+    const proto::SimulationTruth truth = Simulate(params, dir, "cpp");
+    uint64_t points = 0;
+    for (const auto& scan : truth.scans()) points += scan.num_points();
+    std::string output;
+    ASSERT_EQ(tiltcal::testing::RunCommand(reader + " " + dir.File("cpp.bag"), &output), 0)
+        << output;
+    EXPECT_NE(output.find("messages=" + std::to_string(truth.num_imu_samples() +
+                                                       truth.scans_size()) + " "),
+              std::string::npos) << output;
+    EXPECT_NE(output.find("clouds=" + std::to_string(truth.scans_size()) + " "),
+              std::string::npos) << output;
+    EXPECT_NE(output.find("points=" + std::to_string(points) + " "), std::string::npos) << output;
+    EXPECT_NE(output.find("imu=" + std::to_string(truth.num_imu_samples()) + " "),
+              std::string::npos) << output;
   }
 }
 
