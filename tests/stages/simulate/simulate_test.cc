@@ -500,6 +500,25 @@ TEST(SimulateTest, BadParamsAreAClearErrorAndLeaveNoOutput) {
   }
 }
 
+// The scenarios of the repository (demo and tests) pass the schema and the
+// simulator's own checks.
+TEST(SimulateTest, RepositoryScenariosAreValid) {
+  for (const char* name : {"flat_vlp16", "tilted_husky_vlp16", "flat_m2dgr_vlp32c",
+                           "offroad_os1_32", "short_test_vlp16"}) {
+    SCOPED_TRACE(name);
+    proto::SimulateParams params;
+    const Status loaded = LoadParams(tiltcal::testing::SourceDir() + "/stages/simulate/scenarios/" +
+                                         name + ".txtpb",
+                                     &params);
+    ASSERT_TRUE(loaded.ok()) << loaded.message();
+    Scenario scenario;
+    const Status built = BuildScenario(params, &scenario);
+    ASSERT_TRUE(built.ok()) << built.message();
+    EXPECT_GT(scenario.num_scans, 0);
+    EXPECT_GT(scenario.world->boxes().size() + scenario.world->pillars().size(), 10u);
+  }
+}
+
 TEST(SimulateTest, CommandLineWritesAllOutputs) {
   const std::string tool = tiltcal::testing::ToolPath("tiltcal_simulate");
   if (!tiltcal::testing::FileExists(tool)) GTEST_SKIP() << "build the tiltcal_simulate target";
