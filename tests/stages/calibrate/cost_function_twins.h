@@ -1,0 +1,101 @@
+#ifndef TILTCAL_TESTS_STAGES_CALIBRATE_COST_FUNCTION_TWINS_H_
+#define TILTCAL_TESTS_STAGES_CALIBRATE_COST_FUNCTION_TWINS_H_
+
+// Autodiff twins of the analytic residuals in stages/calibrate, for tests and
+// the benchmark anchor ONLY (never used in production). They evaluate the
+// same formulas through the independent templated reference spline
+// (tests/common/spline/spline_reference.h) on ceres::Jet. Parameter blocks,
+// order and storage are identical to the analytic cost functions; quaternions
+// are (x, y, z, w) with the right-perturbation manifold.
+
+#include <ceres/autodiff_cost_function.h>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "tests/common/spline/spline_reference.h"
+
+namespace tiltcal::testing {
+
+template <typename T>
+void LoadQuaternions(const T* const q0, const T* const q1, const T* const q2, const T* const q3,
+                     Eigen::Quaternion<T> out[4]) {
+  const T* const ptr[4] = {q0, q1, q2, q3};
+  for (int i = 0; i < 4; ++i) out[i] = Eigen::Map<const Eigen::Quaternion<T>>(ptr[i]);
+}
+
+template <typename T>
+void LoadVectors(const T* const p0, const T* const p1, const T* const p2, const T* const p3,
+                 Eigen::Matrix<T, 3, 1> out[4]) {
+  const T* const ptr[4] = {p0, p1, p2, p3};
+  for (int i = 0; i < 4; ++i) out[i] = Eigen::Map<const Eigen::Matrix<T, 3, 1>>(ptr[i]);
+}
+
+// r = (omega_b(t) + b_g - omega_m) / sigma.
+struct GyroTwin {
+  double u, inv_dt, sigma;
+  Eigen::Vector3d measured;
+  template <typename T>
+  bool operator()(const T* const q0, const T* const q1, const T* const q2, const T* const q3,
+                  const T* const bias, T* residual) const {
+    Eigen::Quaternion<T> q[4];
+    LoadQuaternions(q0, q1, q2, q3, q);
+    const auto s = ReferenceSo3<T>(q, T(u), inv_dt);
+    for (int r = 0; r < 3; ++r) residual[r] = (s.omega[r] + bias[r] - T(measured[r])) / sigma;
+    return true;
+  }
+  using AutoDiff = ceres::AutoDiffCostFunction<GyroTwin, 3, 4, 4, 4, 4, 3>;
+};
+
+// r = (C^T (p'' - g_norm n_g) + b_a - f_m) / sigma.
+struct AccelTwin {
+  double u, inv_dt, sigma, gravity_norm;
+  Eigen::Vector3d measured;
+  template <typename T>
+  bool operator()(const T* const q0, const T* const q1, const T* const q2, const T* const q3,
+                  const T* const p0, const T* const p1, const T* const p2, const T* const p3,
+                  const T* const gravity_dir, const T* const bias, T* residual) const {
+    Eigen::Quaternion<T> q[4];
+    Eigen::Matrix<T, 3, 1> p[4];
+    LoadQuaternions(q0, q1, q2, q3, q);
+    LoadVectors(p0, p1, p2, p3, p);
+    const auto s = ReferenceSo3<T>(q, T(u), inv_dt);
+    const auto ps = ReferenceR3<T>(p, T(u), inv_dt);
+    const Eigen::Matrix<T, 3, 1> g = Eigen::Map<const Eigen::Matrix<T, 3, 1>>(gravity_dir) * T(gravity_norm);
+    const Eigen::Matrix<T, 3, 1> f = s.q.conjugate() * (ps.acceleration - g);
+    for (int r = 0; r < 3; ++r) residual[r] = (f[r] + bias[r] - T(measured[r])) / sigma;
+    return true;
+  }
+  using AutoDiff = ceres::AutoDiffCostFunction<AccelTwin, 3, 4, 4, 4, 4, 3, 3, 3, 3, 3, 3>;
+};
+
+// p_a = C(t_j + tau) (C_bl p_l + r_b) + r_a(t_j + tau), frozen segment,
+// r = (n^T p_a + d) / sigma.
+struct PointToPlaneTwin {
+  double time_in_segment_s, inv_dt, sigma, offset;
+  Eigen::Vector3d point, normal;
+  template <typename T>
+  bool operator()(const T* const q0, const T* const q1, const T* const q2, const T* const q3,
+                  const T* const p0, const T* const p1, const T* const p2, const T* const p3,
+                  const T* const q_bl_ptr, const T* const r_b_ptr, const T* const tau,
+                  T* residual) const {
+    Eigen::Quaternion<T> q[4];
+    Eigen::Matrix<T, 3, 1> p[4];
+    LoadQuaternions(q0, q1, q2, q3, q);
+    LoadVectors(p0, p1, p2, p3, p);
+    const T u = (T(time_in_segment_s) + tau[0]) * inv_dt;
+    const auto s = ReferenceSo3<T>(q, u, inv_dt);
+    const auto ps = ReferenceR3<T>(p, u, inv_dt);
+    const Eigen::Quaternion<T> q_bl = Eigen::Map<const Eigen::Quaternion<T>>(q_bl_ptr).normalized();
+    const Eigen::Matrix<T, 3, 1> x_b =
+        q_bl * point.cast<T>() + Eigen::Map<const Eigen::Matrix<T, 3, 1>>(r_b_ptr);
+    const Eigen::Matrix<T, 3, 1> p_a = s.q * x_b + ps.position;
+    residual[0] = (normal.cast<T>().dot(p_a) + T(offset)) / sigma;
+    return true;
+  }
+  using AutoDiff = ceres::AutoDiffCostFunction<PointToPlaneTwin, 1, 4, 4, 4, 4, 3, 3, 3, 3, 4, 3, 1>;
+};
+
+}  // namespace tiltcal::testing
+
+#endif  // TILTCAL_TESTS_STAGES_CALIBRATE_COST_FUNCTION_TWINS_H_
