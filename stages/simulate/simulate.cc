@@ -125,6 +125,7 @@ Status BuildScenario(const proto::SimulateParams& params, Scenario* scenario) {
   tc.vibration_pitch_rad = tp.vibration_pitch_deg() * kDegToRad;
   tc.vibration_frequency_hz = tp.vibration_frequency_hz();
   tc.heading_rad = tp.heading_deg() * kDegToRad;
+  tc.max_yaw_rate_radps = tp.max_yaw_rate_radps();
   tc.ground_roll_rad = params.ground_roll_deg() * kDegToRad;
   tc.ground_pitch_rad = params.ground_pitch_deg() * kDegToRad;
   tc.imu_height_m = rig.imu_height_m();

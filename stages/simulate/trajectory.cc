@@ -17,9 +17,21 @@ PlanarTrajectory::PlanarTrajectory(const TrajectoryConfig& config) : config_(con
   world_from_plane_ = RotY(config.ground_pitch_rad) * RotX(config.ground_roll_rad);
   const double c = std::cos(config.heading_rad), s = std::sin(config.heading_rad);
   heading_rotation_ << c, -s, s, c;
-  // Arc length of one loop (θ from 0 to 2π), trapezoid rule.
+  MeasurePath();
+  if (config_.max_yaw_rate_radps > 0.0) {
+    // Yaw rate = κ v; scaling the path by f divides κ by f at the same speed.
+    const double f = max_yaw_rate_radps_ / config_.max_yaw_rate_radps;
+    config_.length_m *= f;
+    config_.width_m *= f;
+    MeasurePath();
+  }
+}
+
+void PlanarTrajectory::MeasurePath() {
+  // Arc length of one loop (θ from 0 to 2π, midpoint rule), bounding box and
+  // peak |dψ/dθ| = |x'y'' − y'x''| / |p'|².
   constexpr int kSteps = 20000;
-  double length = 0.0;
+  double length = 0.0, max_dpsi_dtheta = 0.0;
   path_min_ = Eigen::Vector2d::Constant(1e300);
   path_max_ = Eigen::Vector2d::Constant(-1e300);
   for (int i = 0; i < kSteps; ++i) {
@@ -29,10 +41,13 @@ PlanarTrajectory::PlanarTrajectory(const TrajectoryConfig& config) : config_(con
     length += dp.norm() * kTwoPi / kSteps;
     path_min_ = path_min_.cwiseMin(p);
     path_max_ = path_max_.cwiseMax(p);
+    max_dpsi_dtheta = std::max(
+        max_dpsi_dtheta, std::abs(dp.x() * ddp.y() - dp.y() * ddp.x()) / dp.squaredNorm());
   }
   arc_length_m_ = length;
-  loop_period_s_ = length / config.speed_mps;
+  loop_period_s_ = length / config_.speed_mps;
   omega_ = kTwoPi / loop_period_s_;
+  max_yaw_rate_radps_ = max_dpsi_dtheta * omega_;
 }
 
 void PlanarTrajectory::Path(double theta, Eigen::Vector2d* p, Eigen::Vector2d* dp,

@@ -30,6 +30,8 @@ struct TrajectoryConfig {
   double vibration_pitch_rad = 0.0;
   double vibration_frequency_hz = 0.0;
   double heading_rad = 0.0;
+  // > 0: scale length and width so that the peak yaw rate is this (rad/s).
+  double max_yaw_rate_radps = 0.0;
   double ground_roll_rad = 0.0;
   double ground_pitch_rad = 0.0;
   double imu_height_m = 0.5;                           // d_b
@@ -59,6 +61,11 @@ class PlanarTrajectory {
   Eigen::Vector3d NormalInWorld() const { return world_from_plane_.col(2); }
   double loop_period_s() const { return loop_period_s_; }
   double arc_length_m() const { return arc_length_m_; }
+  // Largest |yaw rate| once moving (after the ramp), rad/s.
+  double max_yaw_rate_radps() const { return max_yaw_rate_radps_; }
+  // Path size after the yaw-rate scaling.
+  double length_m() const { return config_.length_m; }
+  double width_m() const { return config_.width_m; }
   // Half extents of the path's bounding box in the plane's (x, y), about 0.
   Eigen::Vector2d PathMin() const { return path_min_; }
   Eigen::Vector2d PathMax() const { return path_max_; }
@@ -68,6 +75,8 @@ class PlanarTrajectory {
   void Path(double theta, Eigen::Vector2d* p, Eigen::Vector2d* dp, Eigen::Vector2d* ddp) const;
   // σ(t), σ'(t), σ''(t).
   void MovingTime(double t, double* s, double* ds, double* dds) const;
+  // Arc length, bounding box and peak yaw rate for the current size.
+  void MeasurePath();
 
   TrajectoryConfig config_;
   Eigen::Matrix3d world_from_plane_;
@@ -75,6 +84,7 @@ class PlanarTrajectory {
   double loop_period_s_ = 1.0;
   double omega_ = 0.0;  // dθ/dσ
   double arc_length_m_ = 0.0;
+  double max_yaw_rate_radps_ = 0.0;
   Eigen::Vector2d path_min_, path_max_;
 };
 

@@ -119,6 +119,25 @@ TEST(SimTrajectoryTest, PlanarMotionOnTheTiltedPlane) {
   EXPECT_GT(max_yaw_rate, 0.3);
 }
 
+TEST(SimTrajectoryTest, PeakYawRateCanBeSet) {
+  for (const double target : {0.3, 0.8}) {
+    TrajectoryConfig config = TiltedConfig(false);
+    config.max_yaw_rate_radps = target;
+    const PlanarTrajectory trajectory(config);
+    EXPECT_NEAR(trajectory.length_m() / trajectory.width_m(), config.length_m / config.width_m,
+                1e-12);
+    double peak = 0.0;
+    const double start = config.static_start_s + config.ramp_s;
+    for (double t = start; t < start + trajectory.loop_period_s(); t += 0.001) {
+      peak = std::max(peak, std::abs(trajectory.Evaluate(t).yaw_rate_radps));
+    }
+    EXPECT_NEAR(peak, target, 1e-3 * target);
+    EXPECT_NEAR(trajectory.max_yaw_rate_radps(), target, 1e-9);
+    // The speed stays as configured: one loop is the arc length at speed_mps.
+    EXPECT_NEAR(trajectory.arc_length_m() / trajectory.loop_period_s(), config.speed_mps, 1e-12);
+  }
+}
+
 TEST(SimWorldTest, SimpleHits) {
   World world(Eigen::Vector3d::UnitZ(), 10.0, 3.0);
   world.AddBox({4, 5, -0.5, 0.5, 2.0});
