@@ -99,39 +99,123 @@ Eigen::Matrix4d PlaneCovariance(const PlaneFit& plane, double noise_variance_m2)
   return cov;
 }
 
-PlaneFit FitPlaneRobust(const float* x, const float* y, const float* z, const uint32_t* idx,
-                        size_t n, const RobustPlaneOptions& options,
-                        std::vector<uint8_t>* inlier) {
+namespace {
+
+// Reassociating float sums lets GCC vectorise the reductions below; NaN and
+// infinity semantics are kept (no finite-math), so a NaN point is never
+// selected. The order of the vectorised sums is fixed by the binary, so the
+// results are deterministic.
+#if defined(__GNUC__) && !defined(__clang__)
+#define TILTCAL_VECTORISE_SUMS \
+  __attribute__((optimize("associative-math", "no-signed-zeros", "no-trapping-math")))
+#else
+#define TILTCAL_VECTORISE_SUMS
+#endif
+
+// SelectAndAccumulate with or without an activity mask.
+template <bool kHasActive>
+TILTCAL_VECTORISE_SUMS bool SelectAndAccumulateImpl(const float* x, const float* y,
+                                                    const float* z, size_t n,
+                                                    const uint8_t* active,
+                                                    const Eigen::Vector3d& normal, double offset,
+                                                    double band, uint8_t* selected,
+                                                    PlaneMoments* moments) {
+  const Eigen::Vector3d& o = moments->origin();
+  // Plane relative to the origin: n·(p − o) + (d + n·o).
+  const float nx = static_cast<float>(normal.x()), ny = static_cast<float>(normal.y()),
+              nz = static_cast<float>(normal.z());
+  const float d_o = static_cast<float>(offset + normal.dot(o));
+  const float ox = static_cast<float>(o.x()), oy = static_cast<float>(o.y()),
+              oz = static_cast<float>(o.z());
+  const float tau = static_cast<float>(band);
+  constexpr size_t kBlock = 256;
+  uint32_t changed = 0;
+  for (size_t begin = 0; begin < n; begin += kBlock) {
+    const size_t end = std::min(n, begin + kBlock);
+    float c = 0, sx = 0, sy = 0, sz = 0, sxx = 0, sxy = 0, sxz = 0, syy = 0, syz = 0, szz = 0;
+    for (size_t k = begin; k < end; ++k) {
+      const float px = x[k] - ox, py = y[k] - oy, pz = z[k] - oz;
+      const float dist = nx * px + ny * py + nz * pz + d_o;
+      uint32_t in = (dist < tau && dist > -tau) ? 1u : 0u;
+      if constexpr (kHasActive) in &= active[k] != 0 ? 1u : 0u;
+      changed |= in ^ selected[k];
+      selected[k] = static_cast<uint8_t>(in);
+      const float w = static_cast<float>(in);
+      const float wx = w * px, wy = w * py, wz = w * pz;
+      c += w;
+      sx += wx;
+      sy += wy;
+      sz += wz;
+      sxx += wx * px;
+      sxy += wx * py;
+      sxz += wx * pz;
+      syy += wy * py;
+      syz += wy * pz;
+      szz += wz * pz;
+    }
+    const double sums[9] = {sx, sy, sz, sxx, sxy, sxz, syy, syz, szz};
+    moments->AddSums(static_cast<int64_t>(std::llround(c)), sums);
+  }
+  return changed != 0;
+}
+
+}  // namespace
+
+bool SelectAndAccumulate(const float* x, const float* y, const float* z, size_t n,
+                         const uint8_t* active, const Eigen::Vector3d& normal, double offset,
+                         double band, uint8_t* selected, PlaneMoments* moments) {
+  return active != nullptr
+             ? SelectAndAccumulateImpl<true>(x, y, z, n, active, normal, offset, band, selected,
+                                             moments)
+             : SelectAndAccumulateImpl<false>(x, y, z, n, active, normal, offset, band, selected,
+                                              moments);
+}
+
+float MeanOfLowest(const float* v, size_t n, const uint8_t* active, size_t k, float floor) {
+  // Max-heap of the k smallest values so far.
+  float heap[64];
+  k = std::min<size_t>(std::max<size_t>(k, 1), 64);
+  size_t count = 0;
+  for (size_t i = 0; i < n; ++i) {
+    if (active != nullptr && !active[i]) continue;
+    const float value = v[i];
+    if (!(value >= floor)) continue;
+    if (count < k) {
+      heap[count++] = value;
+      std::push_heap(heap, heap + count);
+    } else if (value < heap[0]) {
+      std::pop_heap(heap, heap + k);
+      heap[k - 1] = value;
+      std::push_heap(heap, heap + k);
+    }
+  }
+  if (count == 0) return std::numeric_limits<float>::quiet_NaN();
+  double sum = 0.0;
+  for (size_t j = 0; j < count; ++j) sum += heap[j];
+  return static_cast<float>(sum / static_cast<double>(count));
+}
+
+PlaneFit FitPlaneRobust(const float* x, const float* y, const float* z, size_t n,
+                        const RobustPlaneOptions& options, std::vector<uint8_t>* inlier) {
   inlier->assign(n, 1);
   if (n == 0) return PlaneFit();
-  const uint32_t i0 = idx != nullptr ? idx[0] : 0;
-  PlaneMoments moments(Eigen::Vector3d(x[i0], y[i0], z[i0]));
-  for (size_t k = 0; k < n; ++k) {
-    const uint32_t i = idx != nullptr ? idx[k] : static_cast<uint32_t>(k);
-    moments.Add(x[i], y[i], z[i]);
-  }
-  PlaneFit fit = FitPlane(moments, options.min_spread_m2);
+  // Initial fit on all finite points (an infinite band keeps every finite one).
+  PlaneMoments all(Eigen::Vector3d(x[0], y[0], z[0]));
+  SelectAndAccumulate(x, y, z, n, nullptr, Eigen::Vector3d::UnitZ(), 0.0,
+                      std::numeric_limits<double>::infinity(), inlier->data(), &all);
+  PlaneFit fit = FitPlane(all, options.min_spread_m2);
+  if (!fit.ok) return fit;
   // Band: starts at 3 x the RMS of the initial fit (so a first fit pulled by
   // outliers keeps most points) and halves every round down to
   // inlier_distance_m; converged when the band is at its floor and the inlier
-  // set no longer changes.
-  double tau = std::max(options.inlier_distance_m,
-                        3.0 * std::sqrt(std::max(0.0, fit.eigenvalues(0))));
+  // set no longer changes. Moments are taken about the initial centroid.
+  double tau = std::max(options.inlier_distance_m, 3.0 * std::sqrt(fit.eigenvalues(0)));
+  PlaneMoments moments(fit.centroid);
   for (int iter = 0; iter < options.max_iterations && fit.ok; ++iter) {
     moments.Clear();
-    const double nx = fit.normal.x(), ny = fit.normal.y(), nz = fit.normal.z();
-    const double d = fit.offset;
     const bool at_floor = tau <= options.inlier_distance_m;
-    bool changed = false;
-    uint8_t* mask = inlier->data();
-    for (size_t k = 0; k < n; ++k) {
-      const uint32_t i = idx != nullptr ? idx[k] : static_cast<uint32_t>(k);
-      const double dist = nx * x[i] + ny * y[i] + nz * z[i] + d;
-      const uint8_t in = std::fabs(dist) < tau ? 1 : 0;
-      changed |= (in != mask[k]);
-      mask[k] = in;
-      if (in) moments.Add(x[i], y[i], z[i]);
-    }
+    const bool changed = SelectAndAccumulate(x, y, z, n, nullptr, fit.normal, fit.offset, tau,
+                                             inlier->data(), &moments);
     if (!changed && at_floor) break;
     if (changed) fit = FitPlane(moments, options.min_spread_m2);
     tau = std::max(options.inlier_distance_m, 0.5 * tau);

@@ -24,6 +24,14 @@ class PlaneMoments {
     syy_ += dy * dy; syz_ += dy * dz; szz_ += dz * dz;
   }
   void Clear() { *this = PlaneMoments(origin_); }
+  // Adds the sums of `count` points taken relative to origin():
+  // sums = {Σx, Σy, Σz, Σxx, Σxy, Σxz, Σyy, Σyz, Σzz}.
+  void AddSums(int64_t count, const double sums[9]) {
+    count_ += count;
+    sx_ += sums[0]; sy_ += sums[1]; sz_ += sums[2];
+    sxx_ += sums[3]; sxy_ += sums[4]; sxz_ += sums[5];
+    syy_ += sums[6]; syz_ += sums[7]; szz_ += sums[8];
+  }
 
   int64_t count() const { return count_; }
   const Eigen::Vector3d& origin() const { return origin_; }
@@ -77,6 +85,22 @@ double PlaneNoiseVariance(const PlaneFit& plane);
 // the plane is not ok.
 Eigen::Matrix4d PlaneCovariance(const PlaneFit& plane, double noise_variance_m2);
 
+// One pass of inlier selection over contiguous columns: point k is selected
+// when active[k] (all when active == nullptr) and |n·p_k + d| < band; the
+// selection is written to selected[k] and the selected points are added to
+// `moments` (relative to its origin). Returns true when any selected[k]
+// changed. Branch-free, in float blocks of 256 points summed in double, so the
+// compiler vectorises it; accurate to ~1e-7 relative for points within a few
+// hundred metres of the moments' origin.
+bool SelectAndAccumulate(const float* x, const float* y, const float* z, size_t n,
+                         const uint8_t* active, const Eigen::Vector3d& normal, double offset,
+                         double band, uint8_t* selected, PlaneMoments* moments);
+
+// Mean of the `k` smallest values of v[0..n) (all of them when n <= k), in
+// one pass without reordering; only values >= floor count (NaN when none).
+// `active` (optional) masks values out.
+float MeanOfLowest(const float* v, size_t n, const uint8_t* active, size_t k, float floor);
+
 // Options of FitPlaneRobust.
 struct RobustPlaneOptions {
   double inlier_distance_m = 0.1;  // inliers: |n·p + d| < this
@@ -84,17 +108,15 @@ struct RobustPlaneOptions {
   double min_spread_m2 = 1e-8;     // see FitPlane
 };
 
-// Plane through the points idx[0..n) of the columns (x, y, z): an initial PCA
-// fit on all of them, then up to max_iterations rounds of re-selecting inliers
-// |n·p + d| < band and refitting on them. The band starts at 3 x the RMS of
-// the initial fit and halves every round down to inlier_distance_m; the loop
-// stops early once the band is at that floor and the inlier set no longer
-// changes. `inlier` (resized to n) receives 1 for the
-// points used by the returned fit. With idx == nullptr the points are
-// 0..n−1. Never allocates beyond `inlier`.
-PlaneFit FitPlaneRobust(const float* x, const float* y, const float* z, const uint32_t* idx,
-                        size_t n, const RobustPlaneOptions& options,
-                        std::vector<uint8_t>* inlier);
+// Plane through the points 0..n−1 of the columns (x, y, z): an initial PCA
+// fit on all finite points, then up to max_iterations rounds of re-selecting
+// inliers |n·p + d| < band and refitting on them. The band starts at 3 x the
+// RMS of the initial fit and halves every round down to inlier_distance_m; the
+// loop stops early once the band is at that floor and the inlier set no
+// longer changes. `inlier` (resized to n) receives 1 for the points used by
+// the returned fit. Never allocates beyond `inlier`.
+PlaneFit FitPlaneRobust(const float* x, const float* y, const float* z, size_t n,
+                        const RobustPlaneOptions& options, std::vector<uint8_t>* inlier);
 
 }  // namespace tiltcal::geometry
 

@@ -121,85 +121,72 @@ GroundSegmenter::GroundSegmenter(const proto::GroundParams& p) {
   bins_.resize(num_bins_);
 }
 
-float GroundSegmenter::SeedHeight(uint32_t begin, uint32_t end, double floor_z) {
-  scratch_z_.clear();
-  const float floor_f = static_cast<float>(floor_z);
-  for (uint32_t i = begin; i < end; ++i) {
-    if (active_[i] && bz_[i] >= floor_f) scratch_z_.push_back(bz_[i]);
-  }
-  if (scratch_z_.empty()) {
-    for (uint32_t i = begin; i < end; ++i) {
-      if (active_[i]) scratch_z_.push_back(bz_[i]);
-    }
-  }
-  if (scratch_z_.empty()) return std::numeric_limits<float>::quiet_NaN();
-  const size_t k = std::min<size_t>(num_seed_points_, scratch_z_.size());
-  if (k < scratch_z_.size()) {
-    std::nth_element(scratch_z_.begin(), scratch_z_.begin() + (k - 1), scratch_z_.end());
-  }
-  double sum = 0.0;
-  for (size_t i = 0; i < k; ++i) sum += scratch_z_[i];
-  return static_cast<float>(sum / static_cast<double>(k));
-}
-
 void GroundSegmenter::ProcessBin(int bin, uint32_t begin, uint32_t end, bool zone0,
                                  double seed_floor_z) {
   Bin& b = bins_[bin];
-  const Eigen::Vector3d origin(bx_[begin], by_[begin], bz_[begin]);
-  geometry::PlaneMoments moments(origin);
-  geometry::PlaneFit fit;
-  const double floor_z = zone0 ? seed_floor_z : -std::numeric_limits<double>::infinity();
+  const size_t n = end - begin;
+  const float* x = bx_.data() + begin;
+  const float* y = by_.data() + begin;
+  const float* z = bz_.data() + begin;
+  uint8_t* active = active_.data() + begin;
+  uint8_t* seeds = seed_scratch_.data() + begin;
+  uint8_t* label = bground_.data() + begin;
+  geometry::PlaneMoments moments(Eigen::Vector3d(x[0], y[0], z[0]));
+  const float floor_z = zone0 ? static_cast<float>(seed_floor_z)
+                              : -std::numeric_limits<float>::infinity();
+  // Seed height: mean z of the lowest points above the floor (all of them
+  // when none is above it).
+  auto seed_height = [&]() {
+    float lpr = geometry::MeanOfLowest(z, n, active, num_seed_points_, floor_z);
+    if (!std::isfinite(lpr)) {
+      lpr = geometry::MeanOfLowest(z, n, active, num_seed_points_,
+                                   -std::numeric_limits<float>::infinity());
+    }
+    return lpr;
+  };
+  // Plane of the active points with z < top (a band 100 m deep below top).
+  auto fit_below = [&](float top) {
+    moments.Clear();
+    geometry::SelectAndAccumulate(x, y, z, n, active, Eigen::Vector3d::UnitZ(),
+                                  -(static_cast<double>(top) - 50.0), 50.0, seeds, &moments);
+    return geometry::FitPlane(moments);
+  };
 
+  float lpr = seed_height();
+  if (!std::isfinite(lpr)) return;
   // Vertical-structure rejection (zone 0 only).
   if (zone0 && reject_vertical_) {
     for (int iter = 0; iter < num_iterations_; ++iter) {
-      const float lpr = SeedHeight(begin, end, floor_z);
-      if (!std::isfinite(lpr)) return;
-      const float top = lpr + vertical_seed_margin_;
-      moments.Clear();
-      for (uint32_t i = begin; i < end; ++i) {
-        if (active_[i] && bz_[i] < top) moments.Add(bx_[i], by_[i], bz_[i]);
-      }
-      fit = geometry::FitPlane(moments);
-      if (!fit.ok || fit.normal.z() >= cos_max_tilt_) break;
-      const float nx = fit.normal.x(), ny = fit.normal.y(), nz = fit.normal.z();
-      const float d = static_cast<float>(fit.offset);
+      const geometry::PlaneFit vertical = fit_below(lpr + vertical_seed_margin_);
+      if (!vertical.ok || vertical.normal.z() >= cos_max_tilt_) break;
+      const float nx = vertical.normal.x(), ny = vertical.normal.y(), nz = vertical.normal.z();
+      const float d = static_cast<float>(vertical.offset);
       uint32_t removed = 0;
-      for (uint32_t i = begin; i < end; ++i) {
-        if (active_[i] && std::fabs(nx * bx_[i] + ny * by_[i] + nz * bz_[i] + d) <
-                              vertical_distance_) {
-          active_[i] = 0;
-          ++removed;
-        }
+      for (size_t i = 0; i < n; ++i) {
+        const bool on = active[i] && std::fabs(nx * x[i] + ny * y[i] + nz * z[i] + d) <
+                                         vertical_distance_;
+        removed += on ? 1 : 0;
+        if (on) active[i] = 0;
       }
       if (removed == 0) break;
+      lpr = seed_height();
+      if (!std::isfinite(lpr)) return;
     }
   }
 
-  // Ground plane from the lowest points, then refits on two-sided inliers.
-  const float lpr = SeedHeight(begin, end, floor_z);
-  if (!std::isfinite(lpr)) return;
-  const float top = lpr + seed_margin_;
-  moments.Clear();
-  for (uint32_t i = begin; i < end; ++i) {
-    if (active_[i] && bz_[i] < top) moments.Add(bx_[i], by_[i], bz_[i]);
-  }
-  fit = geometry::FitPlane(moments);
+  // Ground plane from the lowest points, then refits on two-sided inliers;
+  // the label of a point is its selection against the last plane but one,
+  // i.e. exactly the points of the final fit.
+  geometry::PlaneFit fit = fit_below(lpr + seed_margin_);
   for (int iter = 0; iter < num_iterations_ && fit.ok; ++iter) {
-    const float nx = fit.normal.x(), ny = fit.normal.y(), nz = fit.normal.z();
-    const float d = static_cast<float>(fit.offset);
     moments.Clear();
-    const bool last = iter + 1 == num_iterations_;
-    for (uint32_t i = begin; i < end; ++i) {
-      const bool in =
-          active_[i] && std::fabs(nx * bx_[i] + ny * by_[i] + nz * bz_[i] + d) < plane_distance_;
-      if (in) moments.Add(bx_[i], by_[i], bz_[i]);
-      if (last) bground_[i] = in ? 1 : 0;
-    }
+    const bool changed = geometry::SelectAndAccumulate(x, y, z, n, active, fit.normal, fit.offset,
+                                                       plane_distance_, label, &moments);
+    if (iter > 0 && !changed) break;
     fit = geometry::FitPlane(moments);
   }
   if (!fit.ok) {
-    for (uint32_t i = begin; i < end; ++i) bground_[i] = 0;
+    std::fill(label, label + n, uint8_t{0});
     return;
   }
   b.ok = true;
@@ -215,21 +202,31 @@ SegmentationSummary GroundSegmenter::Segment(const float* x, const float* y, con
   SegmentationSummary summary;
   summary.num_points = static_cast<uint32_t>(n);
   bin_of_.resize(n);
+  r_of_.resize(n);
   std::fill(bin_start_.begin(), bin_start_.end(), 0u);
 
   // 1. Bin index of every point and per-bin counts.
   uint32_t* count = bin_start_.data() + 1;
   size_t binned = 0;
+  const float min_r2 = static_cast<float>(min_range2_), max_r2 = static_cast<float>(max_range2_);
+  const float b1 = static_cast<float>(bound_[1]), b2 = static_cast<float>(bound_[2]),
+              b3 = static_cast<float>(bound_[3]);
+  float bound_f[4], inv_width_f[4];
+  for (int k = 0; k < 4; ++k) {
+    bound_f[k] = static_cast<float>(bound_[k]);
+    inv_width_f[k] = static_cast<float>(inv_ring_width_[k]);
+  }
   for (size_t i = 0; i < n; ++i) {
     const float xi = x[i], yi = y[i], zi = z[i];
     bin_of_[i] = -1;
-    if (!std::isfinite(xi) || !std::isfinite(yi) || !std::isfinite(zi)) continue;
-    const double r2 = static_cast<double>(xi) * xi + static_cast<double>(yi) * yi;
-    if (r2 <= min_range2_ || r2 > max_range2_) continue;
-    const double r = std::sqrt(r2);
-    const int zone = r < bound_[1] ? 0 : r < bound_[2] ? 1 : r < bound_[3] ? 2 : 3;
+    // NaN fails every comparison below (and z is checked explicitly).
+    const float r2 = xi * xi + yi * yi;
+    if (!(r2 > min_r2 && r2 <= max_r2) || !std::isfinite(zi)) continue;
+    const float r = std::sqrt(r2);
+    r_of_[i] = r;
+    const int zone = r < b1 ? 0 : r < b2 ? 1 : r < b3 ? 2 : 3;
     const int ring_local =
-        std::min(static_cast<int>((r - bound_[zone]) * inv_ring_width_[zone]), rings_[zone] - 1);
+        std::min(static_cast<int>((r - bound_f[zone]) * inv_width_f[zone]), rings_[zone] - 1);
     const int sector = std::min(static_cast<int>(Azimuth02Pi(yi, xi) * sector_scale_[zone]),
                                 sectors_[zone] - 1);
     const int bin = ring_first_bin_[first_ring_[zone] + ring_local] + sector;
@@ -244,8 +241,10 @@ SegmentationSummary GroundSegmenter::Segment(const float* x, const float* y, con
   by_.resize(binned);
   bz_.resize(binned);
   bsrc_.resize(binned);
+  br_.resize(binned);
   bground_.assign(binned, 0);
   active_.assign(binned, 1);
+  seed_scratch_.assign(binned, 0);
   {
     // bin_start_[b] is the write cursor of bin b; restored afterwards.
     for (size_t i = 0; i < n; ++i) {
@@ -255,6 +254,7 @@ SegmentationSummary GroundSegmenter::Segment(const float* x, const float* y, con
       bx_[pos] = x[i];
       by_[pos] = y[i];
       bz_[pos] = z[i];
+      br_[pos] = r_of_[i];
       bsrc_[pos] = static_cast<uint32_t>(i);
     }
     for (int b = num_bins_; b > 0; --b) bin_start_[b] = bin_start_[b - 1];

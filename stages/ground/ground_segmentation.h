@@ -62,6 +62,7 @@ class GroundSegmenter {
   const float* binned_x() const { return bx_.data(); }
   const float* binned_y() const { return by_.data(); }
   const float* binned_z() const { return bz_.data(); }
+  const float* binned_range() const { return br_.data(); }  // horizontal range, m
   const uint32_t* binned_source() const { return bsrc_.data(); }
   const uint8_t* binned_ground() const { return bground_.data(); }
 
@@ -78,8 +79,6 @@ class GroundSegmenter {
   };
 
   void ProcessBin(int bin, uint32_t begin, uint32_t end, bool zone0, double seed_floor_z);
-  // Mean z of the `count` lowest active points of [begin, end) with z >= floor.
-  float SeedHeight(uint32_t begin, uint32_t end, double floor_z);
 
   // Layout.
   double bound_[5];
@@ -113,12 +112,13 @@ class GroundSegmenter {
 
   // Buffers reused between scans.
   std::vector<int32_t> bin_of_;
+  std::vector<float> r_of_;
   std::vector<uint32_t> bin_start_;
-  std::vector<float> bx_, by_, bz_;
+  std::vector<float> bx_, by_, bz_, br_;
   std::vector<uint32_t> bsrc_;
   std::vector<uint8_t> bground_;
   std::vector<uint8_t> active_;
-  std::vector<float> scratch_z_;
+  std::vector<uint8_t> seed_scratch_;
   std::vector<float> reference_samples_;
   std::vector<Bin> bins_;
   size_t num_binned_ = 0;

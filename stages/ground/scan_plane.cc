@@ -20,6 +20,25 @@ std::string Format(const char* format, double a, double b = 0.0) {
 
 ScanPlaneFitter::ScanPlaneFitter(const proto::GroundParams& params) : params_(params) {}
 
+namespace {
+
+// Range histograms: 5 cm bins.
+constexpr float kRangeBinM = 0.05f;
+
+// Value below which `fraction` of the histogram's samples lie (bin centre).
+double HistogramQuantile(const std::vector<uint32_t>& histogram, uint64_t total,
+                         double fraction) {
+  const uint64_t target = static_cast<uint64_t>(fraction * static_cast<double>(total));
+  uint64_t seen = 0;
+  for (size_t b = 0; b < histogram.size(); ++b) {
+    seen += histogram[b];
+    if (seen > target) return (static_cast<double>(b) + 0.5) * kRangeBinM;
+  }
+  return (static_cast<double>(histogram.size()) - 0.5) * kRangeBinM;
+}
+
+}  // namespace
+
 ScanPlane ScanPlaneFitter::Fit(const GroundSegmenter& segmenter,
                                const SegmentationSummary& summary, double height_prior_m,
                                std::vector<uint8_t>* inlier) {
@@ -29,6 +48,7 @@ ScanPlane ScanPlaneFitter::Fit(const GroundSegmenter& segmenter,
   const float* x = segmenter.binned_x();
   const float* y = segmenter.binned_y();
   const float* z = segmenter.binned_z();
+  const float* range = segmenter.binned_range();
   const uint8_t* ground = segmenter.binned_ground();
 
   if (summary.num_binned == 0) {
@@ -37,31 +57,38 @@ ScanPlane ScanPlaneFitter::Fit(const GroundSegmenter& segmenter,
                         params_.max_range_m());
     return out;
   }
+  const size_t num_range_bins =
+      static_cast<size_t>(params_.max_range_m() / kRangeBinM) + 2;
 
-  // Fit radius: fixed, or sized to where the lowest beam meets the ground.
+  // Fit radius: fixed, or sized to where the lowest beam meets the ground
+  // (a low quantile of the ground points' ranges).
   double radius = params_.fit_radius_m();
   if (radius <= 0.0) {
-    radii_.clear();
+    histogram_.assign(num_range_bins, 0);
+    uint64_t total = 0;
     for (size_t i = 0; i < n; ++i) {
-      if (ground[i]) radii_.push_back(std::sqrt(x[i] * x[i] + y[i] * y[i]));
+      if (!ground[i]) continue;
+      ++histogram_[std::min(num_range_bins - 1, static_cast<size_t>(range[i] / kRangeBinM))];
+      ++total;
     }
-    double first_ring = params_.fit_radius_min_m();
-    if (!radii_.empty()) {
-      const size_t k = std::min(radii_.size() - 1,
-                                static_cast<size_t>(params_.fit_first_ring_quantile() *
-                                                    static_cast<double>(radii_.size())));
-      std::nth_element(radii_.begin(), radii_.begin() + k, radii_.end());
-      first_ring = radii_[k];
-    }
+    const double first_ring =
+        total > 0 ? HistogramQuantile(histogram_, total, params_.fit_first_ring_quantile())
+                  : params_.fit_radius_min_m();
     radius = std::clamp(params_.fit_radius_first_ring_ratio() * first_ring,
                         params_.fit_radius_min_m(), params_.fit_radius_max_m());
   }
   out.fit_radius_m = radius;
-  const float radius2 = static_cast<float>(radius * radius);
+  const float radius_f = static_cast<float>(radius);
   candidates_.clear();
+  cx_.clear();
+  cy_.clear();
+  cz_.clear();
   for (size_t i = 0; i < n; ++i) {
-    if (ground[i] && x[i] * x[i] + y[i] * y[i] <= radius2) {
+    if (ground[i] && range[i] <= radius_f) {
       candidates_.push_back(static_cast<uint32_t>(i));
+      cx_.push_back(x[i]);
+      cy_.push_back(y[i]);
+      cz_.push_back(z[i]);
     }
   }
   out.num_candidates = static_cast<uint32_t>(candidates_.size());
@@ -75,7 +102,7 @@ ScanPlane ScanPlaneFitter::Fit(const GroundSegmenter& segmenter,
   geometry::RobustPlaneOptions options;
   options.inlier_distance_m = params_.inlier_distance_m();
   options.max_iterations = static_cast<int>(params_.fit_iterations());
-  out.fit = geometry::FitPlaneRobust(x, y, z, candidates_.data(), candidates_.size(), options,
+  out.fit = geometry::FitPlaneRobust(cx_.data(), cy_.data(), cz_.data(), cx_.size(), options,
                                      &fit_inlier_);
   if (!out.fit.ok) {
     out.reason = proto::GROUND_FIT_FAILED;
@@ -87,6 +114,7 @@ ScanPlane ScanPlaneFitter::Fit(const GroundSegmenter& segmenter,
   uint32_t num_inliers = 0;
   const uint32_t sectors = params_.azimuth_sectors();
   sector_count_.assign(sectors, 0);
+  histogram_.assign(num_range_bins, 0);
   const float sector_scale = static_cast<float>(sectors / (2.0 * M_PI));
   for (size_t k = 0; k < candidates_.size(); ++k) {
     if (!fit_inlier_[k]) continue;
@@ -96,22 +124,15 @@ ScanPlane ScanPlaneFitter::Fit(const GroundSegmenter& segmenter,
     const uint32_t s = std::min<uint32_t>(
         static_cast<uint32_t>(Azimuth02Pi(y[i], x[i]) * sector_scale), sectors - 1);
     ++sector_count_[s];
+    ++histogram_[std::min(num_range_bins - 1, static_cast<size_t>(range[i] / kRangeBinM))];
   }
   out.num_inliers = num_inliers;
-  // Radial spread of the inliers: 90th / 10th percentile of the ranges.
-  radii_.clear();
-  for (size_t k = 0; k < candidates_.size(); ++k) {
-    if (!fit_inlier_[k]) continue;
-    const uint32_t i = candidates_[k];
-    radii_.push_back(std::sqrt(x[i] * x[i] + y[i] * y[i]));
-  }
-  if (radii_.size() >= 10) {
-    const size_t lo = radii_.size() / 10, hi = radii_.size() - 1 - radii_.size() / 10;
-    std::nth_element(radii_.begin(), radii_.begin() + lo, radii_.end());
-    const float r_lo = radii_[lo];
-    std::nth_element(radii_.begin() + lo, radii_.begin() + hi, radii_.end());
-    const float r_hi = radii_[hi];
-    out.radial_spread = r_lo > 0.0f ? static_cast<double>(r_hi) / r_lo : 0.0;
+  // Radial spread of the inliers: 90th / 10th percentile of the ranges
+  // (5 cm resolution).
+  if (num_inliers >= 10) {
+    const double r_lo = HistogramQuantile(histogram_, num_inliers, 0.1);
+    const double r_hi = HistogramQuantile(histogram_, num_inliers, 0.9);
+    out.radial_spread = r_lo > 0.0 ? r_hi / r_lo : 0.0;
   }
   uint32_t covered = 0;
   for (uint32_t c : sector_count_) covered += c >= params_.min_points_per_sector() ? 1 : 0;

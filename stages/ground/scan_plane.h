@@ -46,8 +46,9 @@ class ScanPlaneFitter {
 
  private:
   proto::GroundParams params_;
-  std::vector<uint32_t> candidates_;
-  std::vector<float> radii_;
+  std::vector<uint32_t> candidates_;   // binned index of each candidate
+  std::vector<float> cx_, cy_, cz_;     // candidate coordinates, contiguous
+  std::vector<uint32_t> histogram_;     // horizontal ranges, 5 cm bins
   std::vector<uint8_t> fit_inlier_;
   std::vector<uint32_t> sector_count_;
 };

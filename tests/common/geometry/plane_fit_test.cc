@@ -165,7 +165,7 @@ TEST(PlaneFit, RobustFitIgnoresOutliers) {
   std::vector<uint8_t> inlier;
   const PlaneFit plain = FitAll(c);
   const PlaneFit robust =
-      FitPlaneRobust(c.x.data(), c.y.data(), c.z.data(), nullptr, c.size(), options, &inlier);
+      FitPlaneRobust(c.x.data(), c.y.data(), c.z.data(), c.size(), options, &inlier);
   ASSERT_TRUE(robust.ok);
   const double robust_err = std::acos(std::min(1.0, robust.normal.dot(n))) * 180.0 / M_PI;
   const double plain_err = std::acos(std::min(1.0, plain.normal.dot(n))) * 180.0 / M_PI;
@@ -177,6 +177,47 @@ TEST(PlaneFit, RobustFitIgnoresOutliers) {
   EXPECT_LT(kept_outliers, 20);
   EXPECT_EQ(robust.num_points,
             static_cast<int64_t>(std::count(inlier.begin(), inlier.end(), uint8_t{1})));
+}
+
+TEST(PlaneFit, SelectAndAccumulateMatchesAPlainLoop) {
+  std::mt19937 rng(6);
+  const Eigen::Vector3d n = Eigen::Vector3d(0.02, -0.05, 1.0).normalized();
+  const Cloud c = PlanePoints(n, 1.3, 1000, 30.0, 0.05, &rng);
+  std::vector<uint8_t> active(c.size()), selected(c.size(), 0);
+  for (size_t i = 0; i < c.size(); ++i) active[i] = i % 7 != 0;
+  PlaneMoments fast(Eigen::Vector3d(1.0, 2.0, -1.0)), slow(Eigen::Vector3d(1.0, 2.0, -1.0));
+  EXPECT_TRUE(SelectAndAccumulate(c.x.data(), c.y.data(), c.z.data(), c.size(), active.data(), n,
+                                  1.3, 0.04, selected.data(), &fast));
+  for (size_t i = 0; i < c.size(); ++i) {
+    const Eigen::Vector3d p(c.x[i], c.y[i], c.z[i]);
+    const bool in = active[i] && std::fabs(n.dot(p) + 1.3) < 0.04;
+    EXPECT_EQ(selected[i], in ? 1 : 0) << i;
+    if (in) slow.Add(p.x(), p.y(), p.z());
+  }
+  EXPECT_EQ(fast.count(), slow.count());
+  EXPECT_LT((fast.Mean() - slow.Mean()).norm(), 1e-5);
+  EXPECT_LT((fast.Covariance() - slow.Covariance()).norm(), 1e-4);
+  // Same selection again: nothing changed.
+  PlaneMoments again(Eigen::Vector3d::Zero());
+  EXPECT_FALSE(SelectAndAccumulate(c.x.data(), c.y.data(), c.z.data(), c.size(), active.data(),
+                                   n, 1.3, 0.04, selected.data(), &again));
+}
+
+TEST(PlaneFit, MeanOfLowestMatchesSorting) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(-3.0f, 1.0f);
+  std::vector<float> v(500);
+  for (float& value : v) value = u(rng);
+  std::vector<float> kept;
+  for (float value : v) {
+    if (value >= -2.5f) kept.push_back(value);
+  }
+  std::sort(kept.begin(), kept.end());
+  double expected = 0.0;
+  for (int i = 0; i < 20; ++i) expected += kept[i];
+  EXPECT_NEAR(MeanOfLowest(v.data(), v.size(), nullptr, 20, -2.5f), expected / 20.0, 1e-5);
+  EXPECT_TRUE(std::isnan(MeanOfLowest(v.data(), v.size(), nullptr, 20, 5.0f)));
+  EXPECT_NEAR(MeanOfLowest(v.data(), 3, nullptr, 20, -10.0f), (v[0] + v[1] + v[2]) / 3.0, 1e-6);
 }
 
 }  // namespace
