@@ -140,6 +140,98 @@ TEST(GroundCli, PlanesMatchTheTruthAndDeskewedScansAreWritten) {
   for (const proto::Scan& scan : deskewed) EXPECT_TRUE(scan.deskewed());
 }
 
+// Splits a CSV line (no quoted fields in these tables).
+std::vector<std::string> SplitCsv(const std::string& line) {
+  std::vector<std::string> cells;
+  size_t start = 0;
+  for (;;) {
+    const size_t comma = line.find(',', start);
+    cells.push_back(line.substr(start, comma - start));
+    if (comma == std::string::npos) return cells;
+    start = comma + 1;
+  }
+}
+
+TEST(GroundCli, InspectCsvAndPcdShowThePlanesAndLabels) {
+  TempDir dir;
+  const Dataset data = WriteDataset(dir, false, false);
+  std::string output;
+  ASSERT_EQ(testing::RunCommand(Command(data, dir, data.params), &output), 0) << output;
+  std::vector<proto::GroundPlane> planes;
+  ASSERT_TRUE(ReadAllRecords<proto::GroundPlane>(dir.File("ground.binpb"), &planes).ok());
+  const std::string inspect = testing::ToolPath("tiltcal_inspect");
+
+  // CSV: dotted names of DESIGN §8, one row per plane, values as written.
+  std::string csv;
+  ASSERT_EQ(testing::RunCommand(inspect + " csv " + dir.File("ground.binpb") + " 2>/dev/null",
+                                &csv), 0) << csv;
+  std::vector<std::string> lines;
+  for (size_t start = 0; start < csv.size();) {
+    const size_t end = csv.find('\n', start);
+    lines.push_back(csv.substr(start, end - start));
+    if (end == std::string::npos) break;
+    start = end + 1;
+  }
+  while (!lines.empty() && lines.back().empty()) lines.pop_back();
+  ASSERT_EQ(lines.size(), planes.size() + 1) << csv;
+  const std::vector<std::string> header = SplitCsv(lines[0]);
+  auto column = [&](const std::string& name) {
+    const auto it = std::find(header.begin(), header.end(), name);
+    EXPECT_NE(it, header.end()) << name << " missing in " << lines[0];
+    return static_cast<size_t>(it - header.begin());
+  };
+  const size_t nz = column("normal_in_lidar.z"), h = column("height_m"), v = column("valid");
+  column("stamp_ns");
+  column("reject_reason");
+  column("rms_m");
+  column("azimuth_coverage");
+  column("height_std_m");
+  for (size_t k = 0; k < planes.size(); ++k) {
+    const std::vector<std::string> row = SplitCsv(lines[k + 1]);
+    ASSERT_EQ(row.size(), header.size()) << lines[k + 1];
+    EXPECT_NEAR(std::stod(row[nz]), planes[k].normal_in_lidar().z(), 1e-12);
+    EXPECT_NEAR(std::stod(row[h]), planes[k].height_m(), 1e-12);
+    EXPECT_EQ(row[v], "1");
+    EXPECT_EQ(lines[k + 1].find("nan"), std::string::npos);
+  }
+
+  // PCD of scan 2 (deskewed and raw) with labels from the ground masks.
+  for (const std::string& scans : {dir.File("deskewed.binpb.lz4"), data.scans}) {
+    const std::string pcd = dir.File("scan.pcd");
+    std::string log;
+    ASSERT_EQ(testing::RunCommand(inspect + " pcd " + scans + " --record=2 --ground=" +
+                                      dir.File("ground.binpb") + " --out=" + pcd,
+                                  &log), 0) << log;
+    std::string bytes;
+    ASSERT_TRUE(ReadFileToString(pcd, &bytes).ok());
+    const size_t data_pos = bytes.find("DATA binary\n");
+    ASSERT_NE(data_pos, std::string::npos);
+    const std::string pcd_header = bytes.substr(0, data_pos);
+    EXPECT_NE(pcd_header.find("FIELDS x y z intensity ring time_offset_ns label"),
+              std::string::npos) << pcd_header;
+    EXPECT_NE(pcd_header.find("POINTS " + std::to_string(planes[2].num_points())),
+              std::string::npos) << pcd_header;
+    const size_t begin = data_pos + std::string("DATA binary\n").size();
+    // PCL's binary writer pads the file with zeros to its mapping size.
+    ASSERT_GE(bytes.size() - begin, static_cast<size_t>(planes[2].num_points()) * 25)
+        << pcd_header;
+    uint32_t ground = 0, inliers = 0;
+    for (uint32_t i = 0; i < planes[2].num_points(); ++i) {
+      const uint8_t label = static_cast<uint8_t>(bytes[begin + i * 25 + 24]);
+      ground += label >= 1 ? 1 : 0;
+      inliers += label == 2 ? 1 : 0;
+    }
+    EXPECT_EQ(ground, planes[2].num_ground_points());
+    EXPECT_EQ(inliers, planes[2].num_inliers());
+  }
+  // A record that does not exist is one clear error.
+  std::string log;
+  EXPECT_EQ(testing::RunCommand(inspect + " pcd " + data.scans + " --record=99 --out=" +
+                                    dir.File("x.pcd"), &log), 1);
+  EXPECT_NE(log.find("no record 99"), std::string::npos) << log;
+  EXPECT_FALSE(testing::FileExists(dir.File("x.pcd")));
+}
+
 TEST(GroundCli, MismatchedColumnsAreOneErrorLineAndNoOutput) {
   TempDir dir;
   const Dataset data = WriteDataset(dir, true, false);
