@@ -1,5 +1,5 @@
 // Ground stage benchmark: wall-clock milliseconds per scan of segmentation +
-// per-scan plane fit (ScanProcessor::Process without deskewing), single
+// per-scan plane fit (ScanProcessor::Process; one row adds deskewing), single
 // thread, on
 //   - simulated VLP-16 street scans (ray-cast, ~25k points),
 //   - the real KITTI HDL-64E scan kitti_000000.bin (124,668 points),
@@ -51,8 +51,8 @@ struct Timing {
 };
 
 Timing TimeScans(const tiltcal::proto::GroundParams& params, const std::vector<Scan>& scans,
-                 int passes) {
-  tiltcal::ground::ScanProcessor processor(params, tiltcal::ground::GroundFrame(), nullptr);
+                 int passes, tiltcal::ground::Deskewer* deskewer = nullptr) {
+  tiltcal::ground::ScanProcessor processor(params, tiltcal::ground::GroundFrame(), deskewer);
   std::vector<double> ms, cpu, seg, fit;
   Timing t;
   for (int pass = 0; pass < passes; ++pass) {
@@ -169,6 +169,20 @@ int main(int argc, char** argv) {
                                              k, k));
   }
   PrintRow("simulated VLP-16 (street, 0.85 m)", TimeScans(params, vlp, passes), 0.0);
+  {
+    // The same scans with deskewing (IMU at 200 Hz turning at 0.5 rad/s).
+    std::vector<tiltcal::proto::ImuSample> imu;
+    for (int64_t t = -1000000000LL; t <= 2000000000LL; t += 5000000) {
+      tiltcal::proto::ImuSample sample;
+      sample.set_stamp_ns(t);
+      sample.mutable_angular_velocity_radps()->set_z(0.5);
+      imu.push_back(sample);
+    }
+    tiltcal::ground::GyroIntegrator integrator(imu, Eigen::Vector3d::Zero());
+    tiltcal::ground::Deskewer deskewer(&integrator, Eigen::Matrix3d::Identity(), 0,
+                                       params.deskew_node_spacing_s());
+    PrintRow("  + deskewing", TimeScans(params, vlp, passes, &deskewer), 0.0);
+  }
 
   Scan kitti;
   if (!ReadKitti(fixtures + "/scans/kitti_000000.bin", &kitti)) {

@@ -7,6 +7,8 @@
 #include <memory>
 #include <vector>
 
+#include <unistd.h>
+
 #include "common/io/provenance.h"
 #include "common/io/record_stream.h"
 #include "common/io/text_proto.h"
@@ -121,6 +123,8 @@ Status Run(const GroundPaths& paths, const proto::GroundParams& params,
                                               /*compress=*/true));
   }
 
+  // Progress on stderr only when it is a terminal.
+  const bool progress = log != nullptr && ::isatty(STDERR_FILENO) != 0;
   std::vector<proto::GroundPlane> planes;
   proto::Scan scan;
   for (int64_t record = 0;; ++record) {
@@ -135,7 +139,11 @@ Status Run(const GroundPaths& paths, const proto::GroundParams& params,
     summary.fit_s += processor.last_fit_s();
     if (planes.back().deskewed()) ++summary.num_deskewed;
     if (scan_writer) TILTCAL_RETURN_IF_ERROR(scan_writer->Write(scan));
+    if (progress && (record + 1) % 50 == 0) {
+      *log << "\rtiltcal_ground: " << (record + 1) << " scans" << std::flush;
+    }
   }
+  if (progress) *log << "\r";
   ApplyTiltJumpGate(params.max_tilt_jump_deg(), static_cast<int>(params.tilt_jump_window()),
                     &planes);
 
