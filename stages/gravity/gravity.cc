@@ -1,0 +1,230 @@
+#include "stages/gravity/gravity.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include "common/imu/gyro_integrator.h"
+#include "common/imu/imu_initialisation.h"
+#include "common/io/eigen_proto.h"
+#include "common/io/imu_stream.h"
+#include "common/io/provenance.h"
+#include "common/io/record_stream.h"
+#include "common/io/text_proto.h"
+
+namespace tiltcal::gravity {
+
+namespace {
+
+constexpr double kRadToDeg = 180.0 / M_PI;
+
+double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return kRadToDeg * std::atan2(a.cross(b).norm(), a.dot(b));
+}
+
+imu::StaticDetectionOptions StaticOptions(const proto::GravityParams& params) {
+  imu::StaticDetectionOptions options;
+  options.window_s = params.static_window_s();
+  options.hop_s = params.static_hop_s();
+  options.max_gyro_std_radps = params.static_gyro_std_max_radps();
+  options.max_accel_std_mps2 = params.static_accel_std_max_mps2();
+  options.max_gyro_mean_radps = params.static_gyro_mean_max_radps();
+  options.min_duration_s = params.static_min_duration_s();
+  return options;
+}
+
+// Linear-interpolated percentile (0..100) of non-empty `values`.
+double Percentile(std::vector<double> values, double percentile) {
+  std::sort(values.begin(), values.end());
+  const double rank = percentile / 100.0 * static_cast<double>(values.size() - 1);
+  const size_t low = static_cast<size_t>(std::floor(rank));
+  const size_t high = std::min(low + 1, values.size() - 1);
+  return values[low] + (rank - low) * (values[high] - values[low]);
+}
+
+std::string Format(const char* format, double a, double b = 0, double c = 0) {
+  char buffer[256];
+  std::snprintf(buffer, sizeof(buffer), format, a, b, c);
+  return buffer;
+}
+
+}  // namespace
+
+Status EstimateGravityReference(const GravityInputs& inputs, const proto::GravityParams& params,
+                                proto::GravityReference* out) {
+  const double g = params.gravity_norm_mps2();
+  imu::ImuInitialisationOptions init_options;
+  init_options.static_detection = StaticOptions(params);
+  init_options.gravity_norm_mps2 = g;
+  init_options.fallback_window_s = params.fallback_window_s();
+  imu::ImuInitialisation init;
+  TILTCAL_RETURN_IF_ERROR(imu::InitialiseImu(inputs.imu, init_options, &init));
+  *out->mutable_gravity_in_world() = ToProto(init.gravity_in_world_mps2);
+  *out->mutable_gyro_bias_radps() = ToProto(init.gyro_bias_radps);
+
+  // Static windows: their specific force is −g_b at that time.
+  Eigen::Vector3d static_force_sum = Eigen::Vector3d::Zero();
+  size_t static_samples = 0;
+  for (const imu::StaticInterval& interval :
+       imu::DetectStaticIntervals(inputs.imu, init_options.static_detection)) {
+    proto::StaticWindow* window = out->add_static_windows();
+    window->set_begin_ns(inputs.first_imu_stamp_ns + std::llround(interval.begin_s * 1e9));
+    window->set_end_ns(inputs.first_imu_stamp_ns + std::llround(interval.end_s * 1e9));
+    *window->mutable_mean_accel_mps2() = ToProto(interval.mean_accel_mps2);
+    window->set_accel_std_mps2(interval.accel_std_mps2);
+    window->set_gyro_std_radps(interval.gyro_std_radps);
+    const size_t n = interval.end_index - interval.begin_index;
+    static_force_sum += interval.mean_accel_mps2 * static_cast<double>(n);
+    static_samples += n;
+  }
+
+  // Per scan: gravity-up in the IMU frame and the slope of the ground.
+  const imu::GyroIntegrator attitude(inputs.imu, init.gyro_bias_radps);
+  const Eigen::Vector3d up_in_world = -init.gravity_in_world_mps2.normalized();
+  const Eigen::Quaterniond imu_from_lidar = ToEigen(inputs.rig.imu_from_lidar().rotation());
+  const bool has_extrinsic = HasValidRotation(inputs.rig.imu_from_lidar());
+  std::vector<double> slopes;
+  std::vector<Eigen::Vector3d> ups;
+  for (const proto::GroundPlane& plane : inputs.ground) {
+    const double t = static_cast<double>(plane.stamp_ns() - inputs.first_imu_stamp_ns) * 1e-9 +
+                     params.time_offset_s();
+    const Eigen::Vector3d up_in_imu = attitude.Rotation(t).conjugate() * up_in_world;
+    proto::InclinationSample* sample = out->add_inclination();
+    sample->set_stamp_ns(plane.stamp_ns());
+    *sample->mutable_up_in_imu() = ToProto(up_in_imu);
+    ups.push_back(up_in_imu);
+    if (plane.valid() && has_extrinsic) {
+      const double slope = AngleDeg(up_in_imu, imu_from_lidar * ToEigen(plane.normal_in_lidar()));
+      sample->set_ground_slope_deg(slope);
+      slopes.push_back(slope);
+    }
+  }
+
+  // Verdict.
+  if (!slopes.empty()) {
+    const double statistic = Percentile(slopes, params.level_percentile());
+    out->set_level_statistic_deg(statistic);
+    out->set_is_level(statistic < params.level_threshold_deg());
+    out->set_level_statistic(Format("%.0fth percentile of the ground slope over %.0f valid "
+                                    "ground planes: %.3f deg",
+                                    params.level_percentile(),
+                                    static_cast<double>(slopes.size()), statistic) +
+                             Format(" (level below %.3f deg)", params.level_threshold_deg()));
+  } else {
+    out->set_is_level(false);
+    out->set_level_statistic(has_extrinsic
+                                 ? "no valid ground plane: the ground slope is unknown, so the "
+                                   "sequence is not taken as level"
+                                 : "the rig has no imu_from_lidar: the ground slope is unknown, "
+                                   "so the sequence is not taken as level");
+  }
+
+  // g_f.
+  if (inputs.dataset_reference.has_gravity_flat()) {
+    out->set_has_gravity_flat(true);
+    *out->mutable_gravity_flat_in_imu() = inputs.dataset_reference.gravity_flat_in_imu();
+    out->set_gravity_flat_source(inputs.dataset_reference_source);
+  } else if (out->is_level()) {
+    const bool from_static = static_samples > 0;
+    const bool from_calibration = inputs.flat_calibration != nullptr;
+    if (from_static) {
+      *out->mutable_gravity_from_static() =
+          ToProto(Eigen::Vector3d(-g * static_force_sum.normalized()));
+    }
+    if (from_calibration) {
+      *out->mutable_gravity_from_calibration() = inputs.flat_calibration->gravity_in_world();
+    }
+    if (from_static && from_calibration) {
+      out->set_sources_disagreement_deg(AngleDeg(ToEigen(out->gravity_from_static()),
+                                                 ToEigen(out->gravity_from_calibration())));
+    }
+    if (from_static || from_calibration) {
+      out->set_has_gravity_flat(true);
+      // The calibration's g_a is optimised with the accelerometer bias; prefer it.
+      *out->mutable_gravity_flat_in_imu() =
+          from_calibration ? out->gravity_from_calibration() : out->gravity_from_static();
+      out->set_gravity_flat_source(from_static && from_calibration ? "both"
+                                   : from_calibration          ? "calibration"
+                                                               : "static_windows");
+    }
+  }
+  if (out->has_gravity_flat()) {
+    const Eigen::Vector3d up_flat = -ToEigen(out->gravity_flat_in_imu()).normalized();
+    for (int i = 0; i < out->inclination_size(); ++i) {
+      out->mutable_inclination(i)->set_inclination_deg(AngleDeg(ups[i], up_flat));
+    }
+  }
+  return Status::Ok();
+}
+
+namespace {
+
+// g_f named by the rig: its own gravity_flat_in_imu, or a gravity.txtpb of a
+// flat run at a path relative to the dataset (the rig's folder).
+Status ReadDatasetReference(const std::string& rig_path, const proto::Rig& rig,
+                            proto::GravityReference* reference, std::string* source) {
+  if (rig.has_gravity_flat_in_imu() && ToEigen(rig.gravity_flat_in_imu()).norm() > 0) {
+    reference->set_has_gravity_flat(true);
+    *reference->mutable_gravity_flat_in_imu() = rig.gravity_flat_in_imu();
+    *source = "rig";
+    return Status::Ok();
+  }
+  if (rig.gravity_reference().empty()) return Status::Ok();
+  const std::string path =
+      (std::filesystem::path(rig_path).parent_path() / rig.gravity_reference()).string();
+  TILTCAL_RETURN_IF_ERROR(ReadTextProto(path, reference));
+  if (!reference->has_gravity_flat()) {
+    return Status::Error(path + ": the gravity reference named by " + rig_path +
+                         " has no gravity_flat_in_imu (was its sequence level?)");
+  }
+  *source = "reference " + rig.gravity_reference();
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status Run(const RunPaths& paths, const proto::GravityParams& params) {
+  GravityInputs inputs;
+  TILTCAL_RETURN_IF_ERROR(ReadImuReadings(paths.imu, &inputs.imu, &inputs.first_imu_stamp_ns));
+  if (!paths.ground.empty()) {
+    TILTCAL_RETURN_IF_ERROR(ReadAllRecords<proto::GroundPlane>(paths.ground, &inputs.ground));
+  }
+  TILTCAL_RETURN_IF_ERROR(ReadTextProto(paths.rig, &inputs.rig));
+  TILTCAL_RETURN_IF_ERROR(ReadDatasetReference(paths.rig, inputs.rig, &inputs.dataset_reference,
+                                               &inputs.dataset_reference_source));
+  proto::CalibrationResult calibration;
+  if (!paths.calibration.empty()) {
+    TILTCAL_RETURN_IF_ERROR(ReadTextProto(paths.calibration, &calibration));
+    inputs.flat_calibration = &calibration;
+  }
+
+  proto::GravityReference out;
+  TILTCAL_RETURN_IF_ERROR(EstimateGravityReference(inputs, params, &out));
+  std::vector<InputPath> input_paths = {{"imu", paths.imu}, {"rig", paths.rig}};
+  if (!paths.ground.empty()) input_paths.push_back({"ground", paths.ground});
+  if (!paths.calibration.empty()) input_paths.push_back({"calibration", paths.calibration});
+  *out.mutable_provenance() =
+      MakeProvenance("tiltcal_gravity", params, input_paths, paths.command_line);
+  TILTCAL_RETURN_IF_ERROR(WriteTextProto(paths.out, out));
+
+  std::fprintf(stderr, "tiltcal_gravity: %d static windows; %s: %s\n",
+               out.static_windows_size(), out.is_level() ? "level" : "tilted",
+               out.level_statistic().c_str());
+  if (out.has_gravity_flat()) {
+    const Eigen::Vector3d g_f = ToEigen(out.gravity_flat_in_imu());
+    std::fprintf(stderr, "tiltcal_gravity: g_f = (%.4f, %.4f, %.4f) m/s^2 from %s\n", g_f.x(),
+                 g_f.y(), g_f.z(), out.gravity_flat_source().c_str());
+  } else {
+    std::fprintf(stderr, "tiltcal_gravity: no g_f (tilted sequence and none in the rig)\n");
+  }
+  if (out.sources_disagreement_deg() > params.max_sources_disagreement_deg()) {
+    std::fprintf(stderr,
+                 "tiltcal_gravity: warning: g_f from the static windows and from the "
+                 "calibration disagree by %.3f deg\n",
+                 out.sources_disagreement_deg());
+  }
+  return Status::Ok();
+}
+
+}  // namespace tiltcal::gravity

@@ -1,0 +1,199 @@
+#include "stages/report/report.h"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include "common/geometry/euler_angles.h"
+#include "common/geometry/rotation_statistics.h"
+#include "common/geometry/so3.h"
+#include "common/io/atomic_file.h"
+#include "common/io/eigen_proto.h"
+#include "common/io/text_proto.h"
+
+namespace tiltcal::report {
+
+namespace {
+
+constexpr double kRadToDeg = 180.0 / M_PI;
+
+Row MakeRow(const std::string& label, const proto::Rigid3& imu_from_lidar, double time_offset_s) {
+  const Rigid3d extrinsic = ToEigen(imu_from_lidar);
+  Row row;
+  row.label = label;
+  row.translation_cm = 100.0 * extrinsic.translation;
+  row.euler123_deg =
+      kRadToDeg * geometry::Euler123FromRotation(extrinsic.rotation.toRotationMatrix());
+  row.time_offset_ms = 1e3 * time_offset_s;
+  return row;
+}
+
+void AddErrors(const proto::SimulationTruth& truth, const proto::CalibrationResult& estimate,
+               Row* row) {
+  const Rigid3d est = ToEigen(estimate.imu_from_lidar());
+  const Rigid3d tru = ToEigen(truth.imu_from_lidar());
+  row->has_errors = true;
+  row->rotation_error_deg =
+      kRadToDeg * geometry::LogMatrix((tru.rotation.conjugate() * est.rotation).toRotationMatrix())
+                      .norm();
+  row->translation_error_cm = 100.0 * (est.translation - tru.translation);
+  row->time_offset_error_ms = 1e3 * (estimate.time_offset_s() - truth.time_offset_s());
+}
+
+std::string Fixed(double value, int decimals) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), "%.*f", decimals, value);
+  return buffer;
+}
+
+std::string Pad(const std::string& text, size_t width) {
+  return text.size() >= width ? text + " " : std::string(width - text.size(), ' ') + text;
+}
+
+}  // namespace
+
+Repeatability ComputeRepeatability(const std::vector<SequenceResult>& results,
+                                   const proto::Rig* rig) {
+  Repeatability out;
+  std::vector<Eigen::Matrix3d> rotations;
+  std::vector<Eigen::Vector3d> translations, others, errors;
+  bool all_have_errors = !results.empty();
+  for (const SequenceResult& result : results) {
+    Row row = MakeRow(result.name, result.calibration.imu_from_lidar(),
+                      result.calibration.time_offset_s());
+    if (result.truth) AddErrors(*result.truth, result.calibration, &row);
+    all_have_errors = all_have_errors && row.has_errors;
+    rotations.push_back(ToEigen(result.calibration.imu_from_lidar()).rotation.toRotationMatrix());
+    translations.push_back(row.translation_cm);
+    others.push_back({row.time_offset_ms, row.rotation_error_deg, row.time_offset_error_ms});
+    errors.push_back(row.translation_error_cm);
+    out.sequences.push_back(row);
+  }
+  out.mean.label = "mean";
+  out.sigma.label = "sigma";
+  if (!results.empty()) {
+    const auto rotation = geometry::ComputeRotationStatistics(rotations);
+    const auto translation = geometry::ComputeVectorStatistics(translations);
+    const auto other = geometry::ComputeVectorStatistics(others);
+    const auto error = geometry::ComputeVectorStatistics(errors);
+    out.rotation_mean_converged = rotation.converged;
+    out.mean.euler123_deg = kRadToDeg * geometry::Euler123FromRotation(rotation.mean);
+    out.sigma.euler123_deg = kRadToDeg * rotation.sigma;
+    out.mean.translation_cm = translation.mean;
+    out.sigma.translation_cm = translation.sigma;
+    out.mean.time_offset_ms = other.mean.x();
+    out.sigma.time_offset_ms = other.sigma.x();
+    if (all_have_errors) {
+      out.mean.has_errors = out.sigma.has_errors = true;
+      out.mean.rotation_error_deg = other.mean.y();
+      out.sigma.rotation_error_deg = other.sigma.y();
+      out.mean.time_offset_error_ms = other.mean.z();
+      out.sigma.time_offset_error_ms = other.sigma.z();
+      out.mean.translation_error_cm = error.mean;
+      out.sigma.translation_error_cm = error.sigma;
+    }
+  }
+  if (rig != nullptr && HasValidRotation(rig->imu_from_lidar())) {
+    out.measured = MakeRow("measured", rig->imu_from_lidar(), 0.0);
+  }
+  return out;
+}
+
+std::string FormatTable(const Repeatability& r, const std::string& title) {
+  const bool errors = r.mean.has_errors ||
+                      std::any_of(r.sequences.begin(), r.sequences.end(),
+                                  [](const Row& row) { return row.has_errors; });
+  size_t label_width = 10;
+  for (const Row& row : r.sequences) label_width = std::max(label_width, row.label.size() + 2);
+  std::string out = title.empty() ? "" : title + "\n";
+  out += "extrinsic imu_from_lidar: r_b^{lb} in cm, C_bl as 1-2-3 Euler angles in deg "
+         "(sigma row: per-component sigma of the SO(3) deviations, deg); tau in ms\n";
+  std::string header = Pad("sequence", label_width) + Pad("r_x", 9) + Pad("r_y", 9) +
+                       Pad("r_z", 9) + Pad("C_1", 10) + Pad("C_2", 10) + Pad("C_3", 10) +
+                       Pad("tau", 9);
+  if (errors) {
+    header += "   |" + Pad("rot err", 9) + Pad("x err", 8) + Pad("y err", 8) + Pad("z err", 8) +
+              Pad("tau err", 9);
+  }
+  out += header + "\n" + std::string(header.size(), '-') + "\n";
+  auto line = [&](const Row& row) {
+    std::string text = Pad(row.label, label_width);
+    for (int i = 0; i < 3; ++i) text += Pad(Fixed(row.translation_cm[i], 2), 9);
+    for (int i = 0; i < 3; ++i) text += Pad(Fixed(row.euler123_deg[i], 3), 10);
+    text += Pad(Fixed(row.time_offset_ms, 3), 9);
+    if (errors && row.has_errors) {
+      text += "   |" + Pad(Fixed(row.rotation_error_deg, 3), 9);
+      for (int i = 0; i < 3; ++i) text += Pad(Fixed(row.translation_error_cm[i], 2), 8);
+      text += Pad(Fixed(row.time_offset_error_ms, 3), 9);
+    }
+    out += text + "\n";
+  };
+  for (const Row& row : r.sequences) line(row);
+  out += std::string(header.size(), '-') + "\n";
+  line(r.mean);
+  line(r.sigma);
+  if (r.measured) line(*r.measured);
+  if (!r.rotation_mean_converged) out += "warning: the SO(3) mean did not converge\n";
+  return out;
+}
+
+std::string FormatCsv(const Repeatability& r) {
+  std::string out =
+      "sequence,r_x_cm,r_y_cm,r_z_cm,euler_1_deg,euler_2_deg,euler_3_deg,time_offset_ms,"
+      "rotation_error_deg,error_x_cm,error_y_cm,error_z_cm,time_offset_error_ms\n";
+  auto line = [&](const Row& row) {
+    char buffer[512];
+    std::snprintf(buffer, sizeof(buffer), "%s,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g",
+                  row.label.c_str(), row.translation_cm.x(), row.translation_cm.y(),
+                  row.translation_cm.z(), row.euler123_deg.x(), row.euler123_deg.y(),
+                  row.euler123_deg.z(), row.time_offset_ms);
+    out += buffer;
+    if (row.has_errors) {
+      std::snprintf(buffer, sizeof(buffer), ",%.17g,%.17g,%.17g,%.17g,%.17g",
+                    row.rotation_error_deg, row.translation_error_cm.x(),
+                    row.translation_error_cm.y(), row.translation_error_cm.z(),
+                    row.time_offset_error_ms);
+      out += buffer;
+    } else {
+      out += ",,,,,";
+    }
+    out += "\n";
+  };
+  for (const Row& row : r.sequences) line(row);
+  line(r.mean);
+  line(r.sigma);
+  if (r.measured) line(*r.measured);
+  return out;
+}
+
+Status Run(const RunOptions& options, std::string* table) {
+  if (options.sequence_dirs.empty()) {
+    return Status::Error("no sequence directories given");
+  }
+  std::vector<SequenceResult> results;
+  for (const std::string& dir : options.sequence_dirs) {
+    SequenceResult result;
+    result.name = std::filesystem::path(dir).lexically_normal().filename().string();
+    if (result.name.empty()) {
+      result.name = std::filesystem::path(dir).lexically_normal().parent_path().filename();
+    }
+    TILTCAL_RETURN_IF_ERROR(ReadTextProto(dir + "/calibration.txtpb", &result.calibration));
+    if (std::filesystem::exists(dir + "/truth.txtpb")) {
+      result.truth.emplace();
+      TILTCAL_RETURN_IF_ERROR(ReadTextProto(dir + "/truth.txtpb", &*result.truth));
+    }
+    results.push_back(std::move(result));
+  }
+  proto::Rig rig;
+  if (!options.rig_path.empty()) TILTCAL_RETURN_IF_ERROR(ReadTextProto(options.rig_path, &rig));
+  const Repeatability repeatability =
+      ComputeRepeatability(results, options.rig_path.empty() ? nullptr : &rig);
+  *table = FormatTable(repeatability, options.title);
+  TILTCAL_RETURN_IF_ERROR(WriteFileAtomically(options.out_table_path, *table));
+  if (!options.out_csv_path.empty()) {
+    TILTCAL_RETURN_IF_ERROR(WriteFileAtomically(options.out_csv_path, FormatCsv(repeatability)));
+  }
+  return Status::Ok();
+}
+
+}  // namespace tiltcal::report

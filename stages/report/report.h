@@ -1,0 +1,68 @@
+#ifndef TILTCAL_STAGES_REPORT_REPORT_H_
+#define TILTCAL_STAGES_REPORT_REPORT_H_
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "common/status.h"
+#include "tiltcal/proto/calibration.pb.h"
+#include "tiltcal/proto/rig.pb.h"
+#include "tiltcal/proto/truth.pb.h"
+
+namespace tiltcal::report {
+
+// One calibrated sequence: out/<sequence>/calibration.txtpb and, for a
+// simulated sequence, the truth.txtpb beside it.
+struct SequenceResult {
+  std::string name;
+  proto::CalibrationResult calibration;
+  std::optional<proto::SimulationTruth> truth;
+};
+
+// One row of the table: the estimate, and its errors when the truth is known.
+struct Row {
+  std::string label;
+  Eigen::Vector3d translation_cm = Eigen::Vector3d::Zero();  // r_b^{lb}
+  Eigen::Vector3d euler123_deg = Eigen::Vector3d::Zero();    // C_bl, 1-2-3 Euler
+  double time_offset_ms = 0;                                 // τ
+  bool has_errors = false;
+  double rotation_error_deg = 0;                             // |Log(C_true^T C_est)|
+  Eigen::Vector3d translation_error_cm = Eigen::Vector3d::Zero();  // est − true
+  double time_offset_error_ms = 0;
+};
+
+// Repeatability over the sequences of a dataset, as the paper's Metrics
+// section: rotation mean on SO(3) (Manton), σ per component of the Lie
+// algebra deviations (deg); translation and τ mean and sample σ.
+struct Repeatability {
+  std::vector<Row> sequences;
+  Row mean;   // rotation: Euler of the SO(3) mean; errors: mean of the errors
+  Row sigma;  // euler123_deg holds σ of the deviations ξ (not an Euler triple)
+  std::optional<Row> measured;  // the rig's measured extrinsic
+  bool rotation_mean_converged = true;
+};
+
+Repeatability ComputeRepeatability(const std::vector<SequenceResult>& results,
+                                   const proto::Rig* rig);
+
+// Text table for people and CSV for scripts.
+std::string FormatTable(const Repeatability& repeatability, const std::string& title);
+std::string FormatCsv(const Repeatability& repeatability);
+
+// Reads <dir>/calibration.txtpb and <dir>/truth.txtpb (if present) for each
+// directory, computes the repeatability and writes the table and the CSV.
+struct RunOptions {
+  std::vector<std::string> sequence_dirs;
+  std::string rig_path;  // optional
+  std::string out_table_path;
+  std::string out_csv_path;  // optional
+  std::string title;
+};
+Status Run(const RunOptions& options, std::string* table);
+
+}  // namespace tiltcal::report
+
+#endif  // TILTCAL_STAGES_REPORT_REPORT_H_

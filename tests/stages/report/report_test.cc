@@ -1,0 +1,104 @@
+#include "stages/report/report.h"
+
+#include <cmath>
+#include <filesystem>
+
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+
+#include "common/geometry/euler_angles.h"
+#include "common/io/atomic_file.h"
+#include "common/io/eigen_proto.h"
+#include "common/io/text_proto.h"
+#include "tests/testing/test_env.h"
+
+namespace tiltcal::report {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+proto::Rigid3 Extrinsic(const Eigen::Vector3d& euler_deg, const Eigen::Vector3d& t_m) {
+  Rigid3d t;
+  t.rotation = Eigen::Quaterniond(geometry::RotationFromEuler123(euler_deg * kDeg));
+  t.translation = t_m;
+  return ToProto(t);
+}
+
+SequenceResult Sequence(const std::string& name, const Eigen::Vector3d& euler_deg,
+                        const Eigen::Vector3d& t_m, double tau_s) {
+  SequenceResult s;
+  s.name = name;
+  *s.calibration.mutable_imu_from_lidar() = Extrinsic(euler_deg, t_m);
+  s.calibration.set_time_offset_s(tau_s);
+  return s;
+}
+
+TEST(Repeatability, HandComputedMeansSigmasAndErrors) {
+  // Yaw 179, -179 and 180 deg: SO(3) mean 180 deg, deviations -1, +1, 0 deg
+  // about z -> σ_3 = sqrt((1 + 1 + 0) / 2) = 1 deg.
+  std::vector<SequenceResult> results = {
+      Sequence("a", {0, 0, 179}, {0.10, 0.20, 0.30}, 0.010),
+      Sequence("b", {0, 0, -179}, {0.12, 0.20, 0.34}, 0.012),
+      Sequence("c", {0, 0, 180}, {0.14, 0.20, 0.32}, 0.014),
+  };
+  proto::SimulationTruth truth;
+  *truth.mutable_imu_from_lidar() = Extrinsic({0, 0, 180}, {0.12, 0.21, 0.30});
+  truth.set_time_offset_s(0.011);
+  for (auto& r : results) r.truth = truth;
+
+  const Repeatability rep = ComputeRepeatability(results, nullptr);
+  ASSERT_EQ(rep.sequences.size(), 3u);
+  EXPECT_NEAR(std::abs(rep.mean.euler123_deg.z()), 180.0, 1e-9);
+  EXPECT_NEAR(rep.mean.euler123_deg.x(), 0.0, 1e-9);
+  EXPECT_NEAR(rep.sigma.euler123_deg.z(), 1.0, 1e-9);
+  EXPECT_NEAR(rep.sigma.euler123_deg.x(), 0.0, 1e-9);
+  // Translation mean (12, 20, 32) cm, sample σ (2, 0, 2) cm.
+  EXPECT_TRUE(rep.mean.translation_cm.isApprox(Eigen::Vector3d(12, 20, 32), 1e-12));
+  EXPECT_NEAR(rep.sigma.translation_cm.x(), 2.0, 1e-12);
+  EXPECT_NEAR(rep.sigma.translation_cm.y(), 0.0, 1e-12);
+  EXPECT_NEAR(rep.sigma.translation_cm.z(), 2.0, 1e-12);
+  // τ mean 12 ms, σ 2 ms.
+  EXPECT_NEAR(rep.mean.time_offset_ms, 12.0, 1e-12);
+  EXPECT_NEAR(rep.sigma.time_offset_ms, 2.0, 1e-12);
+  // Errors: rotation 1, 1, 0 deg; x error -2, 0, +2 cm; τ error -1, 1, 3 ms.
+  EXPECT_NEAR(rep.sequences[0].rotation_error_deg, 1.0, 1e-9);
+  EXPECT_NEAR(rep.sequences[2].rotation_error_deg, 0.0, 1e-9);
+  EXPECT_NEAR(rep.sequences[0].translation_error_cm.x(), -2.0, 1e-9);
+  EXPECT_NEAR(rep.sequences[1].translation_error_cm.z(), 4.0, 1e-9);
+  EXPECT_NEAR(rep.mean.rotation_error_deg, 2.0 / 3.0, 1e-9);
+  EXPECT_NEAR(rep.mean.time_offset_error_ms, 1.0, 1e-9);
+  EXPECT_NEAR(rep.sigma.time_offset_error_ms, 2.0, 1e-9);
+}
+
+TEST(Repeatability, RunWritesTableAndCsvAndFailsOnMissingResult) {
+  testing::TempDir dir;
+  for (const auto& [name, yaw] : {std::pair<std::string, double>{"seq1", 10.0}, {"seq2", 12.0}}) {
+    std::filesystem::create_directory(dir.File(name));
+    const SequenceResult s = Sequence(name, {180, 0, yaw}, {0.1, 0, 0.2}, 0.005);
+    ASSERT_TRUE(WriteTextProto(dir.File(name + "/calibration.txtpb"), s.calibration).ok());
+  }
+  RunOptions options;
+  options.sequence_dirs = {dir.File("seq1"), dir.File("seq2/")};
+  options.out_table_path = dir.File("repeatability.txt");
+  options.out_csv_path = dir.File("repeatability.csv");
+  std::string table;
+  const Status status = report::Run(options, &table);
+  ASSERT_TRUE(status.ok()) << status.message();
+  EXPECT_NE(table.find("seq1"), std::string::npos) << table;
+  EXPECT_NE(table.find("seq2"), std::string::npos) << table;
+  EXPECT_EQ(table.find("rot err"), std::string::npos) << "no truth, no error columns";
+  std::string csv;
+  ASSERT_TRUE(ReadFileToString(dir.File("repeatability.csv"), &csv).ok());
+  EXPECT_NE(csv.find("\nmean,10,0,20,180,"), std::string::npos) << csv;
+  EXPECT_NE(csv.find(",11,"), std::string::npos) << csv;  // mean yaw 11 deg
+
+  options.sequence_dirs.push_back(dir.File("missing"));
+  options.out_table_path = dir.File("other.txt");
+  const Status missing = report::Run(options, &table);
+  ASSERT_FALSE(missing.ok());
+  EXPECT_NE(missing.message().find("missing/calibration.txtpb"), std::string::npos);
+  EXPECT_FALSE(testing::FileExists(dir.File("other.txt")));
+}
+
+}  // namespace
+}  // namespace tiltcal::report
