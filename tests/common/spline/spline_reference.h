@@ -115,6 +115,29 @@ ReferenceSo3Sample<T> ReferenceSo3(const Eigen::Quaternion<T> knots_in[4], const
   return out;
 }
 
+// The same quantities by the Sommer et al. recursion (the formula the
+// analytic code differentiates), on Jets: the benchmark's autodiff anchor, so
+// that "analytic vs autodiff" compares the same mathematics.
+template <typename T>
+ReferenceSo3Sample<T> SommerSo3(const Eigen::Quaternion<T> knots[4], const T& u, double inv_dt) {
+  const ReferenceBasis<T> basis = MakeReferenceBasis(u, inv_dt);
+  ReferenceSo3Sample<T> out;
+  out.q = knots[0].normalized();
+  out.omega.setZero();
+  out.alpha.setZero();
+  for (int j = 1; j < 4; ++j) {
+    const Eigen::Matrix<T, 3, 1> d =
+        geometry::LogQuaternion(Eigen::Quaternion<T>(knots[j - 1].conjugate() * knots[j]));
+    const Eigen::Quaternion<T> e = geometry::ExpQuaternion(Eigen::Matrix<T, 3, 1>(basis.lambda[j] * d));
+    out.q = out.q * e;
+    const Eigen::Matrix<T, 3, 1> vd = basis.lambda_d1[j] * d;
+    const Eigen::Quaternion<T> e_inv = e.conjugate();
+    out.omega = e_inv * out.omega + vd;
+    out.alpha = e_inv * out.alpha + basis.lambda_d2[j] * d + out.omega.cross(vd);
+  }
+  return out;
+}
+
 template <typename T>
 struct ReferenceR3Sample {
   Eigen::Matrix<T, 3, 1> position, velocity, acceleration;

@@ -159,6 +159,11 @@ TEST(So3SplineTest, MatchesProductRuleReference) {
         EXPECT_LT((s.rotation - ref.q.toRotationMatrix()).norm(), 1e-13);
         EXPECT_LT((s.angular_velocity - ref.omega).norm(), 1e-12 * (1.0 + ref.omega.norm()));
         EXPECT_LT((s.angular_acceleration - ref.alpha).norm(), 1e-11 * (1.0 + ref.alpha.norm()));
+        // The Jet Sommer recursion (benchmark anchor) agrees as well.
+        const auto sommer = testing::SommerSo3<double>(k.q, u, 1.0 / dt);
+        EXPECT_LT((sommer.q.toRotationMatrix() - ref.q.toRotationMatrix()).norm(), 1e-13);
+        EXPECT_LT((sommer.omega - ref.omega).norm(), 1e-12 * (1.0 + ref.omega.norm()));
+        EXPECT_LT((sommer.alpha - ref.alpha).norm(), 1e-11 * (1.0 + ref.alpha.norm()));
         R3SplineSample p;
         EvaluateR3Spline(k.p_ptr, u, 1.0 / dt, &p);
         const auto ref_p = testing::ReferenceR3<double>(k.p, u, 1.0 / dt);

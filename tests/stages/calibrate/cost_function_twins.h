@@ -3,8 +3,11 @@
 
 // Autodiff twins of the analytic residuals in stages/calibrate, for tests and
 // the benchmark anchor ONLY (never used in production). They evaluate the
-// same formulas through the independent templated reference spline
-// (tests/common/spline/spline_reference.h) on ceres::Jet. Parameter blocks,
+// same formulas through the templated reference spline
+// (tests/common/spline/spline_reference.h) on ceres::Jet: kSommer = false
+// (the aliases GyroTwin, AccelTwin, PointToPlaneTwin used by the tests) takes
+// the independent quaternion product-rule derivatives; kSommer = true (the
+// benchmark anchor) the Sommer recursion, i.e. the analytic code's formulas. Parameter blocks,
 // order and storage are identical to the analytic cost functions; quaternions
 // are (x, y, z, w) with the right-perturbation manifold.
 
@@ -16,6 +19,15 @@
 #include "tests/common/spline/spline_reference.h"
 
 namespace tiltcal::testing {
+
+template <bool kSommer, typename T>
+ReferenceSo3Sample<T> EvaluateSo3(const Eigen::Quaternion<T> knots[4], const T& u, double inv_dt) {
+  if constexpr (kSommer) {
+    return SommerSo3<T>(knots, u, inv_dt);
+  } else {
+    return ReferenceSo3<T>(knots, u, inv_dt);
+  }
+}
 
 template <typename T>
 void LoadQuaternions(const T* const q0, const T* const q1, const T* const q2, const T* const q3,
@@ -32,7 +44,8 @@ void LoadVectors(const T* const p0, const T* const p1, const T* const p2, const 
 }
 
 // r = (omega_b(t) + b_g - omega_m) / sigma.
-struct GyroTwin {
+template <bool kSommer>
+struct GyroTwinT {
   double u, inv_dt, sigma;
   Eigen::Vector3d measured;
   template <typename T>
@@ -40,15 +53,16 @@ struct GyroTwin {
                   const T* const bias, T* residual) const {
     Eigen::Quaternion<T> q[4];
     LoadQuaternions(q0, q1, q2, q3, q);
-    const auto s = ReferenceSo3<T>(q, T(u), inv_dt);
+    const auto s = EvaluateSo3<kSommer>(q, T(u), inv_dt);
     for (int r = 0; r < 3; ++r) residual[r] = (s.omega[r] + bias[r] - T(measured[r])) / sigma;
     return true;
   }
-  using AutoDiff = ceres::AutoDiffCostFunction<GyroTwin, 3, 4, 4, 4, 4, 3>;
+  using AutoDiff = ceres::AutoDiffCostFunction<GyroTwinT, 3, 4, 4, 4, 4, 3>;
 };
 
 // r = (C^T (p'' - g_norm n_g) + b_a - f_m) / sigma.
-struct AccelTwin {
+template <bool kSommer>
+struct AccelTwinT {
   double u, inv_dt, sigma, gravity_norm;
   Eigen::Vector3d measured;
   template <typename T>
@@ -59,19 +73,20 @@ struct AccelTwin {
     Eigen::Matrix<T, 3, 1> p[4];
     LoadQuaternions(q0, q1, q2, q3, q);
     LoadVectors(p0, p1, p2, p3, p);
-    const auto s = ReferenceSo3<T>(q, T(u), inv_dt);
+    const auto s = EvaluateSo3<kSommer>(q, T(u), inv_dt);
     const auto ps = ReferenceR3<T>(p, T(u), inv_dt);
     const Eigen::Matrix<T, 3, 1> g = Eigen::Map<const Eigen::Matrix<T, 3, 1>>(gravity_dir) * T(gravity_norm);
     const Eigen::Matrix<T, 3, 1> f = s.q.conjugate() * (ps.acceleration - g);
     for (int r = 0; r < 3; ++r) residual[r] = (f[r] + bias[r] - T(measured[r])) / sigma;
     return true;
   }
-  using AutoDiff = ceres::AutoDiffCostFunction<AccelTwin, 3, 4, 4, 4, 4, 3, 3, 3, 3, 3, 3>;
+  using AutoDiff = ceres::AutoDiffCostFunction<AccelTwinT, 3, 4, 4, 4, 4, 3, 3, 3, 3, 3, 3>;
 };
 
 // p_a = C(t_j + tau) (C_bl p_l + r_b) + r_a(t_j + tau), frozen segment,
 // r = (n^T p_a + d) / sigma.
-struct PointToPlaneTwin {
+template <bool kSommer>
+struct PointToPlaneTwinT {
   double time_in_segment_s, inv_dt, sigma, offset;
   Eigen::Vector3d point, normal;
   template <typename T>
@@ -84,7 +99,7 @@ struct PointToPlaneTwin {
     LoadQuaternions(q0, q1, q2, q3, q);
     LoadVectors(p0, p1, p2, p3, p);
     const T u = (T(time_in_segment_s) + tau[0]) * inv_dt;
-    const auto s = ReferenceSo3<T>(q, u, inv_dt);
+    const auto s = EvaluateSo3<kSommer>(q, u, inv_dt);
     const auto ps = ReferenceR3<T>(p, u, inv_dt);
     const Eigen::Quaternion<T> q_bl = Eigen::Map<const Eigen::Quaternion<T>>(q_bl_ptr).normalized();
     const Eigen::Matrix<T, 3, 1> x_b =
@@ -93,8 +108,12 @@ struct PointToPlaneTwin {
     residual[0] = (normal.cast<T>().dot(p_a) + T(offset)) / sigma;
     return true;
   }
-  using AutoDiff = ceres::AutoDiffCostFunction<PointToPlaneTwin, 1, 4, 4, 4, 4, 3, 3, 3, 3, 4, 3, 1>;
+  using AutoDiff = ceres::AutoDiffCostFunction<PointToPlaneTwinT, 1, 4, 4, 4, 4, 3, 3, 3, 3, 4, 3, 1>;
 };
+
+using GyroTwin = GyroTwinT<false>;
+using AccelTwin = AccelTwinT<false>;
+using PointToPlaneTwin = PointToPlaneTwinT<false>;
 
 }  // namespace tiltcal::testing
 

@@ -199,6 +199,7 @@ TEST(GyroCostFunctionTest, MatchesAutodiffTwinAndNumericDifferences) {
       const double sigma = 0.01;
       GyroCostFunction analytic(spline::KnotWindow{0, u}, 1.0 / dt, measured, sigma);
       testing::GyroTwin::AutoDiff twin(new testing::GyroTwin{u, 1.0 / dt, sigma, measured});
+      testing::GyroTwinT<true>::AutoDiff sommer(new testing::GyroTwinT<true>{u, 1.0 / dt, sigma, measured});
       std::vector<double*> params = {s.q[0].coeffs().data(), s.q[1].coeffs().data(),
                                      s.q[2].coeffs().data(), s.q[3].coeffs().data(),
                                      s.gyro_bias.data()};
@@ -206,6 +207,7 @@ TEST(GyroCostFunctionTest, MatchesAutodiffTwinAndNumericDifferences) {
                                          Block::kQuaternion, Block::kEuclidean};
       const std::string label = "dt " + std::to_string(dt) + " u " + std::to_string(u);
       ExpectSameLocalJacobians(analytic, twin, params, blocks, 1e-9, label);
+      ExpectSameLocalJacobians(analytic, sommer, params, blocks, 1e-9, label + " sommer");
       ExpectGradientCheckerPasses(analytic, params, blocks, label);
       ExpectTangentFiniteDifferencesMatch(analytic, params, blocks, label);
     }
@@ -221,6 +223,7 @@ TEST(AccelCostFunctionTest, MatchesAutodiffTwinAndNumericDifferences) {
       const double sigma = 0.05, g = 9.81;
       AccelCostFunction analytic(spline::KnotWindow{0, u}, 1.0 / dt, measured, sigma, g);
       testing::AccelTwin::AutoDiff twin(new testing::AccelTwin{u, 1.0 / dt, sigma, g, measured});
+      testing::AccelTwinT<true>::AutoDiff sommer(new testing::AccelTwinT<true>{u, 1.0 / dt, sigma, g, measured});
       std::vector<double*> params = {
           s.q[0].coeffs().data(), s.q[1].coeffs().data(), s.q[2].coeffs().data(),
           s.q[3].coeffs().data(), s.p[0].data(),          s.p[1].data(),
@@ -232,6 +235,7 @@ TEST(AccelCostFunctionTest, MatchesAutodiffTwinAndNumericDifferences) {
                                          Block::kEuclidean};
       const std::string label = "dt " + std::to_string(dt) + " u " + std::to_string(u);
       ExpectSameLocalJacobians(analytic, twin, params, blocks, 1e-9, label);
+      ExpectSameLocalJacobians(analytic, sommer, params, blocks, 1e-9, label + " sommer");
       ExpectGradientCheckerPasses(analytic, params, blocks, label);
       ExpectTangentFiniteDifferencesMatch(analytic, params, blocks, label);
     }
@@ -269,9 +273,12 @@ TEST(PointToPlaneCostFunctionTest, MatchesAutodiffTwinAndNumericDifferences) {
       EXPECT_NEAR(analytic.NormalizedTime(s.tau), u, 1e-9);
       testing::PointToPlaneTwin::AutoDiff twin(new testing::PointToPlaneTwin{
           point_time - segment_start, 1.0 / dt, sigma, offset, point, normal});
+      testing::PointToPlaneTwinT<true>::AutoDiff sommer(new testing::PointToPlaneTwinT<true>{
+          point_time - segment_start, 1.0 / dt, sigma, offset, point, normal});
       const std::vector<double*> params = PlaneParams(&s, 0);
       const std::string label = "dt " + std::to_string(dt) + " u " + std::to_string(u);
       ExpectSameLocalJacobians(analytic, twin, params, kPlaneBlocks, 1e-9, label);
+      ExpectSameLocalJacobians(analytic, sommer, params, kPlaneBlocks, 1e-9, label + " sommer");
       // Not ceres::GradientChecker here: in Ceres 2.1.0 its numeric Jacobian of
       // a size-1 parameter block (tau) is wrong even for r = sin(50 t) (it
       // reports ~8.5 instead of 50), so the tangent-space central differences

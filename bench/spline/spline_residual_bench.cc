@@ -1,0 +1,225 @@
+// Micro-benchmark of the calibrator's spline residuals: evaluations per
+// second of each analytic cost function with all Jacobians, against
+// fixed-size ceres::AutoDiffCostFunction twins measured in the same run
+// (tests/stages/calibrate/cost_function_twins.h):
+//   anchor     = autodiff of the same Sommer-recursion formulas (what a
+//                careful Ceres-autodiff implementation would run);
+//   prod-rule  = autodiff of the quaternion product-rule derivatives
+//                (Lovegrove-style, as in Kontiki / LI-Calib).
+// Times are CPU time per evaluation (the machine is shared; wall time is
+// noisy). Prints the autodiff / analytic ratios per residual, and the
+// Jacobian-evaluation time one LM iteration of the target problem (60 s,
+// 200 Hz IMU, 20k point-to-plane residuals) would spend in these cost
+// functions alone.
+//
+// Run: build/bench/spline/spline_residual_bench [--benchmark_min_time=0.2]
+
+#include <cstdio>
+#include <map>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <benchmark/benchmark.h>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "common/geometry/so3.h"
+#include "stages/calibrate/accel_cost_function.h"
+#include "stages/calibrate/gyro_cost_function.h"
+#include "stages/calibrate/point_to_plane_cost_function.h"
+#include "tests/stages/calibrate/cost_function_twins.h"
+
+namespace tiltcal {
+namespace {
+
+constexpr double kDt = 0.05;
+constexpr int kNumCosts = 64;  // cost functions at different u, cycled
+
+// Parameter blocks of one window: a vehicle-like motion (~1 rad/s, ~3 m/s).
+struct State {
+  Eigen::Quaterniond q[4];
+  Eigen::Vector3d p[4];
+  Eigen::Vector3d gyro_bias{0.001, -0.002, 0.0005};
+  Eigen::Vector3d accel_bias{0.02, 0.01, -0.03};
+  Eigen::Vector3d gravity_dir{0.01, -0.02, -1.0};
+  Eigen::Quaterniond q_bl;
+  Eigen::Vector3d r_b_lb{0.1, -0.05, 0.3};
+  double tau = 0.002;
+
+  State() {
+    std::mt19937 rng(1);
+    std::normal_distribution<double> n(0.0, 1.0);
+    q[0] = geometry::ExpQuaternion(Eigen::Vector3d(0.1, -0.2, 0.8));
+    p[0] = Eigen::Vector3d(3.0, -1.0, 0.2);
+    for (int i = 1; i < 4; ++i) {
+      q[i] = q[i - 1] * geometry::ExpQuaternion(Eigen::Vector3d(kDt * Eigen::Vector3d(0.2 * n(rng), 0.2 * n(rng), 1.0)));
+      p[i] = p[i - 1] + kDt * Eigen::Vector3d(3.0 + 0.3 * n(rng), 0.3 * n(rng), 0.05 * n(rng));
+    }
+    gravity_dir.normalize();
+    q_bl = geometry::ExpQuaternion(Eigen::Vector3d(0.02, -0.01, 1.57));
+  }
+
+  std::vector<double*> Gyro() {
+    return {q[0].coeffs().data(), q[1].coeffs().data(), q[2].coeffs().data(), q[3].coeffs().data(),
+            gyro_bias.data()};
+  }
+  std::vector<double*> Accel() {
+    return {q[0].coeffs().data(), q[1].coeffs().data(), q[2].coeffs().data(), q[3].coeffs().data(),
+            p[0].data(), p[1].data(), p[2].data(), p[3].data(), gravity_dir.data(), accel_bias.data()};
+  }
+  std::vector<double*> Plane() {
+    return {q[0].coeffs().data(), q[1].coeffs().data(), q[2].coeffs().data(), q[3].coeffs().data(),
+            p[0].data(), p[1].data(), p[2].data(), p[3].data(), q_bl.coeffs().data(), r_b_lb.data(),
+            &tau};
+  }
+};
+
+double U(int k) { return (k + 0.5) / kNumCosts; }
+
+enum Variant { kAnalytic, kSommerAutoDiff, kProductRuleAutoDiff };
+
+std::vector<std::unique_ptr<ceres::CostFunction>> MakeGyro(int variant) {
+  std::vector<std::unique_ptr<ceres::CostFunction>> out;
+  const Eigen::Vector3d m(0.1, 0.2, 1.0);
+  for (int k = 0; k < kNumCosts; ++k) {
+    if (variant == kAnalytic) {
+      out.emplace_back(new calibrate::GyroCostFunction(spline::KnotWindow{0, U(k)}, 1 / kDt, m, 0.01));
+    } else if (variant == kSommerAutoDiff) {
+      using F = testing::GyroTwinT<true>;
+      out.emplace_back(new F::AutoDiff(new F{U(k), 1 / kDt, 0.01, m}));
+    } else {
+      using F = testing::GyroTwinT<false>;
+      out.emplace_back(new F::AutoDiff(new F{U(k), 1 / kDt, 0.01, m}));
+    }
+  }
+  return out;
+}
+
+std::vector<std::unique_ptr<ceres::CostFunction>> MakeAccel(int variant) {
+  std::vector<std::unique_ptr<ceres::CostFunction>> out;
+  const Eigen::Vector3d m(0.3, -0.1, 9.8);
+  for (int k = 0; k < kNumCosts; ++k) {
+    if (variant == kAnalytic) {
+      out.emplace_back(new calibrate::AccelCostFunction(spline::KnotWindow{0, U(k)}, 1 / kDt, m, 0.05, 9.81));
+    } else if (variant == kSommerAutoDiff) {
+      using F = testing::AccelTwinT<true>;
+      out.emplace_back(new F::AutoDiff(new F{U(k), 1 / kDt, 0.05, 9.81, m}));
+    } else {
+      using F = testing::AccelTwinT<false>;
+      out.emplace_back(new F::AutoDiff(new F{U(k), 1 / kDt, 0.05, 9.81, m}));
+    }
+  }
+  return out;
+}
+
+std::vector<std::unique_ptr<ceres::CostFunction>> MakePlane(int variant) {
+  std::vector<std::unique_ptr<ceres::CostFunction>> out;
+  const Eigen::Vector3d point(7.0, 2.0, -0.8);
+  const Eigen::Vector3d normal = Eigen::Vector3d(0.1, 0.2, 0.97).normalized();
+  for (int k = 0; k < kNumCosts; ++k) {
+    const double t = U(k) * kDt - 0.002;  // segment start 0, tau = 0.002
+    if (variant == kAnalytic) {
+      out.emplace_back(new calibrate::PointToPlaneCostFunction(0.0, 1 / kDt, t, point, normal, 0.4, 0.05));
+    } else if (variant == kSommerAutoDiff) {
+      using F = testing::PointToPlaneTwinT<true>;
+      out.emplace_back(new F::AutoDiff(new F{t, 1 / kDt, 0.05, 0.4, point, normal}));
+    } else {
+      using F = testing::PointToPlaneTwinT<false>;
+      out.emplace_back(new F::AutoDiff(new F{t, 1 / kDt, 0.05, 0.4, point, normal}));
+    }
+  }
+  return out;
+}
+
+void RunEvaluate(benchmark::State& bm, std::vector<std::unique_ptr<ceres::CostFunction>> costs,
+                 std::vector<double*> params) {
+  const ceres::CostFunction& first = *costs.front();
+  std::vector<std::vector<double>> jac_storage;
+  std::vector<double*> jacobians;
+  for (int size : first.parameter_block_sizes()) {
+    jac_storage.emplace_back(size * first.num_residuals());
+  }
+  for (auto& j : jac_storage) jacobians.push_back(j.data());
+  std::vector<double> residuals(first.num_residuals());
+  int k = 0;
+  for (auto _ : bm) {
+    costs[k]->Evaluate(params.data(), residuals.data(), jacobians.data());
+    benchmark::DoNotOptimize(residuals.data());
+    benchmark::DoNotOptimize(jacobians.front());
+    benchmark::ClobberMemory();
+    k = (k + 1) % kNumCosts;
+  }
+  bm.SetItemsProcessed(bm.iterations());
+}
+
+State g_state;
+
+void BM_Gyro(benchmark::State& bm) { RunEvaluate(bm, MakeGyro(bm.range(0)), g_state.Gyro()); }
+void BM_Accel(benchmark::State& bm) { RunEvaluate(bm, MakeAccel(bm.range(0)), g_state.Accel()); }
+void BM_PointToPlane(benchmark::State& bm) { RunEvaluate(bm, MakePlane(bm.range(0)), g_state.Plane()); }
+
+// Argument: 0 analytic, 1 autodiff (Sommer, the anchor), 2 autodiff (product rule).
+BENCHMARK(BM_Gyro)->Arg(kAnalytic)->Arg(kSommerAutoDiff)->Arg(kProductRuleAutoDiff)->Unit(benchmark::kNanosecond);
+BENCHMARK(BM_Accel)->Arg(kAnalytic)->Arg(kSommerAutoDiff)->Arg(kProductRuleAutoDiff)->Unit(benchmark::kNanosecond);
+BENCHMARK(BM_PointToPlane)->Arg(kAnalytic)->Arg(kSommerAutoDiff)->Arg(kProductRuleAutoDiff)->Unit(benchmark::kNanosecond);
+
+// Console output plus a record of each run's time per iteration (ns).
+class RatioReporter : public benchmark::ConsoleReporter {
+ public:
+  void ReportRuns(const std::vector<Run>& runs) override {
+    ConsoleReporter::ReportRuns(runs);
+    for (const Run& run : runs) {
+      if (run.run_type == Run::RT_Iteration) ns_[run.benchmark_name()] = run.GetAdjustedCPUTime();
+    }
+  }
+  double Ns(const std::string& name) const {
+    const auto it = ns_.find(name);
+    return it == ns_.end() ? 0.0 : it->second;
+  }
+
+ private:
+  std::map<std::string, double> ns_;
+};
+
+}  // namespace
+}  // namespace tiltcal
+
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  tiltcal::RatioReporter reporter;
+  benchmark::RunSpecifiedBenchmarks(&reporter);
+
+  std::printf("\nCPU ns per evaluation with all Jacobians (dt %.2f s)\n", tiltcal::kDt);
+  std::printf("residual         analytic  autodiff(anchor)  autodiff(prod-rule)  anchor/analytic  prod-rule/analytic\n");
+  struct Row {
+    const char* label;
+    const char* name;
+    double count;  // blocks per LM iteration in the target problem
+  };
+  const Row rows[] = {{"gyro", "BM_Gyro", 12000}, {"accel", "BM_Accel", 12000},
+                      {"point_to_plane", "BM_PointToPlane", 20000}};
+  double analytic_s = 0.0, anchor_s = 0.0;
+  for (const Row& row : rows) {
+    const std::string base(row.name);
+    const double a = reporter.Ns(base + "/0");
+    const double d = reporter.Ns(base + "/1");
+    const double p = reporter.Ns(base + "/2");
+    if (a <= 0.0 || d <= 0.0 || p <= 0.0) continue;  // filtered out
+    std::printf("%-15s %9.0f  %16.0f  %19.0f  %15.1f  %18.1f\n", row.label, a, d, p, d / a, p / a);
+    analytic_s += row.count * a * 1e-9;
+    anchor_s += row.count * d * 1e-9;
+  }
+  if (analytic_s > 0.0) {
+    std::printf(
+        "\nJacobian evaluation per LM iteration, 60 s @ 200 Hz (12k gyro + 12k accel) + 20k planes,\n"
+        "cost functions only (no Ceres block overhead, no J^T J, no factorisation), 1 thread:\n"
+        "  analytic %.3f s   autodiff anchor %.3f s   (budget for the whole iteration: 0.25 s)\n",
+        analytic_s, anchor_s);
+  }
+  benchmark::Shutdown();
+  return 0;
+}
