@@ -7,11 +7,22 @@
 
 namespace tiltcal::geometry {
 
+Eigen::Matrix3d RotX(double a) {
+  return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitX()).toRotationMatrix();
+}
+Eigen::Matrix3d RotY(double a) {
+  return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitY()).toRotationMatrix();
+}
+Eigen::Matrix3d RotZ(double a) {
+  return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+}
+
 Eigen::Matrix3d RotationFromEuler123(const Eigen::Vector3d& angles_rad) {
-  return (Eigen::AngleAxisd(angles_rad.z(), Eigen::Vector3d::UnitZ()) *
-          Eigen::AngleAxisd(angles_rad.y(), Eigen::Vector3d::UnitY()) *
-          Eigen::AngleAxisd(angles_rad.x(), Eigen::Vector3d::UnitX()))
-      .toRotationMatrix();
+  return RotZ(angles_rad.z()) * RotY(angles_rad.y()) * RotX(angles_rad.x());
+}
+
+Eigen::Matrix3d RotationFromEuler123Deg(const Eigen::Vector3d& angles_deg) {
+  return RotationFromEuler123(angles_deg * (M_PI / 180.0));
 }
 
 Eigen::Vector3d Euler123FromRotation(const Eigen::Matrix3d& c) {

@@ -13,6 +13,13 @@ namespace tiltcal::geometry {
 // in (-π, π]. At θ2 = ±π/2 (gimbal lock) θ1 is set to 0.
 Eigen::Matrix3d RotationFromEuler123(const Eigen::Vector3d& angles_rad);
 Eigen::Vector3d Euler123FromRotation(const Eigen::Matrix3d& rotation);
+// The same with angles in degrees (rig presets and params are in degrees).
+Eigen::Matrix3d RotationFromEuler123Deg(const Eigen::Vector3d& angles_deg);
+
+// Active rotations about the x, y and z axes by `angle_rad`.
+Eigen::Matrix3d RotX(double angle_rad);
+Eigen::Matrix3d RotY(double angle_rad);
+Eigen::Matrix3d RotZ(double angle_rad);
 
 }  // namespace tiltcal::geometry
 

@@ -10,7 +10,7 @@
 
 #include "common/io/provenance.h"
 #include "common/io/text_proto.h"
-#include "stages/simulate/euler_angles.h"
+#include "common/geometry/euler_angles.h"
 #include "stages/simulate/point_cloud_layout.h"
 #include "stages/simulate/random.h"
 #include "stages/simulate/ros1_bag_writer.h"
@@ -129,7 +129,7 @@ Status BuildScenario(const proto::SimulateParams& params, Scenario* scenario) {
   tc.ground_roll_rad = params.ground_roll_deg() * kDegToRad;
   tc.ground_pitch_rad = params.ground_pitch_deg() * kDegToRad;
   tc.imu_height_m = rig.imu_height_m();
-  tc.vehicle_from_imu = RotationFromEulerDeg(ToEigen(rig.imu_rotation_in_vehicle_deg()));
+  tc.vehicle_from_imu = geometry::RotationFromEuler123Deg(ToEigen(rig.imu_rotation_in_vehicle_deg()));
   if ((tc.vibration_roll_rad > 0 || tc.vibration_pitch_rad > 0) &&
       tc.vibration_frequency_hz <= 0) {
     return Status::Error("field trajectory.vibration_frequency_hz must be > 0 with a vibration");
@@ -172,7 +172,7 @@ Status BuildScenario(const proto::SimulateParams& params, Scenario* scenario) {
   sc.range_noise_m = lp.range_noise_m();
   sc.velodyne_stamp_at_start = lp.velodyne_stamp_at_start();
   sc.first_scan_time_s = lp.first_scan_time_s();
-  sc.imu_from_lidar_rotation = RotationFromEulerDeg(ToEigen(rig.lidar_rotation_in_imu_deg()));
+  sc.imu_from_lidar_rotation = geometry::RotationFromEuler123Deg(ToEigen(rig.lidar_rotation_in_imu_deg()));
   sc.imu_from_lidar_translation = ToEigen(rig.lidar_translation_in_imu_m());
 
   // The LiDAR must be above the ground (checked at the start pose).
@@ -298,7 +298,7 @@ Status Run(const proto::SimulateParams& params, const SimulateOutputs& outputs,
   const Eigen::Matrix3d c_aw = c_wb0.transpose();
   const Eigen::Vector3d n_w = trajectory.NormalInWorld();
   const Eigen::Vector3d up_w = Eigen::Vector3d::UnitZ();
-  const Eigen::Matrix3d c_vb = RotationFromEulerDeg(ToEigen(params.rig().imu_rotation_in_vehicle_deg()));
+  const Eigen::Matrix3d c_vb = geometry::RotationFromEuler123Deg(ToEigen(params.rig().imu_rotation_in_vehicle_deg()));
   const Eigen::Vector3d g_f = c_vb.transpose() * scenario.gravity_w;
   const Eigen::Vector3d up_f = -g_f.normalized();
   const Eigen::Matrix3d& c_bl = sc.imu_from_lidar_rotation;
@@ -403,7 +403,7 @@ Status Run(const proto::SimulateParams& params, const SimulateOutputs& outputs,
   if (!outputs.rig_path.empty()) {
     const auto& rf = params.rig_file();
     proto::Rig rig;
-    SetRigid(c_bl * RotationFromEulerDeg(ToEigen(rf.rotation_error_deg())),
+    SetRigid(c_bl * geometry::RotationFromEuler123Deg(ToEigen(rf.rotation_error_deg())),
              r_bl + ToEigen(rf.translation_error_m()), rig.mutable_imu_from_lidar());
     rig.set_imu_height_m(params.rig().imu_height_m());
     rig.set_imu_topic(ip.topic());

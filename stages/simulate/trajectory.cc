@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "stages/simulate/euler_angles.h"
+#include "common/geometry/euler_angles.h"
 
 namespace tiltcal::simulate {
 
@@ -14,7 +14,7 @@ constexpr double kPitchFrequencyRatio = 1.37;
 }  // namespace
 
 PlanarTrajectory::PlanarTrajectory(const TrajectoryConfig& config) : config_(config) {
-  world_from_plane_ = RotY(config.ground_pitch_rad) * RotX(config.ground_roll_rad);
+  world_from_plane_ = geometry::RotY(config.ground_pitch_rad) * geometry::RotX(config.ground_roll_rad);
   const double c = std::cos(config.heading_rad), s = std::sin(config.heading_rad);
   heading_rotation_ << c, -s, s, c;
   MeasurePath();
@@ -127,9 +127,9 @@ ImuState PlanarTrajectory::Evaluate(double t) const {
   const double dvt = config_.vibration_pitch_rad *
                      (ddsigma * std::sin(w2 * t + 1.0) + dsigma * w2 * std::cos(w2 * t + 1.0));
 
-  const Eigen::Matrix3d rx = RotX(phi), ry = RotY(vt);
+  const Eigen::Matrix3d rx = geometry::RotX(phi), ry = geometry::RotY(vt);
   const Eigen::Matrix3d vib = rx * ry;
-  state.world_from_imu = world_from_plane_ * RotZ(psi) * vib * config_.vehicle_from_imu;
+  state.world_from_imu = world_from_plane_ * geometry::RotZ(psi) * vib * config_.vehicle_from_imu;
   // Body rates: C = A B ⇒ ω(C) = B^T ω(A) + ω(B), for Rz(ψ) · Rx(φ) · Ry(ϑ).
   const Eigen::Vector3d omega_v = vib.transpose() * Eigen::Vector3d(0.0, 0.0, dpsi) +
                                   ry.transpose() * Eigen::Vector3d(dphi, 0.0, 0.0) +
@@ -147,13 +147,13 @@ void PlanarTrajectory::Pose(double t, Eigen::Matrix3d* world_from_imu,
   Path(theta, &p, &dp, &ddp);
   *position_w = world_from_plane_ * Eigen::Vector3d(p.x(), p.y(), config_.imu_height_m);
   const double psi = std::atan2(dp.y(), dp.x());
-  Eigen::Matrix3d r = world_from_plane_ * RotZ(psi);
+  Eigen::Matrix3d r = world_from_plane_ * geometry::RotZ(psi);
   if (config_.vibration_roll_rad != 0.0 || config_.vibration_pitch_rad != 0.0) {
     const double w1 = kTwoPi * config_.vibration_frequency_hz;
     const double w2 = w1 * kPitchFrequencyRatio;
     const double phi = config_.vibration_roll_rad * dsigma * std::sin(w1 * t);
     const double vt = config_.vibration_pitch_rad * dsigma * std::sin(w2 * t + 1.0);
-    r = r * RotX(phi) * RotY(vt);
+    r = r * geometry::RotX(phi) * geometry::RotY(vt);
   }
   *world_from_imu = r * config_.vehicle_from_imu;
 }
