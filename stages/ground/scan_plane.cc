@@ -140,6 +140,13 @@ ScanPlane ScanPlaneFitter::Fit(const GroundSegmenter& segmenter,
   const double noise_variance = geometry::PlaneNoiseVariance(out.fit);
   out.rms_m = std::sqrt(std::max(0.0, out.fit.eigenvalues(0)));
   out.covariance = geometry::PlaneCovariance(out.fit, noise_variance);
+  // Floors for what the point noise does not capture (see the params).
+  const double floor_rad = params_.covariance_normal_floor_deg() * M_PI / 180.0;
+  out.covariance.topLeftCorner<3, 3>() +=
+      floor_rad * floor_rad *
+      (Eigen::Matrix3d::Identity() - out.fit.normal * out.fit.normal.transpose());
+  out.covariance(3, 3) +=
+      params_.covariance_height_floor_m() * params_.covariance_height_floor_m();
   out.tilt_from_up_deg =
       std::acos(std::clamp(out.fit.normal.z(), -1.0, 1.0)) * kRadToDeg;
   const double height = out.fit.offset;

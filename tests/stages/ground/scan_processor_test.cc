@@ -145,6 +145,12 @@ TEST(ScanProcessor, CovarianceIsPositiveAndMasksMatchCounts) {
   EXPECT_GT(cov(0, 0), 0.0);
   // Height standard deviation is small but not zero for 2 cm noise.
   EXPECT_LT(std::sqrt(cov(3, 3)), 0.005);
+  // The normal stays unit: no variance along itself; the floors are applied.
+  const Eigen::Vector3d n = NormalOf(plane);
+  EXPECT_NEAR(n.dot(cov.topLeftCorner<3, 3>() * n), 0.0, 1e-12);
+  const proto::GroundParams params = DefaultGroundParams();
+  EXPECT_GE(plane.normal_std_deg(), params.covariance_normal_floor_deg());
+  EXPECT_GE(plane.height_std_m(), params.covariance_height_floor_m());
   int ground = 0, inliers = 0;
   for (uint64_t w : plane.ground_mask()) ground += __builtin_popcountll(w);
   for (uint64_t w : plane.inlier_mask()) inliers += __builtin_popcountll(w);
