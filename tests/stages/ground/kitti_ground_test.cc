@@ -10,7 +10,12 @@
 
 #include <gtest/gtest.h>
 
+#include "common/io/atomic_file.h"
+#include "common/io/record_stream.h"
+#include "common/io/text_proto.h"
 #include "stages/ground/scan_processor.h"
+#include "tiltcal/proto/imu.pb.h"
+#include "tiltcal/proto/rig.pb.h"
 #include "tests/stages/ground/ground_test_util.h"
 #include "tests/stages/ground/synthetic_lidar.h"
 
@@ -67,6 +72,57 @@ TEST_P(KittiGround, PlaneMatchesTheReference) {
 
 INSTANTIATE_TEST_SUITE_P(Scans, KittiGround,
                          ::testing::Values("kitti_000000.bin", "kitti_000003.bin"));
+
+// The real scans through the executable: written as a scan stream (no point
+// times, already motion-compensated by KITTI, so deskewing is off), an empty
+// IMU stream and an identity rig without height prior.
+TEST(KittiGroundCli, ExecutableFitsTheReferencePlane) {
+  const std::string dir_fixtures = testing::SharedFixturesDir();
+  if (dir_fixtures.empty()) GTEST_SKIP() << "../shared/fixtures is absent";
+  testing::TempDir dir;
+  proto::Provenance provenance;
+  provenance.set_producer("kitti_ground_test");
+  RecordWriter scans;
+  ASSERT_TRUE(scans.Open(dir.File("scans.binpb.lz4"), "tiltcal.proto.Scan", provenance, true).ok());
+  int index = 0;
+  for (const char* name : {"kitti_000000.bin", "kitti_000003.bin"}) {
+    proto::Scan scan;
+    ASSERT_TRUE(ReadKittiBin(dir_fixtures + "/scans/" + name, &scan));
+    scan.set_index(index);
+    scan.set_stamp_ns(1000000000LL + index * 300000000LL);  // frames 0 and 3 at 10 Hz
+    ++index;
+    ASSERT_TRUE(scans.Write(scan).ok());
+  }
+  ASSERT_TRUE(scans.Close().ok());
+  RecordWriter imu;
+  ASSERT_TRUE(imu.Open(dir.File("imu.binpb"), "tiltcal.proto.ImuSample", provenance, false).ok());
+  ASSERT_TRUE(imu.Close().ok());
+  proto::Rig rig;
+  rig.mutable_imu_from_lidar()->mutable_rotation()->set_w(1.0);
+  ASSERT_TRUE(WriteTextProto(dir.File("rig.txtpb"), rig).ok());
+  proto::GroundParams params = testing::DefaultGroundParams();
+  params.set_deskew(false);
+  ASSERT_TRUE(WriteTextProto(dir.File("params.txtpb"), params).ok());
+  std::string output;
+  ASSERT_EQ(testing::RunCommand(testing::ToolPath("tiltcal_ground") + " --imu=" +
+                                    dir.File("imu.binpb") + " --scans=" +
+                                    dir.File("scans.binpb.lz4") + " --rig=" +
+                                    dir.File("rig.txtpb") + " --params=" +
+                                    dir.File("params.txtpb") + " --out_ground=" +
+                                    dir.File("ground.binpb"),
+                                &output), 0) << output;
+  std::vector<proto::GroundPlane> planes;
+  ASSERT_TRUE(ReadAllRecords<proto::GroundPlane>(dir.File("ground.binpb"), &planes).ok());
+  ASSERT_EQ(planes.size(), 2u);
+  const Eigen::Vector3d reference = Eigen::Vector3d(-0.001, 0.034, 0.9994).normalized();
+  for (const proto::GroundPlane& plane : planes) {
+    EXPECT_TRUE(plane.valid()) << plane.reject_detail();
+    EXPECT_FALSE(plane.deskewed());
+    EXPECT_LT(testing::AngleDeg(testing::NormalOf(plane), reference), 0.5);
+    EXPECT_GE(plane.height_m(), 1.72);
+    EXPECT_LE(plane.height_m(), 1.78);
+  }
+}
 
 }  // namespace
 }  // namespace tiltcal::ground
