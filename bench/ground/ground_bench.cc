@@ -163,7 +163,7 @@ int main(int argc, char** argv) {
   for (int k = 0; k < 10; ++k) {
     tiltcal::testing::SyntheticPose pose;
     pose.position_g = Eigen::Vector3d(0, 0, 0.85);
-    pose.g_from_lidar = tiltcal::testing::RollPitchYaw(0.02 * k, -0.01 * k, 0.3 * k);
+    pose.g_from_lidar = tiltcal::testing::RollPitchYaw(0.003 * k, -0.002 * k, 0.3 * k);
     vlp.push_back(tiltcal::testing::CastScan(tiltcal::testing::StreetScene(k),
                                              tiltcal::testing::SyntheticLidar::Vlp16(), pose,
                                              k, k));
@@ -181,7 +181,7 @@ int main(int argc, char** argv) {
     tiltcal::ground::GyroIntegrator integrator(imu, Eigen::Vector3d::Zero());
     tiltcal::ground::Deskewer deskewer(&integrator, Eigen::Matrix3d::Identity(), 0,
                                        params.deskew_node_spacing_s());
-    PrintRow("  + deskewing", TimeScans(params, vlp, passes, &deskewer), 0.0);
+    PrintRow("  + deskewing (timing only)", TimeScans(params, vlp, passes, &deskewer), 0.0);
   }
 
   Scan kitti;
