@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <memory>
 
 #include <ceres/loss_function.h>
 
@@ -38,8 +39,9 @@ double SigmaOr(const proto::GroundResidualParams& p, double fallback) {
   return p.sigma() > 0.0 ? p.sigma() : fallback;
 }
 
-ceres::LossFunction* MakeLoss(const proto::GroundResidualParams& p) {
-  return p.cauchy_scale() > 0.0 ? new ceres::CauchyLoss(p.cauchy_scale()) : nullptr;
+std::unique_ptr<ceres::LossFunction> MakeLoss(const proto::GroundResidualParams& p) {
+  if (!(p.cauchy_scale() > 0.0)) return nullptr;
+  return std::make_unique<ceres::CauchyLoss>(p.cauchy_scale());
 }
 
 // n_l (unit) and d_l of a usable plane; false when the plane is invalid.
@@ -74,6 +76,12 @@ Eigen::Matrix3d WhiteningMatrix(double sigma, const Eigen::Matrix3d& extra) {
 }
 
 }  // namespace
+
+GroundLosses::GroundLosses(const proto::CalibrateParams& params)
+    : flat_(MakeLoss(params.flat())),
+      dist_(MakeLoss(params.dist())),
+      incl_(MakeLoss(params.incl())),
+      up_(MakeLoss(params.up())) {}
 
 GroundSequenceInfo MakeGroundSequenceInfo(const proto::Rig& rig,
                                           const proto::GravityReference* gravity) {
@@ -181,8 +189,9 @@ std::string GroundResidualSummary::ToString() const {
 Status AddGroundResiduals(const std::vector<proto::GroundPlane>& planes,
                           const GroundResidualSelection& selection,
                           const proto::CalibrateParams& params, const GroundSequenceInfo& info,
-                          int64_t time_origin_ns, CalibrationState* state,
-                          ceres::Problem* problem, GroundResidualSummary* summary) {
+                          const GroundLosses& losses, int64_t time_origin_ns,
+                          CalibrationState* state, ceres::Problem* problem,
+                          GroundResidualSummary* summary) {
   *summary = GroundResidualSummary();
   summary->num_planes = static_cast<int>(planes.size());
   if (!selection.any()) return Status::Ok();
@@ -263,7 +272,7 @@ Status AddGroundResiduals(const std::vector<proto::GroundPlane>& planes,
           has_covariance && params.flat().use_plane_covariance() ? cov_nn : Eigen::Matrix3d::Zero();
       auto* cost = new FlatGroundCostFunction(segment_start_s, grid.inv_dt(), t_k, normal,
                                               WhiteningMatrix(sigma_flat, extra));
-      problem->AddResidualBlock(cost, MakeLoss(params.flat()), knots[0], knots[1], knots[2],
+      problem->AddResidualBlock(cost, losses.flat(), knots[0], knots[1], knots[2],
                                 knots[3], state->gravity_direction, state->imu_from_lidar_rotation,
                                 state->time_offset_s);
       ++summary->num_flat;
@@ -277,7 +286,7 @@ Status AddGroundResiduals(const std::vector<proto::GroundPlane>& planes,
       }
       auto* cost =
           new DistanceCostFunction(normal, height_m, info.imu_height_m, 1.0 / std::sqrt(variance));
-      problem->AddResidualBlock(cost, MakeLoss(params.dist()), state->imu_from_lidar_rotation,
+      problem->AddResidualBlock(cost, losses.dist(), state->imu_from_lidar_rotation,
                                 state->imu_from_lidar_translation);
       ++summary->num_dist;
     }
@@ -295,7 +304,7 @@ Status AddGroundResiduals(const std::vector<proto::GroundPlane>& planes,
       }
       auto* cost = new InclinationCostFunction(segment_start_s, grid.inv_dt(), t_k, normal,
                                                info.gravity_flat_in_imu, 1.0 / std::sqrt(variance));
-      problem->AddResidualBlock(cost, MakeLoss(params.incl()), knots[0], knots[1], knots[2],
+      problem->AddResidualBlock(cost, losses.incl(), knots[0], knots[1], knots[2],
                                 knots[3], state->gravity_direction, state->imu_from_lidar_rotation,
                                 state->time_offset_s);
       ++summary->num_incl;
@@ -305,7 +314,7 @@ Status AddGroundResiduals(const std::vector<proto::GroundPlane>& planes,
           has_covariance && params.up().use_plane_covariance() ? cov_nn : Eigen::Matrix3d::Zero();
       auto* cost = new UpCostFunction(normal, info.gravity_flat_in_imu,
                                       WhiteningMatrix(sigma_up, extra));
-      problem->AddResidualBlock(cost, MakeLoss(params.up()), state->imu_from_lidar_rotation);
+      problem->AddResidualBlock(cost, losses.up(), state->imu_from_lidar_rotation);
       ++summary->num_up;
     }
   }

@@ -35,16 +35,18 @@
 //   covariance has no component along n_l, and e_incl is first-order
 //   insensitive to n_l on level ground). A plane without a usable 4x4
 //   covariance falls back to sigma_k alone (counted).
-// Each residual block gets its own robust loss: Cauchy with
-// params.k.cauchy_scale (in whitened units), none when 0.
+// Each residual type has its own robust loss (GroundLosses): Cauchy with
+// params.k.cauchy_scale (in whitened units, i.e. of sigma_k), none when 0.
 //
 // Planes: skipped when invalid (valid = false, non-finite or non-unit normal,
 // d_l <= 0 or non-finite), or when t_k + tau is outside the spline.
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
+#include <ceres/loss_function.h>
 #include <ceres/problem.h>
 
 #include <Eigen/Core>
@@ -96,6 +98,23 @@ struct GroundResidualSelection {
 Status SelectGroundResiduals(const proto::CalibrateParams& params, const GroundSequenceInfo& info,
                              GroundResidualSelection* selection);
 
+// The robust losses of the four residual types, each shared by all blocks of
+// its type (Cauchy losses hold no per-residual state). Owned here, not by the
+// Problem: the Problem must be built with
+// Options::loss_function_ownership = DO_NOT_TAKE_OWNERSHIP (as
+// CalibrationProblem does), and this object must outlive it.
+class GroundLosses {
+ public:
+  explicit GroundLosses(const proto::CalibrateParams& params);
+  ceres::LossFunction* flat() const { return flat_.get(); }  // null = no robust loss
+  ceres::LossFunction* dist() const { return dist_.get(); }
+  ceres::LossFunction* incl() const { return incl_.get(); }
+  ceres::LossFunction* up() const { return up_.get(); }
+
+ private:
+  std::unique_ptr<ceres::LossFunction> flat_, dist_, incl_, up_;
+};
+
 struct GroundResidualSummary {
   int num_planes = 0;            // planes given
   int num_invalid = 0;           // skipped: invalid plane
@@ -116,8 +135,9 @@ struct GroundResidualSummary {
 Status AddGroundResiduals(const std::vector<proto::GroundPlane>& planes,
                           const GroundResidualSelection& selection,
                           const proto::CalibrateParams& params, const GroundSequenceInfo& info,
-                          int64_t time_origin_ns, CalibrationState* state,
-                          ceres::Problem* problem, GroundResidualSummary* summary);
+                          const GroundLosses& losses, int64_t time_origin_ns,
+                          CalibrationState* state, ceres::Problem* problem,
+                          GroundResidualSummary* summary);
 
 }  // namespace tiltcal::calibrate
 

@@ -114,6 +114,13 @@ void AddStateBlocks(CalibrationState* state, ceres::Problem* problem) {
   problem->AddParameterBlock(state->gravity_direction, 3, new ceres::SphereManifold<3>);
 }
 
+// The tests' problems do not own loss functions, as CalibrationProblem.
+ceres::Problem::Options ProblemOptions() {
+  ceres::Problem::Options options;
+  options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  return options;
+}
+
 GroundSequenceInfo InfoFor(const Scenario& sc, bool level) {
   GroundSequenceInfo info;
   info.imu_height_m = sc.d_b;
@@ -134,16 +141,22 @@ proto::CalibrateParams UnitSigmaParams() {
   return params;
 }
 
+// No robust losses (cauchy_scale 0).
+const GroundLosses& NoLosses() {
+  static const GroundLosses losses(UnitSigmaParams());
+  return losses;
+}
+
 // Cost 0.5 sum r^2 of one residual kind at the true state.
 double CostOf(const Scenario& sc, bool level, GroundResidualSelection selection,
               GroundResidualSummary* summary = nullptr) {
   CalibrationState state(sc.Grid());
   sc.FillState(&state);
-  ceres::Problem problem;
+  ceres::Problem problem{ProblemOptions()};
   AddStateBlocks(&state, &problem);
   GroundResidualSummary local;
   const Status status = AddGroundResiduals(sc.Planes(), selection, UnitSigmaParams(),
-                                           InfoFor(sc, level), kOriginNs, &state, &problem,
+                                           InfoFor(sc, level), NoLosses(), kOriginNs, &state, &problem,
                                            summary ? summary : &local);
   EXPECT_TRUE(status.ok()) << status.message();
   double cost = 0.0;
@@ -195,12 +208,12 @@ TEST(GroundResidualsTest, WrongExtrinsicGivesNonZeroResiduals) {
   for (int kind = 0; kind < 3; ++kind) {
     CalibrationState state(truth.Grid());
     wrong.FillState(&state);
-    ceres::Problem problem;
+    ceres::Problem problem{ProblemOptions()};
     AddStateBlocks(&state, &problem);
     GroundResidualSummary summary;
     const GroundResidualSelection sel = Only(false, kind == 0, kind == 1, kind == 2);
     ASSERT_TRUE(AddGroundResiduals(truth.Planes(), sel, UnitSigmaParams(), InfoFor(truth, false),
-                                   kOriginNs, &state, &problem, &summary)
+                                   NoLosses(), kOriginNs, &state, &problem, &summary)
                     .ok());
     double cost = 0.0;
     problem.Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr, nullptr, nullptr);
@@ -227,11 +240,11 @@ TEST(GroundResidualsTest, InvalidAndOutOfSplinePlanesAreSkipped) {
   }
   CalibrationState state(sc.Grid());
   sc.FillState(&state);
-  ceres::Problem problem;
+  ceres::Problem problem{ProblemOptions()};
   AddStateBlocks(&state, &problem);
   GroundResidualSummary summary;
   ASSERT_TRUE(AddGroundResiduals(planes, Only(true, true, true, true), UnitSigmaParams(),
-                                 InfoFor(sc, false), kOriginNs, &state, &problem, &summary)
+                                 InfoFor(sc, false), NoLosses(), kOriginNs, &state, &problem, &summary)
                   .ok());
   EXPECT_EQ(summary.num_planes, good + 6);
   EXPECT_EQ(summary.num_invalid, 4);
@@ -242,18 +255,45 @@ TEST(GroundResidualsTest, InvalidAndOutOfSplinePlanesAreSkipped) {
   EXPECT_EQ(summary.num_incl, good);
   EXPECT_EQ(summary.num_up, good);
   EXPECT_EQ(problem.NumResidualBlocks(), 4 * good);
-  // One robust loss per block when asked for (blocks still evaluate).
   EXPECT_NE(summary.ToString().find("4 invalid"), std::string::npos) << summary.ToString();
+}
+
+// Each residual type gets the Cauchy loss of its own params: cost
+// 0.5 a^2 log(1 + r^2 / a^2) per block with r the weighted residual.
+TEST(GroundResidualsTest, CauchyLossPerResidualType) {
+  const Scenario sc;
+  proto::GroundPlane plane = sc.Plane(2.0);
+  plane.set_height_m(plane.height_m() + 0.05);  // e_dist = 0.05 m
+  proto::CalibrateParams params = UnitSigmaParams();
+  params.mutable_dist()->set_sigma(0.01);        // r = 5
+  params.mutable_dist()->set_cauchy_scale(2.0);
+  params.mutable_up()->set_cauchy_scale(7.0);    // e_up = 0: no contribution
+  const GroundLosses losses(params);
+  ASSERT_NE(losses.dist(), nullptr);
+  EXPECT_EQ(losses.flat(), nullptr);
+  CalibrationState state(sc.Grid());
+  sc.FillState(&state);
+  ceres::Problem problem{ProblemOptions()};
+  AddStateBlocks(&state, &problem);
+  GroundResidualSummary summary;
+  ASSERT_TRUE(AddGroundResiduals({plane}, Only(false, true, false, true), params,
+                                 InfoFor(sc, false), losses, kOriginNs, &state, &problem, &summary)
+                  .ok());
+  double cost = 0.0;
+  problem.Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr, nullptr, nullptr);
+  const double r = 0.05 / 0.01, a = 2.0;
+  EXPECT_NEAR(cost, 0.5 * a * a * std::log1p(r * r / (a * a)), 1e-9);
+  EXPECT_LT(cost, 0.5 * r * r);
 }
 
 TEST(GroundResidualsTest, MissingParameterBlockIsAnError) {
   const Scenario sc;
   CalibrationState state(sc.Grid());
   sc.FillState(&state);
-  ceres::Problem problem;  // no blocks added
+  ceres::Problem problem{ProblemOptions()};  // no blocks added
   GroundResidualSummary summary;
   const Status status = AddGroundResiduals(sc.Planes(), Only(false, true, false, false),
-                                           UnitSigmaParams(), InfoFor(sc, false), kOriginNs,
+                                           UnitSigmaParams(), InfoFor(sc, false), NoLosses(), kOriginNs,
                                            &state, &problem, &summary);
   EXPECT_FALSE(status.ok());
   EXPECT_NE(status.message().find("imu_from_lidar_rotation"), std::string::npos);
@@ -295,11 +335,11 @@ TEST(GroundResidualsTest, PlaneCovarianceWhitening) {
   for (int kind = 0; kind < 4; ++kind) {
     CalibrationState state(sc.Grid());
     sc.FillState(&state);
-    ceres::Problem problem;
+    ceres::Problem problem{ProblemOptions()};
     AddStateBlocks(&state, &problem);
     GroundResidualSummary summary;
     ASSERT_TRUE(AddGroundResiduals({plane}, Only(kind == 0, kind == 1, kind == 2, kind == 3),
-                                   params, info, kOriginNs, &state, &problem, &summary)
+                                   params, info, NoLosses(), kOriginNs, &state, &problem, &summary)
                     .ok());
     EXPECT_EQ(summary.num_without_covariance, 0);
     double cost = 0.0;
@@ -337,10 +377,10 @@ TEST(GroundResidualsTest, PlaneCovarianceWhitening) {
   bare.clear_covariance();
   CalibrationState state(sc.Grid());
   sc.FillState(&state);
-  ceres::Problem problem;
+  ceres::Problem problem{ProblemOptions()};
   AddStateBlocks(&state, &problem);
   GroundResidualSummary summary;
-  ASSERT_TRUE(AddGroundResiduals({bare}, Only(false, true, false, false), params, info, kOriginNs,
+  ASSERT_TRUE(AddGroundResiduals({bare}, Only(false, true, false, false), params, info, NoLosses(), kOriginNs,
                                  &state, &problem, &summary)
                   .ok());
   EXPECT_EQ(summary.num_without_covariance, 1);
@@ -360,13 +400,13 @@ TEST(GroundResidualsTest, DistAndUpRecoverTheirObservableDirections) {
     sc.FillState(&state);
     const Eigen::Vector3d init(-0.6, 1.0, 0.6);
     state.SetImuFromLidarTranslation(init);
-    ceres::Problem problem;
+    ceres::Problem problem{ProblemOptions()};
     AddStateBlocks(&state, &problem);
     GroundResidualSummary summary;
     proto::CalibrateParams params = UnitSigmaParams();
     params.mutable_dist()->set_sigma(0.02);
     ASSERT_TRUE(AddGroundResiduals(sc.Planes(), Only(false, true, false, false), params,
-                                   InfoFor(sc, false), kOriginNs, &state, &problem, &summary)
+                                   InfoFor(sc, false), NoLosses(), kOriginNs, &state, &problem, &summary)
                     .ok());
     problem.SetParameterBlockConstant(state.imu_from_lidar_rotation);
     ceres::Solver::Options options;
@@ -384,11 +424,11 @@ TEST(GroundResidualsTest, DistAndUpRecoverTheirObservableDirections) {
     const Eigen::Quaterniond init =
         sc.q_bl * geometry::ExpQuaternion(Eigen::Vector3d(0.05, -0.04, 0.03));
     state.SetImuFromLidarRotation(init);
-    ceres::Problem problem;
+    ceres::Problem problem{ProblemOptions()};
     AddStateBlocks(&state, &problem);
     GroundResidualSummary summary;
     ASSERT_TRUE(AddGroundResiduals(sc.Planes(), Only(false, false, false, true), UnitSigmaParams(),
-                                   InfoFor(sc, false), kOriginNs, &state, &problem, &summary)
+                                   InfoFor(sc, false), NoLosses(), kOriginNs, &state, &problem, &summary)
                     .ok());
     ceres::Solver::Options options;
     options.linear_solver_type = ceres::DENSE_QR;
