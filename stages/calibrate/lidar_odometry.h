@@ -1,0 +1,103 @@
+#ifndef TILTCAL_STAGES_CALIBRATE_LIDAR_ODOMETRY_H_
+#define TILTCAL_STAGES_CALIBRATE_LIDAR_ODOMETRY_H_
+
+// Scan-to-local-map LiDAR odometry on deskewed scans, for the position
+// initialisation of the calibrator (issue 5 item 4; OA-Calib's NDT odometry).
+//
+// Frames: each scan's points are in its LiDAR frame l_k at the scan time
+// (deskewed). Poses are T_{l0 lk} = (C_{l0 lk}, r_{l0}^{lk l0}), i.e.
+// l0_from_lidar, with l0 the first scan's LiDAR frame (so pose 0 = identity).
+//
+// Per scan: voxel downsampling (scan_voxel_m) and a range crop; prediction
+//   C_pred = C_{l0 l(k-1)} C_prior(k-1)^T C_prior(k)   when a rotation prior
+//            (e.g. gyro mapped through the measured extrinsic, see
+//            LidarRotationPriorFromImu) is given, else constant rotation rate;
+//   r_pred = r_{k-1} + (C_{k-1} C_{k-2}^T)(r_{k-1} - r_{k-2}) * dt_k / dt_{k-1}
+//            (constant body-frame velocity);
+// then PCL registration (GICP or NDT) against a local map made of the last
+// local_map_keyframes keyframes (a scan becomes a keyframe when it moved more
+// than keyframe_distance_m or keyframe_angle_deg from the last keyframe),
+// voxel-downsampled at map_voxel_m. PCL only appears in the .cc file.
+// Cost: a VLP-16 scan (~29k points) downsampled at 0.5-0.6 m leaves ~1.5-2k
+// points; GICP then takes ~10-20 ms of one core per scan.
+
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+namespace tiltcal::calibrate {
+
+enum class RegistrationMethod { kGicp, kNdt };
+
+struct LidarOdometryOptions {
+  RegistrationMethod method = RegistrationMethod::kGicp;
+  double scan_voxel_m = 0.5;    // source downsampling, m
+  double map_voxel_m = 0.4;     // local map downsampling, m
+  double min_range_m = 1.0;     // points closer to the sensor are dropped, m
+  double max_range_m = 80.0;    // points farther are dropped, m
+  int max_iterations = 10;      // registration iterations per scan
+  double transformation_epsilon = 1e-4;  // convergence on the update (PCL's squared-change test)
+  double max_correspondence_m = 1.0;     // GICP correspondence distance, m
+  int gicp_neighbours = 10;              // k for the GICP covariances
+  double ndt_resolution_m = 2.0;         // NDT cell size, m
+  double ndt_step_size_m = 0.1;          // NDT More-Thuente max step, m
+  double keyframe_distance_m = 1.0;
+  double keyframe_angle_deg = 5.0;
+  int local_map_keyframes = 6;
+  // Quality: surfels of the full-resolution local map (voxel edge, m); a
+  // source point is an inlier within inlier_distance_m of its voxel's surfel.
+  double quality_voxel_m = 1.0;
+  double inlier_distance_m = 0.1;
+};
+
+struct LidarOdometryPose {
+  double time_s = 0.0;
+  Eigen::Isometry3d l0_from_lidar = Eigen::Isometry3d::Identity();  // T_{l0 lk}
+  bool registered = false;   // false for scan 0 and for scans that could not be registered
+  bool converged = false;    // the registration reported convergence
+  bool keyframe = false;
+  int num_source_points = 0;  // after downsampling and cropping
+  // Quality after alignment, against planar surfels of the local map (the
+  // keyframes at full resolution, quality_voxel_m voxels): of the source
+  // points that fall in a surfel voxel (num_quality_points), the fraction
+  // within inlier_distance_m of the plane and their RMS point-to-plane
+  // distance (m). A good registration gives ~1 and ~the range noise.
+  int num_quality_points = 0;
+  double fitness_rms_m = 0.0;
+  double inlier_fraction = 0.0;
+  double seconds = 0.0;      // wall time spent on this scan, s
+};
+
+class LidarOdometry {
+ public:
+  explicit LidarOdometry(const LidarOdometryOptions& options);
+  ~LidarOdometry();
+  LidarOdometry(const LidarOdometry&) = delete;
+  LidarOdometry& operator=(const LidarOdometry&) = delete;
+
+  // Registers the next scan (times increasing). rotation_prior = predicted
+  // C_{l0 lk} (only its change since the previous scan is used). Points must
+  // be finite; an empty scan keeps the predicted pose with registered=false.
+  const LidarOdometryPose& AddScan(double time_s, const std::vector<Eigen::Vector3f>& points_lidar,
+                                   const std::optional<Eigen::Quaterniond>& rotation_prior);
+
+  const std::vector<LidarOdometryPose>& poses() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// The rotation prior of scan k from the gyro: with C_ab from gyro
+// integration and the measured extrinsic rotation C_bl,
+//   C_{l0 lk} = C_bl^T C_ab(t_0)^T C_ab(t_k) C_bl.
+Eigen::Quaterniond LidarRotationPriorFromImu(const Eigen::Quaterniond& world_from_imu_at_first_scan,
+                                             const Eigen::Quaterniond& world_from_imu_at_scan,
+                                             const Eigen::Quaterniond& imu_from_lidar);
+
+}  // namespace tiltcal::calibrate
+
+#endif  // TILTCAL_STAGES_CALIBRATE_LIDAR_ODOMETRY_H_
