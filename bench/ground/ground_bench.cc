@@ -25,6 +25,8 @@
 #include <string>
 #include <vector>
 
+#include "common/imu/gyro_integrator.h"
+#include "common/imu/imu_reading.h"
 #include "common/io/params.h"
 #include "stages/ground/scan_processor.h"
 #include "tests/stages/ground/synthetic_lidar.h"
@@ -171,16 +173,16 @@ int main(int argc, char** argv) {
   PrintRow("simulated VLP-16 (street, 0.85 m)", TimeScans(params, vlp, passes), 0.0);
   {
     // The same scans with deskewing (IMU at 200 Hz turning at 0.5 rad/s).
-    std::vector<tiltcal::proto::ImuSample> imu;
-    for (int64_t t = -1000000000LL; t <= 2000000000LL; t += 5000000) {
-      tiltcal::proto::ImuSample sample;
-      sample.set_stamp_ns(t);
-      sample.mutable_angular_velocity_radps()->set_z(0.5);
-      imu.push_back(sample);
+    std::vector<tiltcal::imu::ImuReading> imu;
+    for (int i = 0; i <= 600; ++i) {  // from -1 s to 2 s
+      tiltcal::imu::ImuReading reading;
+      reading.time_s = 0.005 * i;
+      reading.angular_velocity_radps = Eigen::Vector3d(0.0, 0.0, 0.5);
+      imu.push_back(reading);
     }
-    tiltcal::ground::GyroIntegrator integrator(imu, Eigen::Vector3d::Zero());
-    tiltcal::ground::Deskewer deskewer(&integrator, Eigen::Matrix3d::Identity(), 0,
-                                       params.deskew_node_spacing_s());
+    tiltcal::imu::GyroIntegrator integrator(imu, Eigen::Vector3d::Zero());
+    tiltcal::ground::Deskewer deskewer(&integrator, -1000000000LL, Eigen::Matrix3d::Identity(),
+                                       0, params.deskew_node_spacing_s());
     PrintRow("  + deskewing (timing only)", TimeScans(params, vlp, passes, &deskewer), 0.0);
   }
 

@@ -9,6 +9,10 @@
 
 #include <unistd.h>
 
+#include "common/imu/gyro_integrator.h"
+#include "common/imu/imu_reading.h"
+#include "common/imu/static_detection.h"
+#include "common/io/imu_stream.h"
 #include "common/io/provenance.h"
 #include "common/io/record_stream.h"
 #include "common/io/text_proto.h"
@@ -16,7 +20,6 @@
 #include "stages/ground/ground_segmentation.h"
 #include "stages/ground/scan_plane.h"
 #include "stages/ground/scan_processor.h"
-#include "tiltcal/proto/imu.pb.h"
 #include "tiltcal/proto/rig.pb.h"
 #include "tiltcal/proto/scan.pb.h"
 
@@ -26,21 +29,6 @@ namespace {
 
 bool Finite(const proto::Vector3& v) {
   return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z());
-}
-
-Status CheckImu(const std::string& path, const std::vector<proto::ImuSample>& samples) {
-  for (size_t i = 0; i < samples.size(); ++i) {
-    const proto::ImuSample& s = samples[i];
-    if (!Finite(s.angular_velocity_radps()) || !Finite(s.linear_acceleration_mps2())) {
-      return Status::Error(path + ": record " + std::to_string(i) + ": non-finite IMU reading");
-    }
-    if (i > 0 && s.stamp_ns() <= samples[i - 1].stamp_ns()) {
-      return Status::Error(path + ": record " + std::to_string(i) + ": stamp " +
-                           std::to_string(s.stamp_ns()) + " ns does not increase (previous " +
-                           std::to_string(samples[i - 1].stamp_ns()) + ")");
-    }
-  }
-  return Status::Ok();
 }
 
 Status CheckScan(const std::string& path, int64_t record, const proto::Scan& scan) {
@@ -95,16 +83,28 @@ Status Run(const GroundPaths& paths, const proto::GroundParams& params,
     return Status::Error(paths.rig + ": non-finite value");
   }
 
-  std::vector<proto::ImuSample> imu;
-  TILTCAL_RETURN_IF_ERROR(ReadAllRecords<proto::ImuSample>(paths.imu, &imu));
-  TILTCAL_RETURN_IF_ERROR(CheckImu(paths.imu, imu));
-  const StaticStart static_start = EstimateStaticGyroBias(
-      imu, params.static_gyro_max_radps(), params.static_min_duration_s());
+  // IMU (only needed for deskewing): readings in seconds from the first stamp.
+  std::vector<imu::ImuReading> readings;
+  int64_t imu_origin_ns = 0;
+  if (params.deskew()) {
+    TILTCAL_RETURN_IF_ERROR(ReadImuReadings(paths.imu, &readings, &imu_origin_ns));
+  }
+  imu::StaticDetectionOptions static_options;
+  static_options.window_s = params.static_window_s();
+  static_options.hop_s = params.static_window_s() / 5.0;
+  static_options.max_gyro_std_radps = params.static_gyro_std_max_radps();
+  static_options.max_accel_std_mps2 = params.static_accel_std_max_mps2();
+  static_options.max_gyro_mean_radps = params.static_gyro_max_radps();
+  static_options.min_duration_s = params.static_min_duration_s();
+  const imu::StaticInterval static_start = readings.empty()
+                                               ? imu::StaticInterval()
+                                               : imu::DetectStaticStart(readings, static_options);
   summary.static_start = static_start.found;
-  summary.static_duration_s = static_start.duration_s;
-  GyroIntegrator integrator(imu, static_start.gyro_bias_radps);
+  summary.static_duration_s = static_start.found ? static_start.end_s - static_start.begin_s : 0.0;
+  const imu::GyroIntegrator integrator(
+      readings, static_start.found ? static_start.mean_gyro_radps : Eigen::Vector3d::Zero());
   const Eigen::Quaterniond c_bl_q(q.w(), q.x(), q.y(), q.z());
-  Deskewer deskewer(&integrator, c_bl_q.normalized().toRotationMatrix(),
+  Deskewer deskewer(&integrator, imu_origin_ns, c_bl_q.normalized().toRotationMatrix(),
                     std::llround(params.time_offset_s() * 1e9), params.deskew_node_spacing_s());
 
   const GroundFrame frame = MakeGroundFrame(rig, params);

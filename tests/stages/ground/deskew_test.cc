@@ -3,6 +3,9 @@
 // truth at the stamp, the raw one must not.
 #include "stages/ground/deskew.h"
 
+#include "common/imu/gyro_integrator.h"
+#include "common/imu/imu_reading.h"
+
 #include <cmath>
 #include <vector>
 
@@ -26,52 +29,28 @@ using testing::SyntheticPose;
 
 constexpr int64_t kStampNs = 5000000000LL;
 
-// IMU samples at 400 Hz over [t0, t1] (IMU clock) with a constant body rate
-// and a constant gyro bias.
-std::vector<proto::ImuSample> ConstantRateImu(int64_t t0_ns, int64_t t1_ns,
-                                              const Eigen::Vector3d& omega_b,
-                                              const Eigen::Vector3d& bias) {
-  std::vector<proto::ImuSample> samples;
+// IMU readings at 400 Hz over [t0, t1] (IMU clock, ns; times in the readings
+// are seconds from t0) with a constant body rate and a constant gyro bias.
+std::vector<imu::ImuReading> ConstantRateImu(int64_t t0_ns, int64_t t1_ns,
+                                             const Eigen::Vector3d& omega_b,
+                                             const Eigen::Vector3d& bias) {
+  std::vector<imu::ImuReading> samples;
   for (int64_t t = t0_ns; t <= t1_ns; t += 2500000) {
-    proto::ImuSample s;
-    s.set_stamp_ns(t);
-    s.mutable_angular_velocity_radps()->set_x(omega_b.x() + bias.x());
-    s.mutable_angular_velocity_radps()->set_y(omega_b.y() + bias.y());
-    s.mutable_angular_velocity_radps()->set_z(omega_b.z() + bias.z());
-    s.mutable_linear_acceleration_mps2()->set_z(9.81);
+    imu::ImuReading s;
+    s.time_s = 1e-9 * static_cast<double>(t - t0_ns);
+    s.angular_velocity_radps = omega_b + bias;
+    s.linear_acceleration_mps2 = Eigen::Vector3d(0, 0, 9.81);
     samples.push_back(s);
   }
   return samples;
-}
-
-TEST(GyroIntegrator, ConstantRateGivesTheExactRotation) {
-  const Eigen::Vector3d w(0.3, -0.2, 0.5), bias(0.01, 0.02, -0.03);
-  const auto samples = ConstantRateImu(0, 2000000000LL, w, bias);
-  GyroIntegrator integrator(samples, bias);
-  const Eigen::Quaterniond q = integrator.Orientation(1234567890LL);
-  const Eigen::Quaterniond expected(Eigen::AngleAxisd(w.norm() * 1.23456789, w.normalized()));
-  EXPECT_LT(q.angularDistance(expected), 1e-9);
-  EXPECT_TRUE(integrator.Covers(0, 2000000000LL));
-  EXPECT_FALSE(integrator.Covers(-1, 10));
-}
-
-TEST(StaticStart, BiasIsTheMeanOfTheStillPrefix) {
-  const Eigen::Vector3d bias(0.004, -0.006, 0.002);
-  auto samples = ConstantRateImu(0, 1000000000LL, Eigen::Vector3d::Zero(), bias);
-  const auto moving = ConstantRateImu(1002500000LL, 3000000000LL, Eigen::Vector3d(0, 0, 0.8), bias);
-  samples.insert(samples.end(), moving.begin(), moving.end());
-  const StaticStart s = EstimateStaticGyroBias(samples, 0.05, 0.5);
-  ASSERT_TRUE(s.found);
-  EXPECT_NEAR(s.duration_s, 1.0, 1e-6);
-  EXPECT_LT((s.gyro_bias_radps - bias).norm(), 1e-12);
-  EXPECT_FALSE(EstimateStaticGyroBias(moving, 0.05, 0.5).found);
 }
 
 struct DeskewCase {
   proto::Scan scan;
   SyntheticPose pose;
   Eigen::Matrix3d c_bl;
-  std::vector<proto::ImuSample> imu;
+  std::vector<imu::ImuReading> imu;
+  int64_t imu_origin_ns;
   int64_t tau_ns;
 };
 
@@ -84,8 +63,9 @@ DeskewCase MakeCase() {
   c.scan = CastScan(StreetScene(11), SyntheticLidar::Vlp16(), c.pose, kStampNs, 11);
   c.tau_ns = 7000000;  // IMU clock = LiDAR clock + 7 ms
   const Eigen::Vector3d omega_b = c.c_bl * c.pose.omega_lidar_radps;
-  c.imu = ConstantRateImu(kStampNs + c.tau_ns - 1000000000LL, kStampNs + c.tau_ns + 1000000000LL,
-                          omega_b, Eigen::Vector3d::Zero());
+  c.imu_origin_ns = kStampNs + c.tau_ns - 1000000000LL;
+  c.imu = ConstantRateImu(c.imu_origin_ns, kStampNs + c.tau_ns + 1000000000LL, omega_b,
+                          Eigen::Vector3d::Zero());
   return c;
 }
 
@@ -97,8 +77,9 @@ TEST(Deskewer, DeskewedPlaneMatchesTheTruthAtTheStamp) {
   proto::Scan raw_scan = c.scan;
   const proto::GroundPlane raw_plane = raw.Process(&raw_scan);
   // Deskewed.
-  GyroIntegrator integrator(c.imu, Eigen::Vector3d::Zero());
-  Deskewer deskewer(&integrator, c.c_bl, c.tau_ns, params.deskew_node_spacing_s());
+  imu::GyroIntegrator integrator(c.imu, Eigen::Vector3d::Zero());
+  Deskewer deskewer(&integrator, c.imu_origin_ns, c.c_bl, c.tau_ns,
+                    params.deskew_node_spacing_s());
   ScanProcessor processor(params, GroundFrame(), &deskewer);
   proto::Scan scan = c.scan;
   const proto::GroundPlane plane = processor.Process(&scan);
@@ -122,8 +103,8 @@ TEST(Deskewer, PointsMatchTheFrameAtTheStamp) {
   lidar.azimuth_steps = 360;
   SyntheticPose still = c.pose;
   c.scan = CastScan(StreetScene(11), lidar, c.pose, kStampNs, 1);
-  GyroIntegrator integrator(c.imu, Eigen::Vector3d::Zero());
-  Deskewer deskewer(&integrator, c.c_bl, c.tau_ns, 0.001);
+  imu::GyroIntegrator integrator(c.imu, Eigen::Vector3d::Zero());
+  Deskewer deskewer(&integrator, c.imu_origin_ns, c.c_bl, c.tau_ns, 0.001);
   proto::Scan scan = c.scan;
   ASSERT_TRUE(deskewer.Deskew(scan.stamp_ns(), scan.time_offset_ns().data(),
                               static_cast<size_t>(scan.x_size()), scan.mutable_x()->mutable_data(),
@@ -145,9 +126,10 @@ TEST(Deskewer, PointsMatchTheFrameAtTheStamp) {
 
 TEST(Deskewer, NoImuCoverageIsARejectionNotANan) {
   DeskewCase c = MakeCase();
-  std::vector<proto::ImuSample> late(c.imu.begin() + 410, c.imu.end());  // starts after the stamp
-  GyroIntegrator integrator(late, Eigen::Vector3d::Zero());
-  Deskewer deskewer(&integrator, c.c_bl, c.tau_ns, 0.001);
+  // The readings start 25 ms after the stamp.
+  std::vector<imu::ImuReading> late(c.imu.begin() + 410, c.imu.end());
+  imu::GyroIntegrator integrator(late, Eigen::Vector3d::Zero());
+  Deskewer deskewer(&integrator, c.imu_origin_ns, c.c_bl, c.tau_ns, 0.001);
   ScanProcessor processor(DefaultGroundParams(), GroundFrame(), &deskewer);
   proto::Scan scan = c.scan;
   const proto::GroundPlane plane = processor.Process(&scan);

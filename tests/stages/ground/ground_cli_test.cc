@@ -249,7 +249,7 @@ TEST(GroundCli, NonMonotonicImuIsAnError) {
   const Dataset data = WriteDataset(dir, false, true);
   std::string output;
   EXPECT_EQ(testing::RunCommand(Command(data, dir, data.params), &output), 1);
-  EXPECT_NE(output.find("imu.binpb: record 200"), std::string::npos) << output;
+  EXPECT_NE(output.find("imu.binpb: IMU sample 200"), std::string::npos) << output;
   EXPECT_FALSE(testing::FileExists(dir.File("ground.binpb")));
 }
 
