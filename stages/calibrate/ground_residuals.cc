@@ -321,4 +321,37 @@ Status AddGroundResiduals(const std::vector<proto::GroundPlane>& planes,
   return Status::Ok();
 }
 
+Status MakeGroundResidualAdder(
+    const std::vector<proto::GroundPlane>& planes, int64_t time_origin_ns, const proto::Rig& rig,
+    const proto::GravityReference* gravity, const proto::CalibrateParams& params,
+    const GroundLosses* losses, std::ostream* log,
+    std::function<Status(CalibrationState*, ceres::Problem*, int*)>* adder,
+    std::vector<std::string>* used, std::string* reason) {
+  *adder = nullptr;
+  used->clear();
+  const GroundSequenceInfo info = MakeGroundSequenceInfo(rig, gravity);
+  GroundResidualSelection selection;
+  TILTCAL_RETURN_IF_ERROR(SelectGroundResiduals(params, info, &selection));
+  if (planes.empty()) {
+    *reason = "ground residuals none: no ground planes given (" + selection.reason + ")";
+    return Status::Ok();
+  }
+  *reason = selection.reason;
+  if (!selection.any()) return Status::Ok();
+  if (selection.flat) used->push_back("flat");
+  if (selection.dist) used->push_back("dist");
+  if (selection.incl) used->push_back("incl");
+  if (selection.up) used->push_back("up");
+  *adder = [&planes, &params, losses, log, selection, info, time_origin_ns](
+               CalibrationState* state, ceres::Problem* problem, int* num_added) -> Status {
+    GroundResidualSummary summary;
+    TILTCAL_RETURN_IF_ERROR(AddGroundResiduals(planes, selection, params, info, *losses,
+                                               time_origin_ns, state, problem, &summary));
+    *num_added = summary.num_flat + summary.num_dist + summary.num_incl + summary.num_up;
+    if (log != nullptr) *log << "tiltcal_calibrate: " << summary.ToString() << "\n" << std::flush;
+    return Status::Ok();
+  };
+  return Status::Ok();
+}
+
 }  // namespace tiltcal::calibrate

@@ -42,7 +42,9 @@
 // d_l <= 0 or non-finite), or when t_k + tau is outside the spline.
 
 #include <cstdint>
+#include <functional>
 #include <memory>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -138,6 +140,22 @@ Status AddGroundResiduals(const std::vector<proto::GroundPlane>& planes,
                           const GroundLosses& losses, int64_t time_origin_ns,
                           CalibrationState* state, ceres::Problem* problem,
                           GroundResidualSummary* summary);
+
+// For tiltcal_calibrate: selects the residuals (SelectGroundResiduals on
+// MakeGroundSequenceInfo(rig, gravity)), names them in *used ("flat",
+// "dist", ...) and *reason (one line), and sets *adder to a function for
+// CalibrationProblem::AddExtraResiduals (same signature as
+// ExtraResidualAdder) that calls AddGroundResiduals on the current state and
+// reports the number of blocks added. *adder stays empty when nothing is
+// selected or there are no planes. planes, params, losses (and gravity, rig)
+// are referenced by the adder and must outlive it. log (may be null) gets one
+// line per call with the GroundResidualSummary.
+Status MakeGroundResidualAdder(
+    const std::vector<proto::GroundPlane>& planes, int64_t time_origin_ns, const proto::Rig& rig,
+    const proto::GravityReference* gravity, const proto::CalibrateParams& params,
+    const GroundLosses* losses, std::ostream* log,
+    std::function<Status(CalibrationState*, ceres::Problem*, int*)>* adder,
+    std::vector<std::string>* used, std::string* reason);
 
 }  // namespace tiltcal::calibrate
 

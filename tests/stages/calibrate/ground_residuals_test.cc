@@ -10,6 +10,8 @@
 // observe.
 
 #include <cmath>
+#include <functional>
+#include <string>
 #include <vector>
 
 #include <ceres/ceres.h>
@@ -442,6 +444,54 @@ TEST(GroundResidualsTest, DistAndUpRecoverTheirObservableDirections) {
     const Eigen::Vector3d err = geometry::BoxMinus(q, sc.q_bl);  // C_true^T C, frame l
     EXPECT_LT((err - err.dot(n_l) * n_l).norm(), 1e-6) << err.transpose();
   }
+}
+
+// The adder handed to the calibrate stage's problem builder.
+TEST(GroundResidualsTest, AdderForTheProblemBuilder) {
+  const Scenario sc;
+  const std::vector<proto::GroundPlane> planes = sc.Planes();
+  proto::Rig rig;
+  rig.set_imu_height_m(sc.d_b);
+  proto::GravityReference gravity;
+  gravity.set_is_level(false);
+  gravity.set_has_gravity_flat(true);
+  const Eigen::Vector3d g_f = sc.GravityFlat();
+  gravity.mutable_gravity_flat_in_imu()->set_x(g_f.x());
+  gravity.mutable_gravity_flat_in_imu()->set_y(g_f.y());
+  gravity.mutable_gravity_flat_in_imu()->set_z(g_f.z());
+  const proto::CalibrateParams params = UnitSigmaParams();
+  const GroundLosses losses(params);
+  std::function<Status(CalibrationState*, ceres::Problem*, int*)> adder;
+  std::vector<std::string> used;
+  std::string reason;
+  ASSERT_TRUE(MakeGroundResidualAdder(planes, kOriginNs, rig, &gravity, params, &losses, nullptr,
+                                      &adder, &used, &reason)
+                  .ok());
+  EXPECT_EQ(used, (std::vector<std::string>{"dist", "incl"}));
+  EXPECT_EQ(reason.rfind("ground residuals dist+incl: ", 0), 0u) << reason;
+  ASSERT_TRUE(static_cast<bool>(adder));
+  CalibrationState state(sc.Grid());
+  sc.FillState(&state);
+  ceres::Problem problem{ProblemOptions()};
+  AddStateBlocks(&state, &problem);
+  int added = 0;
+  ASSERT_TRUE(adder(&state, &problem, &added).ok());
+  EXPECT_EQ(added, 2 * static_cast<int>(planes.size()));
+  EXPECT_EQ(problem.NumResidualBlocks(), added);
+  // No planes: no adder, and the reason says why.
+  const std::vector<proto::GroundPlane> none;
+  ASSERT_TRUE(MakeGroundResidualAdder(none, kOriginNs, rig, &gravity, params, &losses, nullptr,
+                                      &adder, &used, &reason)
+                  .ok());
+  EXPECT_FALSE(static_cast<bool>(adder));
+  EXPECT_TRUE(used.empty());
+  EXPECT_NE(reason.find("no ground planes"), std::string::npos) << reason;
+  // ON without its input is an error here too.
+  proto::CalibrateParams on = params;
+  on.mutable_up()->set_mode(proto::GroundResidualParams::ON);
+  EXPECT_FALSE(MakeGroundResidualAdder(planes, kOriginNs, rig, nullptr, on, &losses, nullptr,
+                                       &adder, &used, &reason)
+                   .ok());
 }
 
 // ------------------------------------------------------------ selection
