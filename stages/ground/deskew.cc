@@ -35,9 +35,10 @@ bool Deskewer::Deskew(int64_t stamp_ns, const int32_t* time_offset_ns, size_t n,
     lo = std::min(lo, time_offset_ns[j]);
     hi = std::max(hi, time_offset_ns[j]);
   }
+  // All points at the stamp (no point times): already in the stamp's frame.
+  if (lo == 0 && hi == 0) return true;
   const int64_t t_ref = stamp_ns + time_offset_ns_;
   if (!Covers(t_ref + std::min<int64_t>(lo, 0), t_ref + std::max<int64_t>(hi, 0))) return false;
-  if (lo == 0 && hi == 0) return true;
 
   // Node k at offset lo + k·h: M_k = C_bl^T C_ab(t_ref)^T C_ab(t_k) C_bl.
   const int64_t h = node_spacing_ns_;

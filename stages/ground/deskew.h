@@ -28,7 +28,8 @@ class Deskewer {
   bool Covers(int64_t t0_ns, int64_t t1_ns) const;
 
   // Deskews the columns in place. Returns false (points untouched) when the
-  // IMU does not cover the sweep. time_offset_ns[j] is t_j − t_k.
+  // IMU does not cover the sweep; true without work when every offset is 0.
+  // time_offset_ns[j] is t_j − t_k.
   bool Deskew(int64_t stamp_ns, const int32_t* time_offset_ns, size_t n, float* x, float* y,
               float* z);
 
