@@ -6,6 +6,7 @@
 
 #include <gflags/gflags.h>
 
+#include "stages/inspect/ground_summary.h"
 #include "stages/inspect/inspect.h"
 #include "stages/inspect/pcd_export.h"
 
@@ -41,6 +42,10 @@ int main(int argc, char** argv) {
                                       std::cout);
   } else if (command == "csv") {
     status = tiltcal::inspect::RunCsv(path, {FLAGS_points, FLAGS_record, FLAGS_field}, std::cout);
+    // ground.binpb: rejected scans by reason on stderr (the table stays clean).
+    if (status.ok() && !FLAGS_points) {
+      status = tiltcal::inspect::PrintGroundSummary(path, std::cerr);
+    }
   } else if (command == "pcd") {
     status = tiltcal::inspect::RunPcd(path, {FLAGS_record, FLAGS_ground, FLAGS_out}, std::cerr);
   } else {

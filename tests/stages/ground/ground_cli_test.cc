@@ -163,8 +163,8 @@ TEST(GroundCli, InspectCsvAndPcdShowThePlanesAndLabels) {
 
   // CSV: dotted names of DESIGN §8, one row per plane, values as written.
   std::string csv;
-  ASSERT_EQ(testing::RunCommand(inspect + " csv " + dir.File("ground.binpb") + " 2>/dev/null",
-                                &csv), 0) << csv;
+  ASSERT_EQ(testing::RunCommand("(" + inspect + " csv " + dir.File("ground.binpb") +
+                                    " 2>/dev/null)", &csv), 0) << csv;
   std::vector<std::string> lines;
   for (size_t start = 0; start < csv.size();) {
     const size_t end = csv.find('\n', start);
@@ -194,6 +194,12 @@ TEST(GroundCli, InspectCsvAndPcdShowThePlanesAndLabels) {
     EXPECT_EQ(row[v], "1");
     EXPECT_EQ(lines[k + 1].find("nan"), std::string::npos);
   }
+
+  // The summary of rejections goes to stderr, not into the table.
+  std::string summary;
+  ASSERT_EQ(testing::RunCommand("(" + inspect + " csv " + dir.File("ground.binpb") +
+                                    " 2>&1 >/dev/null)", &summary), 0);
+  EXPECT_NE(summary.find("10 scans, 10 valid"), std::string::npos) << summary;
 
   // PCD of scan 2 (deskewed and raw) with labels from the ground masks.
   for (const std::string& scans : {dir.File("deskewed.binpb.lz4"), data.scans}) {
