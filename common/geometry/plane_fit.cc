@@ -223,4 +223,37 @@ PlaneFit FitPlaneRobust(const float* x, const float* y, const float* z, size_t n
   return fit;
 }
 
+PlaneFit FitPlaneRobustFrom(const float* x, const float* y, const float* z, size_t n,
+                            const Eigen::Vector3d& normal, double offset,
+                            const RobustPlaneOptions& options, std::vector<uint8_t>* inlier) {
+  inlier->assign(n, 0);
+  if (n == 0) return PlaneFit();
+  PlaneMoments moments(Eigen::Vector3d(x[0], y[0], z[0]));
+  SelectAndAccumulate(x, y, z, n, nullptr, normal, offset, options.inlier_distance_m,
+                      inlier->data(), &moments);
+  PlaneFit fit = FitPlane(moments, options.min_spread_m2);
+  for (int iter = 0; iter < options.max_iterations && fit.ok; ++iter) {
+    moments.Clear();
+    const bool changed = SelectAndAccumulate(x, y, z, n, nullptr, fit.normal, fit.offset,
+                                             options.inlier_distance_m, inlier->data(), &moments);
+    if (!changed) break;
+    fit = FitPlane(moments, options.min_spread_m2);
+  }
+  return fit;
+}
+
+size_t CountWithinBand(const float* x, const float* y, const float* z, size_t n, size_t stride,
+                       const Eigen::Vector3d& normal, double offset, double band) {
+  const float nx = static_cast<float>(normal.x()), ny = static_cast<float>(normal.y()),
+              nz = static_cast<float>(normal.z()), d = static_cast<float>(offset),
+              tau = static_cast<float>(band);
+  size_t count = 0;
+  stride = std::max<size_t>(stride, 1);
+  for (size_t k = 0; k < n; k += stride) {
+    const float dist = nx * x[k] + ny * y[k] + nz * z[k] + d;
+    count += (dist < tau && dist > -tau) ? 1 : 0;
+  }
+  return count;
+}
+
 }  // namespace tiltcal::geometry

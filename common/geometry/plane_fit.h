@@ -118,6 +118,17 @@ struct RobustPlaneOptions {
 PlaneFit FitPlaneRobust(const float* x, const float* y, const float* z, size_t n,
                         const RobustPlaneOptions& options, std::vector<uint8_t>* inlier);
 
+// As FitPlaneRobust, but starting from the plane n·p + d = 0 (unit n) with
+// the band at inlier_distance_m from the first round: a refinement of a
+// hypothesis that must not drift to a compromise between nearby surfaces.
+PlaneFit FitPlaneRobustFrom(const float* x, const float* y, const float* z, size_t n,
+                            const Eigen::Vector3d& normal, double offset,
+                            const RobustPlaneOptions& options, std::vector<uint8_t>* inlier);
+
+// Number of the points k = 0, stride, 2·stride, ... < n with |n·p + d| < band.
+size_t CountWithinBand(const float* x, const float* y, const float* z, size_t n, size_t stride,
+                       const Eigen::Vector3d& normal, double offset, double band);
+
 }  // namespace tiltcal::geometry
 
 #endif  // TILTCAL_COMMON_GEOMETRY_PLANE_FIT_H_

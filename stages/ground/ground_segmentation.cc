@@ -337,4 +337,14 @@ SegmentationSummary GroundSegmenter::Segment(const float* x, const float* y, con
   return summary;
 }
 
+void GroundSegmenter::GroundBinPlanes(double radius_m, std::vector<Eigen::Vector4d>* planes) const {
+  planes->clear();
+  const float r2 = static_cast<float>(radius_m * radius_m);
+  for (const Bin& bin : bins_) {
+    if (!bin.ground) continue;
+    if (bin.centroid.x() * bin.centroid.x() + bin.centroid.y() * bin.centroid.y() > r2) continue;
+    planes->emplace_back(bin.normal.x(), bin.normal.y(), bin.normal.z(), bin.offset);
+  }
+}
+
 }  // namespace tiltcal::ground

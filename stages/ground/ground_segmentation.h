@@ -66,6 +66,11 @@ class GroundSegmenter {
   const uint32_t* binned_source() const { return bsrc_.data(); }
   const uint8_t* binned_ground() const { return bground_.data(); }
 
+  // Planes (n_x, n_y, n_z, d) of the bins accepted as ground whose centroid
+  // lies within `radius_m` (horizontal), in bin order: plane hypotheses for
+  // the per-scan fit.
+  void GroundBinPlanes(double radius_m, std::vector<Eigen::Vector4d>* planes) const;
+
  private:
   struct Bin {
     bool ok = false;

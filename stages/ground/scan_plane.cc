@@ -102,8 +102,34 @@ ScanPlane ScanPlaneFitter::Fit(const GroundSegmenter& segmenter,
   geometry::RobustPlaneOptions options;
   options.inlier_distance_m = params_.inlier_distance_m();
   options.max_iterations = static_cast<int>(params_.fit_iterations());
-  out.fit = geometry::FitPlaneRobust(cx_.data(), cy_.data(), cz_.data(), cx_.size(), options,
-                                     &fit_inlier_);
+  // Plane hypotheses: the accepted ground bins near the sensor; the one with
+  // the most candidates within hypothesis_band_m (scored on at most ~1024
+  // evenly spaced candidates) is refined with a fixed band, so a kerb or a
+  // raised sidewalk cannot pull the fit to a compromise. Without hypotheses:
+  // robust fit from the least-squares plane of all candidates.
+  segmenter.GroundBinPlanes(radius, &hypotheses_);
+  const size_t m = cx_.size();
+  const size_t stride = std::max<size_t>(1, m / 1024);
+  size_t best_score = 0;
+  int best = -1;
+  for (size_t h = 0; h < hypotheses_.size(); ++h) {
+    const Eigen::Vector4d& plane = hypotheses_[h];
+    const size_t score =
+        geometry::CountWithinBand(cx_.data(), cy_.data(), cz_.data(), m, stride, plane.head<3>(),
+                                  plane(3), params_.hypothesis_band_m());
+    if (score > best_score) {
+      best_score = score;
+      best = static_cast<int>(h);
+    }
+  }
+  if (best >= 0) {
+    out.fit = geometry::FitPlaneRobustFrom(cx_.data(), cy_.data(), cz_.data(), m,
+                                           hypotheses_[best].head<3>(), hypotheses_[best](3),
+                                           options, &fit_inlier_);
+  } else {
+    out.fit = geometry::FitPlaneRobust(cx_.data(), cy_.data(), cz_.data(), m, options,
+                                       &fit_inlier_);
+  }
   if (!out.fit.ok) {
     out.reason = proto::GROUND_FIT_FAILED;
     out.detail = Format("degenerate plane from %.0f points", candidates_.size());

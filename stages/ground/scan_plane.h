@@ -49,6 +49,7 @@ class ScanPlaneFitter {
   std::vector<uint32_t> candidates_;   // binned index of each candidate
   std::vector<float> cx_, cy_, cz_;     // candidate coordinates, contiguous
   std::vector<uint32_t> histogram_;     // horizontal ranges, 5 cm bins
+  std::vector<Eigen::Vector4d> hypotheses_;  // ground bin planes (n, d)
   std::vector<uint8_t> fit_inlier_;
   std::vector<uint32_t> sector_count_;
 };

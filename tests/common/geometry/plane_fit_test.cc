@@ -179,6 +179,39 @@ TEST(PlaneFit, RobustFitIgnoresOutliers) {
             static_cast<int64_t>(std::count(inlier.begin(), inlier.end(), uint8_t{1})));
 }
 
+TEST(PlaneFit, RefinementFromAHypothesisStaysOnItsSurface) {
+  // A road and a sidewalk 15 cm higher beside it: plain trimming from the
+  // least-squares plane may settle between them; starting from a road
+  // hypothesis with a fixed band keeps the road.
+  std::mt19937 rng(8);
+  std::uniform_real_distribution<double> ux(-8.0, 8.0), uy_road(-6.0, 2.5), uy_walk(2.5, 6.0);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  Cloud c;
+  for (int i = 0; i < 3000; ++i) c.Add(Eigen::Vector3d(ux(rng), uy_road(rng), -0.9 + noise(rng)));
+  for (int i = 0; i < 1500; ++i) c.Add(Eigen::Vector3d(ux(rng), uy_walk(rng), -0.75 + noise(rng)));
+  RobustPlaneOptions options;
+  options.inlier_distance_m = 0.08;
+  options.max_iterations = 10;
+  std::vector<uint8_t> inlier;
+  const Eigen::Vector3d hypothesis = Eigen::Vector3d(0.0, 0.01, 1.0).normalized();
+  const PlaneFit fit = FitPlaneRobustFrom(c.x.data(), c.y.data(), c.z.data(), c.size(),
+                                          hypothesis, 0.9, options, &inlier);
+  ASSERT_TRUE(fit.ok);
+  EXPECT_LT(std::acos(std::min(1.0, fit.normal.z())) * 180.0 / M_PI, 0.05);
+  EXPECT_NEAR(fit.offset, 0.9, 0.002);
+  EXPECT_EQ(fit.num_points, 3000);
+  // Scoring: the road hypothesis has more support than the sidewalk one.
+  const size_t road = CountWithinBand(c.x.data(), c.y.data(), c.z.data(), c.size(), 1,
+                                      Eigen::Vector3d::UnitZ(), 0.9, 0.05);
+  const size_t walk = CountWithinBand(c.x.data(), c.y.data(), c.z.data(), c.size(), 1,
+                                      Eigen::Vector3d::UnitZ(), 0.75, 0.05);
+  EXPECT_EQ(road, 3000u);
+  EXPECT_EQ(walk, 1500u);
+  EXPECT_EQ(CountWithinBand(c.x.data(), c.y.data(), c.z.data(), c.size(), 3,
+                            Eigen::Vector3d::UnitZ(), 0.9, 0.05),
+            1000u);
+}
+
 TEST(PlaneFit, SelectAndAccumulateMatchesAPlainLoop) {
   std::mt19937 rng(6);
   const Eigen::Vector3d n = Eigen::Vector3d(0.02, -0.05, 1.0).normalized();

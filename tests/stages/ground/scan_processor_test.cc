@@ -174,6 +174,22 @@ TEST(ScanProcessor, CovarianceIsPositiveAndMasksMatchCounts) {
   EXPECT_EQ(inlier_off_ground, 0);
 }
 
+TEST(ScanProcessor, RaisedSidewalkDoesNotTiltTheRoadPlane) {
+  // A 15 cm kerb and sidewalk along one side of the road (labelled ground by
+  // the segmentation, as in Patchwork++): the robust fit keeps the road.
+  SyntheticScene scene = StreetScene(12);
+  scene.boxes.emplace_back(Eigen::Vector3d(-60.0, 2.5, 0.0), Eigen::Vector3d(60.0, 6.0, 0.15));
+  ScanProcessor processor(DefaultGroundParams(), GroundFrame(), nullptr);
+  SyntheticPose pose;
+  pose.position_g = Eigen::Vector3d(0.0, 0.0, 0.85);
+  pose.g_from_lidar = RollPitchYaw(0.01, -0.02, 0.0);
+  proto::Scan scan = CastScan(scene, SyntheticLidar::Vlp16(), pose, 1, 12);
+  const proto::GroundPlane plane = processor.Process(&scan);
+  ASSERT_TRUE(plane.valid()) << plane.reject_detail();
+  EXPECT_LT(AngleDeg(NormalOf(plane), TrueNormal(pose)), 0.1);
+  EXPECT_NEAR(plane.height_m(), 0.85, 0.005);
+}
+
 TEST(ScanProcessor, NoGroundAllWallsIsRejected) {
   SyntheticScene scene;
   scene.ground = false;
