@@ -172,27 +172,31 @@ bool SelectAndAccumulate(const float* x, const float* y, const float* z, size_t 
 }
 
 float MeanOfLowest(const float* v, size_t n, const uint8_t* active, size_t k, float floor) {
-  // Max-heap of the k smallest values so far.
-  float heap[64];
+  // Candidates below a threshold T; when the buffer is full, keep its k
+  // smallest and lower T to the k-th (amortised O(1) per value whatever the
+  // order of the values, e.g. a bin whose points come highest first).
   k = std::min<size_t>(std::max<size_t>(k, 1), 64);
+  const size_t capacity = 4 * k;
+  float buffer[256];
   size_t count = 0;
+  float threshold = std::numeric_limits<float>::infinity();
   for (size_t i = 0; i < n; ++i) {
     if (active != nullptr && !active[i]) continue;
     const float value = v[i];
-    if (!(value >= floor)) continue;
-    if (count < k) {
-      heap[count++] = value;
-      std::push_heap(heap, heap + count);
-    } else if (value < heap[0]) {
-      std::pop_heap(heap, heap + k);
-      heap[k - 1] = value;
-      std::push_heap(heap, heap + k);
+    if (!(value >= floor) || !(value < threshold)) continue;
+    buffer[count++] = value;
+    if (count == capacity) {
+      std::nth_element(buffer, buffer + (k - 1), buffer + capacity);
+      threshold = buffer[k - 1];
+      count = k;
     }
   }
   if (count == 0) return std::numeric_limits<float>::quiet_NaN();
+  if (count > k) std::nth_element(buffer, buffer + (k - 1), buffer + count);
+  const size_t used = std::min(count, k);
   double sum = 0.0;
-  for (size_t j = 0; j < count; ++j) sum += heap[j];
-  return static_cast<float>(sum / static_cast<double>(count));
+  for (size_t j = 0; j < used; ++j) sum += buffer[j];
+  return static_cast<float>(sum / static_cast<double>(used));
 }
 
 PlaneFit FitPlaneRobust(const float* x, const float* y, const float* z, size_t n,

@@ -1,6 +1,7 @@
 #include "common/geometry/plane_fit.h"
 
 #include <algorithm>
+#include <functional>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -251,6 +252,22 @@ TEST(PlaneFit, MeanOfLowestMatchesSorting) {
   EXPECT_NEAR(MeanOfLowest(v.data(), v.size(), nullptr, 20, -2.5f), expected / 20.0, 1e-5);
   EXPECT_TRUE(std::isnan(MeanOfLowest(v.data(), v.size(), nullptr, 20, 5.0f)));
   EXPECT_NEAR(MeanOfLowest(v.data(), 3, nullptr, 20, -10.0f), (v[0] + v[1] + v[2]) / 3.0, 1e-6);
+  // Values in decreasing and increasing order, with an activity mask.
+  std::vector<float> sorted_desc = v;
+  std::sort(sorted_desc.begin(), sorted_desc.end(), std::greater<float>());
+  std::vector<uint8_t> active(v.size(), 1);
+  active[v.size() - 1] = 0;  // the smallest value is inactive
+  std::vector<float> expected_values(sorted_desc.begin(), sorted_desc.end() - 1);
+  std::sort(expected_values.begin(), expected_values.end());
+  double expected_active = 0.0;
+  for (int i = 0; i < 20; ++i) expected_active += expected_values[i];
+  EXPECT_NEAR(MeanOfLowest(sorted_desc.data(), sorted_desc.size(), active.data(), 20, -10.0f),
+              expected_active / 20.0, 1e-5);
+  std::vector<float> sorted_asc(sorted_desc.rbegin(), sorted_desc.rend());
+  double expected_all = 0.0;
+  for (int i = 0; i < 20; ++i) expected_all += sorted_asc[i];
+  EXPECT_NEAR(MeanOfLowest(sorted_asc.data(), sorted_asc.size(), nullptr, 20, -10.0f),
+              expected_all / 20.0, 1e-5);
 }
 
 }  // namespace
