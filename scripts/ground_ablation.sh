@@ -1,0 +1,161 @@
+#!/usr/bin/env bash
+# Ground-residual ablation (issue 6 item 4): simulates a level and a tilted
+# (8 deg pitch, 3 deg roll) sequence with the Husky-like rig, runs decode,
+# ground and gravity once per sequence, then tiltcal_calibrate once per
+# ground-residual set (params overrides: each residual forced ON or OFF), and
+# prints the errors against the simulation truth: rotation (deg), translation
+# per axis (cm), time offset (ms). Then the misinitialisation study: the same
+# on the tilted sequence with the rig's r_b^{lb} off by [-0.6, 1.0, 0.6] m.
+#
+# The tilted sequence takes its flat-ground gravity g_f from the level run
+# (rig gravity_reference -> level/gravity.txtpb), as a real dataset would.
+#
+#   scripts/ground_ablation.sh [BIN_DIR]
+#   ABLATION_DIR=/tmp/ablation ABLATION_DURATION_S=30 ABLATION_SETS="none dist" \
+#     ABLATION_MISINIT=0 scripts/ground_ablation.sh build-x/bin
+#
+# Outputs in $ABLATION_DIR: the sequences, runs/<name>/{calibration,truth}.txtpb,
+# errors.csv (tiltcal_report), table.txt (what is printed).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+ROOT=$(pwd)
+BIN=$(cd "${1:-$ROOT/build/bin}" && pwd)
+WORK=${ABLATION_DIR:-/tmp/tiltcal_ground_ablation}
+DURATION_S=${ABLATION_DURATION_S:-30}
+SETS=${ABLATION_SETS:-"none flat dist incl dist+incl dist+up flat+dist"}
+MISINIT=${ABLATION_MISINIT:-1}
+MISINIT_SETS=${ABLATION_MISINIT_SETS:-"none dist incl dist+incl dist+up"}
+MISINIT_OFFSET=(-0.6 1.0 0.6)  # m, added to the rig's r_b^{lb}
+
+for tool in simulate decode ground gravity calibrate report; do
+  [ -x "$BIN/tiltcal_$tool" ] || { echo "ground_ablation: $BIN/tiltcal_$tool missing (build it)" >&2; exit 1; }
+done
+mkdir -p "$WORK"
+log() { echo "ground_ablation: $*" >&2; }
+
+# --- sequences ----------------------------------------------------------------
+
+prepare() {  # name base_scenario
+  local name=$1 base=$2 dir=$WORK/$1
+  if [ -s "$dir/gravity.txtpb" ]; then log "$name: reusing $dir"; return; fi
+  mkdir -p "$dir"
+  sed -E -e "s/^duration_s: .*/duration_s: $DURATION_S/" -e "s/^num_threads: .*/num_threads: 2/" \
+    "$base" > "$dir/scenario.txtpb"
+  log "$name: simulate ($DURATION_S s)"
+  "$BIN/tiltcal_simulate" --quiet --params="$dir/scenario.txtpb" --out_bag="$dir/seq.bag" \
+    --out_truth="$dir/truth.txtpb" --out_rig="$dir/rig.txtpb"
+  if [ "$name" = tilted ]; then
+    # g_f from the level run.
+    sed -i -E '/^gravity_reference:/d' "$dir/rig.txtpb"
+    echo 'gravity_reference: "../level/gravity.txtpb"' >> "$dir/rig.txtpb"
+  fi
+  log "$name: decode, ground, gravity"
+  "$BIN/tiltcal_decode" --bag="$dir/seq.bag" --rig="$dir/rig.txtpb" \
+    --params="$ROOT/stages/decode/default_params.txtpb" \
+    --out_imu="$dir/imu.binpb" --out_scans="$dir/scans.binpb.lz4"
+  "$BIN/tiltcal_ground" --imu="$dir/imu.binpb" --scans="$dir/scans.binpb.lz4" --rig="$dir/rig.txtpb" \
+    --params="$ROOT/stages/ground/default_params.txtpb" --out_ground="$dir/ground.binpb"
+  "$BIN/tiltcal_gravity" --imu="$dir/imu.binpb" --ground="$dir/ground.binpb" --rig="$dir/rig.txtpb" \
+    --params="$ROOT/stages/gravity/default_params.txtpb" --out="$dir/gravity.txtpb"
+}
+
+# Calibrate params with every ground residual forced ON or OFF: "none",
+# "flat", "dist+incl", ... Rewrites the mode of each residual's line of the
+# default params (a field may not be given twice in text format).
+write_params() {  # set out_file
+  local set=$1 out=$2 script=()
+  for r in flat dist incl up; do
+    local mode=OFF
+    [[ "+$set+" == *"+$r+"* ]] && mode=ON
+    script+=(-e "s/^$r \\{ mode: [A-Z]+/$r { mode: $mode/")
+  done
+  sed -E "${script[@]}" "$ROOT/stages/calibrate/default_params.txtpb" > "$out"
+  for r in flat dist incl up; do
+    grep -q "^$r { mode: " "$out" || { log "no '$r { mode: ...' line in the default params"; exit 1; }
+  done
+}
+
+# The rig with r_b^{lb} moved by MISINIT_OFFSET (the translation block of
+# imu_from_lidar as written by tiltcal_simulate).
+write_misinit_rig() {  # rig_in rig_out
+  awk -v ox="${MISINIT_OFFSET[0]}" -v oy="${MISINIT_OFFSET[1]}" -v oz="${MISINIT_OFFSET[2]}" '
+    /translation[[:space:]]*\{/ { in_t = 1 }
+    in_t && match($0, /^[[:space:]]*[xyz]:/) {
+      split($0, kv, ":"); key = kv[1]; gsub(/[[:space:]]/, "", key)
+      v = kv[2] + (key == "x" ? ox : key == "y" ? oy : oz)
+      sub(/:.*/, ": " sprintf("%.6f", v)); done[key] = 1
+    }
+    in_t && /\}/ { in_t = 0 }
+    { print }
+    END { if (!(done["x"] && done["y"] && done["z"])) exit 3 }' "$1" > "$2"
+}
+
+calibrate() {  # run_name sequence set rig
+  local run=$1 seq=$2 set=$3 rig=$4 dir=$WORK/runs/$1 seqdir=$WORK/$2
+  mkdir -p "$dir"
+  if [ -s "$dir/calibration.txtpb" ]; then return; fi
+  write_params "$set" "$dir/params.txtpb"
+  local start=$SECONDS
+  if ! "$BIN/tiltcal_calibrate" --quiet --imu="$seqdir/imu.binpb" --scans="$seqdir/scans.binpb.lz4" \
+      --ground="$seqdir/ground.binpb" --gravity="$seqdir/gravity.txtpb" --rig="$rig" \
+      --params="$dir/params.txtpb" --out="$dir/calibration.txtpb" 2> "$dir/stderr.txt"; then
+    log "$run: calibrate failed: $(tail -1 "$dir/stderr.txt")"
+    return
+  fi
+  echo $((SECONDS - start)) > "$dir/seconds.txt"
+  cp "$seqdir/truth.txtpb" "$dir/truth.txtpb"
+  log "$run: $((SECONDS - start)) s"
+}
+
+prepare level "$ROOT/stages/simulate/scenarios/flat_vlp16.txtpb"
+prepare tilted "$ROOT/stages/simulate/scenarios/tilted_husky_vlp16.txtpb"
+for f in level tilted; do
+  log "$f: $(grep -E '^(is_level|level_statistic|has_gravity_flat):' "$WORK/$f/gravity.txtpb" | tr '\n' ' ')"
+done
+
+RUNS=()
+for seq in level tilted; do
+  for set in $SETS; do
+    calibrate "${seq}__$set" "$seq" "$set" "$WORK/$seq/rig.txtpb"
+    RUNS+=("${seq}__$set")
+  done
+done
+if [ "$MISINIT" = 1 ]; then
+  write_misinit_rig "$WORK/tilted/rig.txtpb" "$WORK/tilted/rig_misinit.txtpb"
+  for set in $MISINIT_SETS; do
+    calibrate "misinit__$set" tilted "$set" "$WORK/tilted/rig_misinit.txtpb"
+    RUNS+=("misinit__$set")
+  done
+fi
+
+# --- table --------------------------------------------------------------------
+
+DIRS=()
+for run in "${RUNS[@]}"; do
+  [ -s "$WORK/runs/$run/calibration.txtpb" ] && DIRS+=("$WORK/runs/$run")
+done
+[ ${#DIRS[@]} -gt 0 ] || { log "no calibration succeeded"; exit 1; }
+"$BIN/tiltcal_report" --out="$WORK/report.txt" --out_csv="$WORK/errors.csv" --title=ablation \
+  "${DIRS[@]}" > /dev/null
+
+{
+  echo "Ground-residual ablation: ${DURATION_S} s Husky-like VLP-16 sequences (level; tilted 8 deg pitch, 3 deg roll)."
+  echo "Errors = estimate - truth. misinit: tilted, rig r_b^{lb} off by [${MISINIT_OFFSET[*]}] m."
+  echo "Measured rig (initial guess) is off by (0.5, -0.7, 1.5) deg and (2, -3, 2.5) cm."
+  echo
+  printf '%-8s %-11s %9s %8s %8s %8s %9s %6s  %s\n' sequence residuals rot_deg dx_cm dy_cm dz_cm tau_ms time_s "ground residuals used"
+  for run in "${RUNS[@]}"; do
+    seq=${run%%__*}
+    set=${run#*__}
+    dir=$WORK/runs/$run
+    if [ ! -s "$dir/calibration.txtpb" ]; then
+      printf '%-8s %-11s %s\n' "$seq" "$set" "FAILED: $(tail -1 "$dir/stderr.txt" 2>/dev/null)"
+      continue
+    fi
+    used=$({ grep -E '^ground_residuals_used:' "$dir/calibration.txtpb" || true; } |
+      sed -E 's/.*"(.*)"/\1/' | paste -sd+ -)
+    awk -F, -v name="$run" -v seq="$seq" -v set="$set" -v secs="$(cat "$dir/seconds.txt")" -v used="${used:-none}" '
+      $1 == name { printf "%-8s %-11s %9.3f %8.2f %8.2f %8.2f %9.3f %6d  %s\n", seq, set, $9, $10, $11, $12, $13, secs, used }' \
+      "$WORK/errors.csv"
+  done
+} | tee "$WORK/table.txt"
