@@ -1,4 +1,9 @@
-#include "stages/calibrate/imu_initialisation.h"
+// Oracle tests (analytic ZYX kinematics, simulated bias and noise) of the IMU
+// initialisation the calibrator uses (common/imu).
+#include "common/imu/gyro_integrator.h"
+#include "common/imu/imu_initialisation.h"
+#include "common/imu/imu_reading.h"
+#include "common/imu/static_detection.h"
 
 #include <cmath>
 #include <random>
@@ -7,6 +12,16 @@
 
 namespace tiltcal::calibrate {
 namespace {
+
+using imu::DetectStaticStart;
+using imu::GyroIntegrator;
+using imu::ImuInitialisation;
+using imu::ImuInitialisationOptions;
+using imu::ImuReading;
+using imu::InitialiseImu;
+using imu::StaticDetectionOptions;
+using imu::StaticInterval;
+using imu::ValidateImuReadings;
 
 constexpr double kDegToRad = M_PI / 180.0;
 
@@ -76,7 +91,7 @@ std::vector<ImuReading> SimulateImu(const EulerMotion& motion, double duration_s
   return out;
 }
 
-TEST(GyroIntegratorTest, MatchesAnalyticAttitudeAtAndBetweenSamples) {
+TEST(CalibrateGyroIntegratorTest, MatchesAnalyticAttitudeAtAndBetweenSamples) {
   EulerMotion m;
   m.yaw_amp = 1.2;
   m.yaw_w = 0.9;
@@ -103,7 +118,7 @@ TEST(GyroIntegratorTest, MatchesAnalyticAttitudeAtAndBetweenSamples) {
   EXPECT_LT(RotationErrorDeg(integrator.RelativeRotation(102.0, 107.5), rel), 0.01);
 }
 
-TEST(GyroIntegratorTest, RemovesTheGivenBias) {
+TEST(CalibrateGyroIntegratorTest, RemovesTheGivenBias) {
   EulerMotion m;  // static
   const Eigen::Vector3d bias(0.01, -0.02, 0.005);
   const std::vector<ImuReading> samples = SimulateImu(m, 5.0, 100.0, bias, 0.0, 0.0, 2);
@@ -113,7 +128,7 @@ TEST(GyroIntegratorTest, RemovesTheGivenBias) {
   EXPECT_NEAR(Eigen::AngleAxisd(without.Rotation(104.9)).angle(), bias.norm() * 4.9, 1e-9);
 }
 
-TEST(ImuReadingsTest, RejectsNonMonotonicAndNonFinite) {
+TEST(CalibrateImuReadingsTest, RejectsNonMonotonicAndNonFinite) {
   std::vector<ImuReading> samples(3);
   samples[0].time_s = 0.0;
   samples[1].time_s = 0.01;
@@ -129,7 +144,7 @@ TEST(ImuReadingsTest, RejectsNonMonotonicAndNonFinite) {
   EXPECT_FALSE(InitialiseImu({}, ImuInitialisationOptions(), &init).ok());
 }
 
-TEST(ImuInitialisationTest, StaticStartGivesBiasAndGravityWithinNoise) {
+TEST(CalibrateImuInitialisationTest, StaticStartGivesBiasAndGravityWithinNoise) {
   EulerMotion m;
   m.start_s = 3.0;  // static for 3 s, then turning and rocking
   m.yaw0 = 0.4;
@@ -160,10 +175,9 @@ TEST(ImuInitialisationTest, StaticStartGivesBiasAndGravityWithinNoise) {
   EXPECT_NEAR(init.gravity_in_world_mps2.norm(), 9.81, 1e-9);
   EXPECT_LT(AngleBetweenDeg(init.gravity_in_world_mps2, g_truth), 0.05);
   EXPECT_NEAR(init.accel_norm_mismatch_mps2, 0.0, 0.01);
-  EXPECT_EQ(init.accel_bias_mps2, Eigen::Vector3d::Zero());
 }
 
-TEST(ImuInitialisationTest, DetectsNoStaticStartWhenMovingAndFallsBack) {
+TEST(CalibrateImuInitialisationTest, DetectsNoStaticStartWhenMovingAndFallsBack) {
   EulerMotion m;
   m.start_s = -1.0;  // already moving at the first sample
   m.pitch0 = 2.0 * kDegToRad;
@@ -188,7 +202,7 @@ TEST(ImuInitialisationTest, DetectsNoStaticStartWhenMovingAndFallsBack) {
   EXPECT_NEAR(init.averaging_end_s - init.averaging_begin_s, 2.0, 0.01);
 }
 
-TEST(ImuInitialisationTest, ShortStaticStartIsNotUsed) {
+TEST(CalibrateImuInitialisationTest, ShortStaticStartIsNotUsed) {
   EulerMotion m;
   m.start_s = 0.6;  // shorter than min_duration_s = 1 s
   m.yaw_amp = 0.8;
