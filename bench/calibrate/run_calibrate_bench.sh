@@ -1,0 +1,93 @@
+#!/usr/bin/env bash
+# tiltcal_calibrate benchmark (issue 5 item 8, DESIGN §6): simulates a
+# sequence (default: the 60 s, 200 Hz, VLP-16 flat-ground Husky sequence
+# stages/simulate/scenarios/flat_vlp16.txtpb), runs decode -> ground ->
+# gravity -> calibrate, and prints
+#   - wall and cpu time per stage and the calibrator's own phases
+#     (from calibration.txtpb: init, odometry, map, association, solve, ...);
+#   - seconds per LM iteration and the problem size (knots, residuals by kind);
+#   - the errors against the simulator's truth: rotation (deg), translation
+#     per axis of b and in the plane of motion (cm), tau (ms).
+# Anchor measured in the same run: the sequence length (x_realtime = 60 s /
+# calibrate wall). Targets of issue 5: whole stage <= 60 s wall on 2 cores,
+# <= 0.25 s per LM iteration.
+#
+# Usage: bench/calibrate/run_calibrate_bench.sh [options]
+#   --build_dir DIR    build with the stage binaries (default <repo>/build-bench)
+#   --scratch DIR      work directory (default /tmp/tiltcal_calibrate_bench)
+#   --scenario FILE    simulate params (default flat_vlp16.txtpb)
+#   --model MODEL      override the LiDAR model (VLP_16, VLP_32C, OS1_32)
+#   --params FILE      calibrate params (default stages/calibrate/default_params.txtpb)
+#   --threads N        num_threads of the calibrator (default 2)
+set -euo pipefail
+
+REPO=$(cd "$(dirname "$0")/../.." && pwd)
+BUILD_DIR="$REPO/build-bench"
+SCRATCH=/tmp/tiltcal_calibrate_bench
+SCENARIO="$REPO/stages/simulate/scenarios/flat_vlp16.txtpb"
+MODEL=""
+PARAMS="$REPO/stages/calibrate/default_params.txtpb"
+THREADS=2
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --build_dir) BUILD_DIR=$2; shift 2 ;;
+    --scratch) SCRATCH=$2; shift 2 ;;
+    --scenario) SCENARIO=$2; shift 2 ;;
+    --model) MODEL=$2; shift 2 ;;
+    --params) PARAMS=$2; shift 2 ;;
+    --threads) THREADS=$2; shift 2 ;;
+    -h|--help) sed -n '2,/^set -euo/p' "$0" | sed '$d'; exit 0 ;;
+    *) echo "run_calibrate_bench: unknown argument $1" >&2; exit 2 ;;
+  esac
+done
+
+TARGETS="tiltcal_simulate tiltcal_decode tiltcal_ground tiltcal_gravity tiltcal_calibrate"
+if [ ! -x "$BUILD_DIR/bin/tiltcal_calibrate" ]; then
+  cmake -S "$REPO" -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
+  cmake --build "$BUILD_DIR" --target $TARGETS -j2
+fi
+BIN="$BUILD_DIR/bin"
+mkdir -p "$SCRATCH"
+W="$SCRATCH"
+
+scenario="$W/scenario.txtpb"
+if [ -n "$MODEL" ]; then
+  sed -e "s/^  model: .*/  model: $MODEL/" "$SCENARIO" > "$scenario"
+else
+  cp "$SCENARIO" "$scenario"
+fi
+sed -e "s/^num_threads: .*/num_threads: $THREADS/" "$PARAMS" > "$W/calibrate_params.txtpb"
+
+now() { date +%s.%N; }
+declare -A WALL CPU
+run() {  # name, command...
+  local name=$1; shift
+  local t0 t1
+  t0=$(now)
+  /usr/bin/time -f "%U %S" -o "$W/time_$name.txt" "$@" 2> "$W/log_$name.txt" || {
+    echo "run_calibrate_bench: $name failed:" >&2; tail -5 "$W/log_$name.txt" >&2; exit 1; }
+  t1=$(now)
+  WALL[$name]=$(echo "$t1 - $t0" | bc -l)
+  CPU[$name]=$(awk '{print $1 + $2}' "$W/time_$name.txt")
+}
+
+run simulate "$BIN/tiltcal_simulate" --params="$scenario" --out_bag="$W/seq.bag" \
+  --out_truth="$W/truth.txtpb" --out_rig="$W/rig.txtpb"
+run decode "$BIN/tiltcal_decode" --bag="$W/seq.bag" --params="$REPO/stages/decode/default_params.txtpb" \
+  --rig="$W/rig.txtpb" --out_imu="$W/imu.binpb" --out_scans="$W/scans.binpb.lz4"
+run ground "$BIN/tiltcal_ground" --imu="$W/imu.binpb" --scans="$W/scans.binpb.lz4" --rig="$W/rig.txtpb" \
+  --params="$REPO/stages/ground/default_params.txtpb" --out_ground="$W/ground.binpb"
+run gravity "$BIN/tiltcal_gravity" --imu="$W/imu.binpb" --ground="$W/ground.binpb" --rig="$W/rig.txtpb" \
+  --params="$REPO/stages/gravity/default_params.txtpb" --out="$W/gravity.txtpb"
+run calibrate "$BIN/tiltcal_calibrate" --imu="$W/imu.binpb" --scans="$W/scans.binpb.lz4" \
+  --ground="$W/ground.binpb" --gravity="$W/gravity.txtpb" --rig="$W/rig.txtpb" \
+  --params="$W/calibrate_params.txtpb" --out="$W/calibration.txtpb"
+
+echo "scenario: $SCENARIO ${MODEL:+(model $MODEL)}, calibrator threads: $THREADS, nproc: $(nproc)"
+printf '%-10s %9s %9s\n' stage wall_s cpu_s
+for s in simulate decode ground gravity calibrate; do
+  printf '%-10s %9.2f %9.2f\n' "$s" "${WALL[$s]}" "${CPU[$s]}"
+done
+python3 "$REPO/bench/calibrate/calibration_errors.py" "$W/calibration.txtpb" "$W/truth.txtpb" \
+  "$W/rig.txtpb" "${WALL[calibrate]}"
+echo "stderr of tiltcal_calibrate: $W/log_calibrate.txt"

@@ -1,0 +1,135 @@
+#include "stages/calibrate/covariance_report.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <utility>
+
+#include <ceres/covariance.h>
+
+#include <Eigen/Eigenvalues>
+
+namespace tiltcal::calibrate {
+
+MotionAxis PrincipalRotationAxis(const std::vector<imu::ImuReading>& samples,
+                                 const Eigen::Vector3d& gyro_bias_radps) {
+  Eigen::Matrix3d s = Eigen::Matrix3d::Zero();
+  for (const imu::ImuReading& r : samples) {
+    const Eigen::Vector3d w = r.angular_velocity_radps - gyro_bias_radps;
+    s += w * w.transpose();
+  }
+  MotionAxis out;
+  if (s.trace() <= 0.0) return out;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(s);
+  out.axis_b = eig.eigenvectors().col(2);
+  int k = 0;
+  out.axis_b.cwiseAbs().maxCoeff(&k);
+  if (out.axis_b[k] < 0.0) out.axis_b = -out.axis_b;
+  out.fraction = eig.eigenvalues()[2] / s.trace();
+  return out;
+}
+
+Status ComputeExtrinsicCovariance(ceres::Problem* problem, CalibrationState* state,
+                                  int num_threads, Matrix7d* covariance) {
+  covariance->setZero();
+  double* rot = state->imu_from_lidar_rotation;
+  double* trans = state->imu_from_lidar_translation;
+  double* tau = state->time_offset_s;
+  for (double* b : {rot, trans, tau}) {
+    if (!problem->HasParameterBlock(b)) {
+      return Status::Error("covariance: the extrinsic / time offset is not in the problem");
+    }
+  }
+  ceres::Covariance::Options options;
+  options.algorithm_type = ceres::SPARSE_QR;
+  options.num_threads = std::max(1, num_threads);
+  options.apply_loss_function = true;
+  ceres::Covariance cov(options);
+  std::vector<std::pair<const double*, const double*>> blocks = {
+      {rot, rot}, {rot, trans}, {rot, tau}, {trans, trans}, {trans, tau}, {tau, tau}};
+  if (!cov.Compute(blocks, problem)) {
+    return Status::Error("covariance: the Jacobian is rank deficient or the factorisation failed");
+  }
+  Eigen::Matrix<double, 7, 7, Eigen::RowMajor> m;
+  if (!cov.GetCovarianceMatrixInTangentSpace({rot, trans, tau}, m.data())) {
+    return Status::Error("covariance: could not read the covariance blocks");
+  }
+  *covariance = m;
+  return Status::Ok();
+}
+
+std::string DescribeDirection(const Eigen::Vector3d& v) {
+  int k = 0;
+  v.cwiseAbs().maxCoeff(&k);
+  char buf[96];
+  std::snprintf(buf, sizeof(buf), "%c (%.2f, %.2f, %.2f)", "xyz"[k], v.x(), v.y(), v.z());
+  return buf;
+}
+
+namespace {
+
+// Eigen-directions of a 3x3 covariance block, largest sigma first.
+void AddGroup(const Eigen::Matrix3d& cov_block, const Eigen::Matrix3d& to_b, int offset,
+              double scale, double threshold, const char* what, const char* unit,
+              const MotionAxis& motion, proto::CalibrationResult* result) {
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(0.5 * (cov_block + cov_block.transpose()));
+  for (int i = 2; i >= 0; --i) {
+    const double sigma = std::sqrt(std::max(0.0, eig.eigenvalues()[i])) * scale;
+    Eigen::Vector3d v = eig.eigenvectors().col(i);
+    const Eigen::Vector3d v_b = to_b * v;
+    const double cos_axis = std::abs(v_b.dot(motion.axis_b));
+    proto::ObservabilityDirection* d = result->add_observability();
+    for (int j = 0; j < 7; ++j) d->add_direction(0.0);
+    for (int j = 0; j < 3; ++j) d->set_direction(offset + j, v[j]);
+    d->set_sigma(sigma);
+    d->set_weak(sigma > threshold);
+    const double angle_deg = std::acos(std::min(1.0, cos_axis)) * 180.0 / M_PI;
+    char buf[256];
+    std::snprintf(buf, sizeof(buf), "%s along b-%s, %.0f deg from the motion's rotation axis%s: "
+                  "sigma %.4g %s%s",
+                  what, DescribeDirection(v_b).c_str(), angle_deg,
+                  angle_deg < 30.0 ? " (along the rotation axis)"
+                                   : (angle_deg > 60.0 ? " (in the plane of rotation)" : ""),
+                  sigma, unit, sigma > threshold ? " -- WEAK" : "");
+    d->set_description(buf);
+  }
+}
+
+}  // namespace
+
+void FillCovarianceReport(const Matrix7d& covariance, const Eigen::Matrix3d& c_bl,
+                          const MotionAxis& motion, const ObservabilityThresholds& thresholds,
+                          proto::CalibrationResult* result) {
+  result->clear_covariance();
+  for (int i = 0; i < 7; ++i) {
+    for (int j = 0; j < 7; ++j) result->add_covariance(covariance(i, j));
+  }
+  const double rad_to_deg = 180.0 / M_PI;
+  proto::Vector3* rs = result->mutable_rotation_sigma_deg();
+  rs->set_x(std::sqrt(std::max(0.0, covariance(0, 0))) * rad_to_deg);
+  rs->set_y(std::sqrt(std::max(0.0, covariance(1, 1))) * rad_to_deg);
+  rs->set_z(std::sqrt(std::max(0.0, covariance(2, 2))) * rad_to_deg);
+  proto::Vector3* ts = result->mutable_translation_sigma_m();
+  ts->set_x(std::sqrt(std::max(0.0, covariance(3, 3))));
+  ts->set_y(std::sqrt(std::max(0.0, covariance(4, 4))));
+  ts->set_z(std::sqrt(std::max(0.0, covariance(5, 5))));
+  result->set_time_offset_sigma_s(std::sqrt(std::max(0.0, covariance(6, 6))));
+
+  result->clear_observability();
+  // Marginal covariance of each group is the corresponding block.
+  AddGroup(covariance.block<3, 3>(0, 0), c_bl, 0, rad_to_deg, thresholds.rotation_sigma_deg,
+           "rotation", "deg", motion, result);
+  AddGroup(covariance.block<3, 3>(3, 3), Eigen::Matrix3d::Identity(), 3, 1.0,
+           thresholds.translation_sigma_m, "translation", "m", motion, result);
+  const double tau_sigma = std::sqrt(std::max(0.0, covariance(6, 6)));
+  proto::ObservabilityDirection* d = result->add_observability();
+  for (int j = 0; j < 7; ++j) d->add_direction(j == 6 ? 1.0 : 0.0);
+  d->set_sigma(tau_sigma);
+  d->set_weak(tau_sigma > thresholds.time_offset_sigma_s);
+  char buf[128];
+  std::snprintf(buf, sizeof(buf), "time offset: sigma %.4g s%s", tau_sigma,
+                tau_sigma > thresholds.time_offset_sigma_s ? " -- WEAK" : "");
+  d->set_description(buf);
+}
+
+}  // namespace tiltcal::calibrate

@@ -1,0 +1,76 @@
+#ifndef TILTCAL_STAGES_CALIBRATE_COVARIANCE_REPORT_H_
+#define TILTCAL_STAGES_CALIBRATE_COVARIANCE_REPORT_H_
+
+// Covariance of the calibration (C_bl, r_b^{lb}, tau) from the final
+// Jacobian, and the observability report (DESIGN §5).
+//
+// Covariance: ceres::Covariance (SPARSE_QR, robust loss applied) of the
+// blocks C_bl, r_b^{lb}, tau in the TANGENT space, 7x7 in the order
+//   (delta_C [3, rad], delta_r [3, m], delta_tau [1, s])
+// with the right perturbation C_bl <- C_bl Exp(delta_C): delta_C is a
+// rotation vector in the LiDAR frame l. Residuals are weighted by 1/sigma, so
+// this is (J^T J)^{-1} of the weighted problem with everything else
+// (trajectory, gravity, biases) marginalised.
+//
+// Observability: the marginal information of each group is eigen-decomposed
+// separately (mixing rad, m and s in one decomposition would depend on units):
+// rotation 3x3 (sigma in deg, directions in l then reported in b),
+// translation 3x3 (sigma in m, frame b) and tau (s). A direction is weak when
+// its sigma exceeds the threshold of its group. Each is named by its angle to
+// the principal rotation axis of the motion (the dominant eigenvector of
+// sum omega omega^T of the bias-corrected gyro, frame b): for a ground
+// vehicle on a plane, translation along that axis (vertical) is the weak one
+// without ground residuals.
+
+#include <string>
+#include <vector>
+
+#include <ceres/problem.h>
+
+#include <Eigen/Core>
+
+#include "common/imu/imu_reading.h"
+#include "common/status.h"
+#include "stages/calibrate/calibration_state.h"
+#include "tiltcal/proto/calibration.pb.h"
+
+namespace tiltcal::calibrate {
+
+using Matrix7d = Eigen::Matrix<double, 7, 7>;
+
+// Principal rotation axis of the motion in the IMU frame b (unit; sign with
+// a non-negative largest component) and the fraction of sum |omega|^2 about
+// it (1 = rotation about one axis only).
+struct MotionAxis {
+  Eigen::Vector3d axis_b = Eigen::Vector3d::UnitZ();
+  double fraction = 0.0;
+};
+MotionAxis PrincipalRotationAxis(const std::vector<imu::ImuReading>& samples,
+                                 const Eigen::Vector3d& gyro_bias_radps);
+
+// Fills *covariance (7x7 as above). Errors (rank deficiency, failure of the
+// factorisation) are returned as Status for the report; they are data, not a
+// failure of the stage.
+Status ComputeExtrinsicCovariance(ceres::Problem* problem, CalibrationState* state,
+                                  int num_threads, Matrix7d* covariance);
+
+struct ObservabilityThresholds {
+  double rotation_sigma_deg = 0.1;
+  double translation_sigma_m = 0.01;
+  double time_offset_sigma_s = 0.001;
+};
+
+// Writes covariance, rotation_sigma_deg, translation_sigma_m,
+// time_offset_sigma_s and the observability directions into *result.
+// c_bl: the estimated C_bl (to express rotation directions in b).
+void FillCovarianceReport(const Matrix7d& covariance, const Eigen::Matrix3d& c_bl,
+                          const MotionAxis& motion, const ObservabilityThresholds& thresholds,
+                          proto::CalibrationResult* result);
+
+// "x", "y", "z" of the dominant component and the direction, e.g.
+// "(0.01, -0.02, 1.00)".
+std::string DescribeDirection(const Eigen::Vector3d& v);
+
+}  // namespace tiltcal::calibrate
+
+#endif  // TILTCAL_STAGES_CALIBRATE_COVARIANCE_REPORT_H_

@@ -1,0 +1,346 @@
+#include "stages/calibrate/initialisation.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include <ceres/sized_cost_function.h>
+
+#include <Eigen/Eigenvalues>
+
+#include "common/imu/gyro_integrator.h"
+#include "common/spline/cubic_basis.h"
+#include "common/spline/so3_spline.h"
+#include "stages/calibrate/problem_builder.h"
+
+namespace tiltcal::calibrate {
+namespace {
+
+double Seconds(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// r = (sum_j b_j(u) p_{s+j} - p_measured) / sigma   (3), position knots s..s+3.
+class PositionSampleCost final : public ceres::SizedCostFunction<3, 3, 3, 3, 3> {
+ public:
+  PositionSampleCost(double u, double inv_dt, const Eigen::Vector3d& measured, double sigma)
+      : basis_(spline::UniformCubicBasis(u, inv_dt)), measured_(measured), inv_sigma_(1.0 / sigma) {}
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    Eigen::Vector3d p = -measured_;
+    for (int j = 0; j < 4; ++j) p += basis_.value[j] * Eigen::Map<const Eigen::Vector3d>(parameters[j]);
+    Eigen::Map<Eigen::Vector3d> r(residuals);
+    r = inv_sigma_ * p;
+    if (jacobians != nullptr) {
+      for (int j = 0; j < 4; ++j) {
+        if (jacobians[j] == nullptr) continue;
+        Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> jac(jacobians[j]);
+        jac = (inv_sigma_ * basis_.value[j]) * Eigen::Matrix3d::Identity();
+      }
+    }
+    return true;
+  }
+
+ private:
+  spline::CubicBasis basis_;
+  Eigen::Vector3d measured_;
+  double inv_sigma_;
+};
+
+ProblemOptions FitOptions(const InitialisationOptions& options) {
+  ProblemOptions p;
+  p.gyro_sigma_radps = options.gyro_sigma_radps;
+  p.accel_sigma_mps2 = options.accel_sigma_mps2;
+  p.estimate_extrinsic = false;
+  p.estimate_time_offset = false;
+  p.estimate_gravity = false;
+  p.estimate_biases = false;
+  return p;
+}
+
+double RmsResidual(const ceres::Solver::Summary& summary) {
+  return summary.num_residuals > 0 ? std::sqrt(2.0 * summary.final_cost / summary.num_residuals)
+                                   : 0.0;
+}
+
+// Linear interpolation of (times, values) at t, clamped at the ends.
+Eigen::Vector3d Interpolate(const std::vector<double>& times,
+                            const std::vector<Eigen::Vector3d>& values, double t) {
+  if (t <= times.front()) return values.front();
+  if (t >= times.back()) return values.back();
+  const size_t i = std::upper_bound(times.begin(), times.end(), t) - times.begin();
+  const double f = (t - times[i - 1]) / (times[i] - times[i - 1]);
+  return (1.0 - f) * values[i - 1] + f * values[i];
+}
+
+}  // namespace
+
+Eigen::Quaterniond AlignRotationAxes(const std::vector<RotationPair>& pairs,
+                                     const Eigen::Quaterniond& imu_from_lidar) {
+  Eigen::Matrix3d mb = Eigen::Matrix3d::Zero(), ml = Eigen::Matrix3d::Zero();
+  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> phis;
+  for (const RotationPair& p : pairs) {
+    const Eigen::AngleAxisd ab(p.imu_delta), al(p.lidar_delta);
+    const Eigen::Vector3d phi_b = ab.angle() * ab.axis();
+    const Eigen::Vector3d phi_l = al.angle() * al.axis();
+    mb += phi_b * phi_b.transpose();
+    ml += phi_l * phi_l.transpose();
+    phis.emplace_back(phi_b, phi_l);
+  }
+  if (mb.trace() <= 0.0 || ml.trace() <= 0.0) return imu_from_lidar;
+  const Eigen::Vector3d a_b = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(mb).eigenvectors().col(2);
+  Eigen::Vector3d a_l = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(ml).eigenvectors().col(2);
+  double corr = 0.0;
+  for (const auto& [pb, pl] : phis) corr += pb.dot(a_b) * pl.dot(a_l);
+  if (corr < 0.0) a_l = -a_l;
+  const Eigen::Vector3d mapped = imu_from_lidar * a_l;
+  return (Eigen::Quaterniond::FromTwoVectors(mapped, a_b) * imu_from_lidar).normalized();
+}
+
+double SearchTimeOffset(const CalibrationState& state, const std::vector<double>& scan_times_s,
+                        const std::vector<Eigen::Quaterniond>& lidar_rotations, double bound_s,
+                        double step_s) {
+  const Eigen::Quaterniond c_bl = state.ImuFromLidarRotation();
+  const spline::SplineTrajectory& traj = state.trajectory;
+  // b-frame rotation vectors of consecutive LiDAR poses.
+  std::vector<Eigen::Vector3d> phi_l;
+  std::vector<std::pair<double, double>> spans;
+  for (size_t k = 0; k + 1 < scan_times_s.size(); ++k) {
+    const Eigen::AngleAxisd d(lidar_rotations[k].conjugate() * lidar_rotations[k + 1]);
+    phi_l.push_back(c_bl * (d.angle() * d.axis()));
+    spans.emplace_back(scan_times_s[k], scan_times_s[k + 1]);
+  }
+  auto cost = [&](double tau) {
+    double sum = 0.0;
+    spline::So3SplineSample r0, r1;
+    for (size_t k = 0; k < phi_l.size(); ++k) {
+      if (!traj.Evaluate(spans[k].first + tau, spline::kSo3Rotation, &r0, nullptr) ||
+          !traj.Evaluate(spans[k].second + tau, spline::kSo3Rotation, &r1, nullptr)) {
+        sum += phi_l[k].squaredNorm();  // same penalty for every tau: skip-like
+        continue;
+      }
+      const Eigen::AngleAxisd d(Eigen::Quaterniond(r0.rotation.transpose() * r1.rotation));
+      sum += (d.angle() * d.axis() - phi_l[k]).squaredNorm();
+    }
+    return sum;
+  };
+  if (phi_l.empty() || step_s <= 0.0) return 0.0;
+  const int n = static_cast<int>(std::floor(bound_s / step_s));
+  int best = 0;
+  double best_cost = cost(0.0);
+  std::vector<double> costs(2 * n + 1);
+  for (int i = -n; i <= n; ++i) {
+    costs[i + n] = cost(i * step_s);
+    if (costs[i + n] < best_cost) {
+      best_cost = costs[i + n];
+      best = i;
+    }
+  }
+  double tau = best * step_s;
+  // Parabola through the neighbours.
+  if (best > -n && best < n) {
+    const double c0 = costs[best + n - 1], c1 = costs[best + n], c2 = costs[best + n + 1];
+    const double den = c0 - 2.0 * c1 + c2;
+    if (den > 0.0) tau += 0.5 * step_s * (c0 - c2) / den;
+  }
+  return tau;
+}
+
+double FitRotationSplineToGyro(const std::vector<imu::ImuReading>& imu_samples,
+                               const InitialisationOptions& options, CalibrationState* state) {
+  spline::SplineTrajectory& traj = state->trajectory;
+  const spline::UniformKnotGrid& grid = traj.grid();
+  const imu::GyroIntegrator integrator(imu_samples, state->GyroBias());
+  // Knot i sits (approximately) at t0 + (i - 1) dt for a cubic B-spline.
+  for (int i = 0; i < traj.num_knots(); ++i) {
+    traj.SetRotationKnot(i, integrator.Rotation(grid.t0_s() + (i - 1) * grid.dt_s()));
+  }
+  CalibrationProblem problem(state, FitOptions(options));
+  problem.AddImuResiduals(imu_samples, /*gyro=*/true, /*accel=*/false);
+  problem.RemoveUnusedKnots();
+  ceres::Solver::Options solver =
+      MakeSolverOptions(options.solver_iterations, options.num_threads, 1e-10);
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver, problem.problem(), &summary);
+  return RmsResidual(summary);
+}
+
+double FitPositionSpline(const std::vector<double>& times_s,
+                         const std::vector<Eigen::Vector3d>& positions_a,
+                         const std::vector<imu::ImuReading>& imu_samples,
+                         const InitialisationOptions& options, CalibrationState* state) {
+  spline::SplineTrajectory& traj = state->trajectory;
+  const spline::UniformKnotGrid& grid = traj.grid();
+  if (times_s.empty()) return 0.0;
+  for (int i = 0; i < traj.num_knots(); ++i) {
+    traj.SetPositionKnot(i, Interpolate(times_s, positions_a, grid.t0_s() + (i - 1) * grid.dt_s()));
+  }
+  CalibrationProblem problem(state, FitOptions(options));
+  problem.SetRotationKnotsConstant();
+  problem.AddImuResiduals(imu_samples, /*gyro=*/false, /*accel=*/true);
+  const double sigma = options.position_sigma_m;
+  Status status = problem.AddExtraResiduals(
+      [&](CalibrationState* s, ceres::Problem* p, int* added) {
+        for (size_t k = 0; k < times_s.size(); ++k) {
+          spline::KnotWindow w;
+          if (!grid.Locate(times_s[k], &w)) continue;
+          const int f = w.first_knot;
+          p->AddResidualBlock(new PositionSampleCost(w.u, grid.inv_dt(), positions_a[k], sigma),
+                              nullptr, s->trajectory.position_knot(f),
+                              s->trajectory.position_knot(f + 1),
+                              s->trajectory.position_knot(f + 2),
+                              s->trajectory.position_knot(f + 3));
+          ++*added;
+        }
+        return Status::Ok();
+      });
+  (void)status;
+  problem.RemoveUnusedKnots();
+  ceres::Solver::Options solver =
+      MakeSolverOptions(options.solver_iterations, options.num_threads, 1e-10);
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver, problem.problem(), &summary);
+  return RmsResidual(summary);
+}
+
+Status InitialiseState(const std::vector<imu::ImuReading>& imu_samples,
+                       const std::vector<LidarScan>& scans, const Rigid3d& measured_imu_from_lidar,
+                       const InitialisationOptions& options, CalibrationState* state,
+                       InitialisationReport* report) {
+  *report = InitialisationReport();
+  // 1. IMU: gyro bias, gravity.
+  auto start = std::chrono::steady_clock::now();
+  TILTCAL_RETURN_IF_ERROR(imu::InitialiseImu(imu_samples, options.imu, &report->imu));
+  state->SetGyroBias(report->imu.gyro_bias_radps);
+  state->SetAccelBias(Eigen::Vector3d::Zero());
+  state->SetGravityDirection(report->imu.gravity_in_world_mps2);
+  state->SetImuFromLidarRotation(measured_imu_from_lidar.rotation);
+  state->SetImuFromLidarTranslation(measured_imu_from_lidar.translation);
+  state->time_offset_s[0] = 0.0;
+  report->imu_seconds = Seconds(start);
+
+  // 2. Rotation spline from the gyro.
+  start = std::chrono::steady_clock::now();
+  report->gyro_fit_rms = FitRotationSplineToGyro(imu_samples, options, state);
+  report->rotation_fit_seconds = Seconds(start);
+
+  // 3. Odometry on scans deskewed with the rotation spline (positions are
+  // still zero, so only rotation and the lever arm move the points).
+  start = std::chrono::steady_clock::now();
+  LidarOdometry odometry(options.odometry);
+  const spline::SplineTrajectory& traj = state->trajectory;
+  const Eigen::Quaterniond c_bl = state->ImuFromLidarRotation();
+  std::vector<int> scan_of_pose;
+  std::vector<Eigen::Quaterniond> imu_rotations;
+  ScanPoseTable table;
+  std::vector<Eigen::Vector3f> deskewed;
+  bool have_first = false;
+  Eigen::Quaterniond c_ab_first = Eigen::Quaterniond::Identity();
+  const size_t scan_step = static_cast<size_t>(std::max(1, options.odometry_scan_step));
+  for (size_t k = 0; k < scans.size(); k += scan_step) {
+    const LidarScan& scan = scans[k];
+    if (scan.points.empty()) continue;
+    spline::So3SplineSample rot;
+    if (!traj.Evaluate(scan.stamp_s, spline::kSo3Rotation, &rot, nullptr)) continue;
+    if (!table.Build(*state, scan, options.deskew_node_spacing_s)) continue;
+    const Eigen::Quaterniond c_ab_k(rot.rotation);
+    if (!have_first) {
+      c_ab_first = c_ab_k;
+      have_first = true;
+    }
+    // T_{lk a} T_{a l(t_j)} p.
+    Eigen::Quaterniond q_k;
+    Eigen::Vector3d t_k;
+    table.Interpolate(0.0, &q_k, &t_k);
+    const Eigen::Quaterniond q_k_inv = q_k.conjugate();
+    deskewed.resize(scan.points.size());
+    for (size_t j = 0; j < scan.points.size(); ++j) {
+      Eigen::Quaterniond q;
+      Eigen::Vector3d t;
+      table.Interpolate(scan.point_time_s[j], &q, &t);
+      deskewed[j] = (q_k_inv * (q * scan.points[j].cast<double>() + t - t_k)).cast<float>();
+    }
+    odometry.AddScan(scan.stamp_s, deskewed, LidarRotationPriorFromImu(c_ab_first, c_ab_k, c_bl));
+    scan_of_pose.push_back(static_cast<int>(k));
+    imu_rotations.push_back(c_ab_k);
+  }
+  const std::vector<LidarOdometryPose>& poses = odometry.poses();
+  report->odometry_scans = static_cast<int>(poses.size());
+  report->odometry_seconds = Seconds(start);
+  if (poses.size() < 2) {
+    return Status::Error("too few scans inside the IMU time range for the LiDAR odometry (" +
+                         std::to_string(poses.size()) + ")");
+  }
+
+  // 4. Extrinsic rotation: rig, or hand-eye when excited.
+  std::vector<Eigen::Quaterniond> imu_reg, lidar_reg;
+  double fitness = 0.0;
+  for (size_t i = 0; i < poses.size(); ++i) {
+    if (i > 0 && !poses[i].registered) continue;
+    if (i > 0) {
+      ++report->odometry_registered;
+      fitness += poses[i].fitness_rms_m;
+    }
+    imu_reg.push_back(imu_rotations[i]);
+    lidar_reg.push_back(Eigen::Quaterniond(poses[i].l0_from_lidar.rotation()));
+  }
+  if (report->odometry_registered > 0) {
+    report->odometry_mean_fitness_m = fitness / report->odometry_registered;
+  }
+  report->hand_eye = EstimateHandEyeRotation(
+      MakeRotationPairs(imu_reg, lidar_reg, std::max(1, options.hand_eye_pair_step)),
+      options.hand_eye);
+  Eigen::Quaterniond c_bl_init =
+      ChooseInitialRotation(measured_imu_from_lidar.rotation, report->hand_eye);
+  report->rotation_from_hand_eye = report->hand_eye.excited;
+  if (!report->rotation_from_hand_eye && options.align_rotation_axis) {
+    // Planar motion: the rotation axis is still seen by both sensors.
+    const std::vector<RotationPair> pairs =
+        MakeRotationPairs(imu_reg, lidar_reg, std::max(1, options.hand_eye_pair_step));
+    const Eigen::Quaterniond aligned = AlignRotationAxes(pairs, c_bl_init);
+    const double correction_deg =
+        Eigen::AngleAxisd(aligned * c_bl_init.conjugate()).angle() * 180.0 / M_PI;
+    if (correction_deg <= options.max_axis_alignment_deg) {
+      c_bl_init = aligned;
+      report->axis_alignment_deg = correction_deg;
+      report->axis_alignment_applied = true;
+    }
+  }
+  state->SetImuFromLidarRotation(c_bl_init);
+
+  // Coarse tau from consecutive odometry rotations against the gyro spline.
+  if (options.time_offset_search_s > 0.0) {
+    std::vector<double> times_reg;
+    for (size_t i = 0; i < poses.size(); ++i) {
+      if (i > 0 && !poses[i].registered) continue;
+      times_reg.push_back(scans[scan_of_pose[i]].stamp_s);
+    }
+    report->time_offset_init_s =
+        SearchTimeOffset(*state, times_reg, lidar_reg, options.time_offset_search_s,
+                         options.time_offset_search_step_s);
+    state->time_offset_s[0] = report->time_offset_init_s;
+  }
+
+  // 5. Position spline from the odometry and the accelerometer.
+  start = std::chrono::steady_clock::now();
+  const Eigen::Matrix3d c_bl_m = c_bl_init.toRotationMatrix();
+  const Eigen::Vector3d r_bl = state->ImuFromLidarTranslation();
+  std::vector<double> times;
+  std::vector<Eigen::Vector3d> positions;
+  for (size_t i = 0; i < poses.size(); ++i) {
+    if (i > 0 && !poses[i].registered) continue;
+    const Eigen::Vector3d r_odo = poses[i].l0_from_lidar.translation();
+    // IMU time of the scan with the coarse tau; C_ab there from the spline.
+    const double t_imu = scans[scan_of_pose[i]].stamp_s + state->time_offset_s[0];
+    spline::So3SplineSample rot;
+    if (!traj.Evaluate(t_imu, spline::kSo3Rotation, &rot, nullptr)) continue;
+    times.push_back(t_imu);
+    positions.push_back(c_ab_first * (c_bl_m * r_odo + r_bl) - rot.rotation * r_bl);
+  }
+  report->position_fit_rms = FitPositionSpline(times, positions, imu_samples, options, state);
+  report->position_fit_seconds = Seconds(start);
+  return Status::Ok();
+}
+
+}  // namespace tiltcal::calibrate

@@ -1,0 +1,121 @@
+#ifndef TILTCAL_STAGES_CALIBRATE_INITIALISATION_H_
+#define TILTCAL_STAGES_CALIBRATE_INITIALISATION_H_
+
+// Initial values of the calibration state that survive planar motion
+// (issue 5 item 4), in this order:
+//  1. gyro bias and g_a from the static start or the first seconds
+//     (common/imu/imu_initialisation.h); accelerometer bias 0;
+//  2. rotation spline C_ab(t): knots from the integrated gyro
+//     (knot i at t0 + (i - 1) dt), then an LM fit to the gyro residuals with
+//     the bias held (rotation knot 0 held: gauge);
+//  3. LiDAR odometry (lidar_odometry.h, GICP or NDT) on scans deskewed with
+//     that rotation spline and the rig's C_bl (tau = 0), giving T_{l0 lk};
+//  4. extrinsic: the rig's measured (C_bl, r_b^{lb}) (the paper's protocol);
+//     hand-eye rotation (hand_eye_rotation.h) replaces C_bl only when its
+//     excitation measure says the motion is rich enough; otherwise (planar
+//     motion) the rig's C_bl is only tilted so that the LiDAR's principal
+//     rotation axis maps onto the IMU's (AlignRotationAxes: fixes the two
+//     tilt angles, keeps the rig's angle about the axis);
+//  4b. coarse tau by a grid search of the odometry's scan-to-scan rotations
+//     against the gyro spline (SearchTimeOffset);
+//  5. position spline r_a^{ba}(t): with C_ab from step 2, the odometry gives
+//     the IMU positions at the scan times,
+//       r_a(t_k) = C_ab(t_f) (C_bl r_{l0}^{lk l0} + r_b^{lb}) - C_ab(t_k) r_b^{lb}
+//     (t_f: the first registered scan, r_a(t_f) taken as 0; scan k at IMU
+//     time t_k + tau), fitted by LM together with the accelerometer
+//     residuals (rotation, gravity, biases held).
+// The odometry registers every odometry_scan_step-th scan.
+
+#include <vector>
+
+#include "common/imu/imu_initialisation.h"
+#include "common/imu/imu_reading.h"
+#include "common/io/eigen_proto.h"
+#include "common/status.h"
+#include "stages/calibrate/calibration_state.h"
+#include "stages/calibrate/hand_eye_rotation.h"
+#include "stages/calibrate/lidar_odometry.h"
+#include "stages/calibrate/lidar_scans.h"
+
+namespace tiltcal::calibrate {
+
+struct InitialisationOptions {
+  imu::ImuInitialisationOptions imu;
+  LidarOdometryOptions odometry;
+  HandEyeOptions hand_eye;
+  int hand_eye_pair_step = 5;        // odometry poses between the two of a rotation pair
+  int odometry_scan_step = 1;        // register every this-many-th scan
+  double gyro_sigma_radps = 0.01;
+  double accel_sigma_mps2 = 0.05;
+  double position_sigma_m = 0.05;    // odometry position samples
+  double deskew_node_spacing_s = 0.005;
+  int solver_iterations = 10;
+  int num_threads = 1;
+  // Without hand-eye excitation, turn the rig's C_bl by the smallest
+  // rotation that maps the LiDAR's principal rotation axis onto the IMU's
+  // (AlignRotationAxes), if that rotation is at most max_axis_alignment_deg.
+  bool align_rotation_axis = true;
+  double max_axis_alignment_deg = 10.0;
+  // Coarse tau: grid search over [-time_offset_search_s, +...] (0 = off).
+  double time_offset_search_s = 0.05;
+  double time_offset_search_step_s = 0.001;
+};
+
+struct InitialisationReport {
+  imu::ImuInitialisation imu;
+  HandEyeResult hand_eye;
+  bool rotation_from_hand_eye = false;
+  int odometry_scans = 0;
+  int odometry_registered = 0;
+  double odometry_mean_fitness_m = 0.0;
+  double gyro_fit_rms = 0.0;      // RMS weighted gyro residual after the fit
+  double position_fit_rms = 0.0;  // RMS weighted residual of the position fit
+  bool axis_alignment_applied = false;
+  double axis_alignment_deg = 0.0;  // correction of the rig's C_bl by the axis alignment
+  double time_offset_init_s = 0.0;  // coarse tau
+  double imu_seconds = 0.0;
+  double rotation_fit_seconds = 0.0;
+  double odometry_seconds = 0.0;
+  double position_fit_seconds = 0.0;
+};
+
+// Fills *state (whose grid covers the IMU samples) from the IMU samples
+// (times relative to the first sample), the raw scans and the rig's
+// measured extrinsic.
+Status InitialiseState(const std::vector<imu::ImuReading>& imu_samples,
+                       const std::vector<LidarScan>& scans, const Rigid3d& measured_imu_from_lidar,
+                       const InitialisationOptions& options, CalibrationState* state,
+                       InitialisationReport* report);
+
+// Rotation-axis alignment for planar motion: with a_b, a_l the principal
+// axes (dominant eigenvectors of sum phi phi^T, phi = Log of the relative
+// rotations, signs matched by their correlation) of the IMU and LiDAR
+// relative rotations, returns R * C_bl with R the smallest rotation taking
+// C_bl a_l to a_b. Fixes the two tilt angles of C_bl; the angle about the
+// axis stays the rig's.
+Eigen::Quaterniond AlignRotationAxes(const std::vector<RotationPair>& pairs,
+                                     const Eigen::Quaterniond& imu_from_lidar);
+
+// Coarse tau: minimises sum_k |Log(C_ab(t_k+tau)^T C_ab(t_{k+1}+tau)) -
+// C_bl Log(C_{l0 lk}^T C_{l0 l(k+1)})|^2 over consecutive scans on a grid of
+// step_s over [-bound_s, bound_s], refined by a parabola.
+double SearchTimeOffset(const CalibrationState& state, const std::vector<double>& scan_times_s,
+                        const std::vector<Eigen::Quaterniond>& lidar_rotations, double bound_s,
+                        double step_s);
+
+// Step 2 alone: knots from the integrated gyro (bias = state's b_g), then the
+// gyro-only LM fit. Returns the RMS weighted gyro residual.
+double FitRotationSplineToGyro(const std::vector<imu::ImuReading>& imu_samples,
+                               const InitialisationOptions& options, CalibrationState* state);
+
+// Step 5 alone: position knots from IMU positions r_a(t) at IMU times (knots
+// first interpolated linearly, then the LM fit with the accelerometer).
+// Returns the RMS weighted residual.
+double FitPositionSpline(const std::vector<double>& times_s,
+                         const std::vector<Eigen::Vector3d>& positions_a,
+                         const std::vector<imu::ImuReading>& imu_samples,
+                         const InitialisationOptions& options, CalibrationState* state);
+
+}  // namespace tiltcal::calibrate
+
+#endif  // TILTCAL_STAGES_CALIBRATE_INITIALISATION_H_

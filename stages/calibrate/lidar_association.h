@@ -1,0 +1,52 @@
+#ifndef TILTCAL_STAGES_CALIBRATE_LIDAR_ASSOCIATION_H_
+#define TILTCAL_STAGES_CALIBRATE_LIDAR_ASSOCIATION_H_
+
+// One outer iteration's LiDAR data association (issue 5 item 5): every raw
+// scan is mapped to frame a with the current state (each point at its own
+// time, ScanPoseTable), the points go into a voxel surfel map
+// (surfel_map.h: planarity gate, PCA plane fit), and a subsample of the
+// points is associated with the surfel of its voxel:
+//   - only every association_stride-th stored point of a scan is tried;
+//   - at most max_points_per_surfel_per_scan points per surfel and scan
+//     (evenly spaced when more qualify);
+//   - at most max_residuals_per_scan per scan (evenly spaced).
+// The associations keep the raw LiDAR-frame point and its LiDAR time, so the
+// residual moves with the trajectory, the extrinsic and tau.
+
+#include <vector>
+
+#include "common/status.h"
+#include "stages/calibrate/calibration_state.h"
+#include "stages/calibrate/lidar_scans.h"
+#include "stages/calibrate/problem_builder.h"
+#include "stages/calibrate/surfel_map.h"
+
+namespace tiltcal::calibrate {
+
+struct AssociationStageOptions {
+  SurfelMapOptions map;
+  double max_distance_m = 0.05;
+  int association_stride = 7;
+  int max_points_per_surfel_per_scan = 2;
+  int max_residuals_per_scan = 64;
+  double node_spacing_s = 0.005;
+};
+
+struct AssociationStageSummary {
+  SurfelExtractionSummary map;
+  int scans_mapped = 0;
+  long long points_mapped = 0;
+  int residuals = 0;
+  int surfels_used = 0;
+  double map_seconds = 0.0;
+  double associate_seconds = 0.0;
+};
+
+void BuildMapAndAssociate(const CalibrationState& state, const std::vector<LidarScan>& scans,
+                          const AssociationStageOptions& options,
+                          std::vector<LidarPointResidual>* residuals,
+                          AssociationStageSummary* summary);
+
+}  // namespace tiltcal::calibrate
+
+#endif  // TILTCAL_STAGES_CALIBRATE_LIDAR_ASSOCIATION_H_

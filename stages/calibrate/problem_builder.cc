@@ -1,0 +1,238 @@
+#include "stages/calibrate/problem_builder.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "common/spline/so3_spline.h"
+#include "stages/calibrate/accel_cost_function.h"
+#include "stages/calibrate/gyro_cost_function.h"
+#include "stages/calibrate/point_to_plane_cost_function.h"
+
+namespace tiltcal::calibrate {
+namespace {
+
+// r = (t - t_prior) / sigma  (3).
+class TranslationPriorCost final : public ceres::SizedCostFunction<3, 3> {
+ public:
+  TranslationPriorCost(const Eigen::Vector3d& prior, double sigma)
+      : prior_(prior), inv_sigma_(1.0 / sigma) {}
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    for (int i = 0; i < 3; ++i) residuals[i] = (parameters[0][i] - prior_[i]) * inv_sigma_;
+    if (jacobians != nullptr && jacobians[0] != nullptr) {
+      for (int i = 0; i < 9; ++i) jacobians[0][i] = (i % 4 == 0) ? inv_sigma_ : 0.0;
+    }
+    return true;
+  }
+
+ private:
+  Eigen::Vector3d prior_;
+  double inv_sigma_;
+};
+
+}  // namespace
+
+CalibrationProblem::CalibrationProblem(CalibrationState* state, const ProblemOptions& options)
+    : state_(state), options_(options) {
+  if (options_.lidar_cauchy_scale > 0.0) {
+    lidar_loss_ = std::make_unique<ceres::CauchyLoss>(options_.lidar_cauchy_scale);
+  }
+  ceres::Problem::Options problem_options;
+  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  problem_options.cost_function_ownership = ceres::TAKE_OWNERSHIP;
+  problem_ = std::make_unique<ceres::Problem>(problem_options);
+  ceres::Problem& p = *problem_;
+
+  spline::SplineTrajectory& traj = state_->trajectory;
+  for (int i = 0; i < traj.num_knots(); ++i) {
+    p.AddParameterBlock(traj.rotation_knot(i), 4, &quaternion_manifold_);
+    p.AddParameterBlock(traj.position_knot(i), 3);
+  }
+  // Gauge: the first knots.
+  if (options_.fix_first_knots) {
+    p.SetParameterBlockConstant(traj.rotation_knot(0));
+    p.SetParameterBlockConstant(traj.position_knot(0));
+  }
+
+  p.AddParameterBlock(state_->imu_from_lidar_rotation, 4, &quaternion_manifold_);
+  p.AddParameterBlock(state_->imu_from_lidar_translation, 3);
+  p.AddParameterBlock(state_->time_offset_s, 1);
+  p.AddParameterBlock(state_->gravity_direction, 3, &sphere_manifold_);
+  p.AddParameterBlock(state_->gyro_bias_radps, 3);
+  p.AddParameterBlock(state_->accel_bias_mps2, 3);
+
+  // tau bounds around the binning value; tau clamped into them.
+  const double bound = std::abs(options_.time_offset_bound_s);
+  const double tau_bin = std::clamp(state_->time_offset_s[0], -bound, bound);
+  tau_lower_ = std::max(-bound, tau_bin - options_.time_offset_step_bound_s);
+  tau_upper_ = std::min(bound, tau_bin + options_.time_offset_step_bound_s);
+  state_->time_offset_s[0] = tau_bin;
+  if (options_.estimate_time_offset && tau_upper_ > tau_lower_) {
+    p.SetParameterLowerBound(state_->time_offset_s, 0, tau_lower_);
+    p.SetParameterUpperBound(state_->time_offset_s, 0, tau_upper_);
+  } else {
+    p.SetParameterBlockConstant(state_->time_offset_s);
+  }
+  if (!options_.estimate_extrinsic) {
+    p.SetParameterBlockConstant(state_->imu_from_lidar_rotation);
+    p.SetParameterBlockConstant(state_->imu_from_lidar_translation);
+  }
+  if (!options_.estimate_gravity) p.SetParameterBlockConstant(state_->gravity_direction);
+  if (!options_.estimate_biases) {
+    p.SetParameterBlockConstant(state_->gyro_bias_radps);
+    p.SetParameterBlockConstant(state_->accel_bias_mps2);
+  }
+  if (options_.translation_prior_sigma_m > 0.0 && options_.estimate_extrinsic) {
+    p.AddResidualBlock(new TranslationPriorCost(options_.translation_prior_m,
+                                                options_.translation_prior_sigma_m),
+                       nullptr, state_->imu_from_lidar_translation);
+    counts_.prior_residuals = 1;
+  }
+  counts_.knots = traj.num_knots();
+  rotation_used_.assign(traj.num_knots(), 0);
+  position_used_.assign(traj.num_knots(), 0);
+}
+
+void CalibrationProblem::MarkKnots(int first_knot, bool position) {
+  for (int j = 0; j < 4; ++j) {
+    rotation_used_[first_knot + j] = 1;
+    if (position) position_used_[first_knot + j] = 1;
+  }
+}
+
+void CalibrationProblem::AddImuResiduals(const std::vector<imu::ImuReading>& samples, bool gyro,
+                                         bool accel) {
+  spline::SplineTrajectory& traj = state_->trajectory;
+  const spline::UniformKnotGrid& grid = traj.grid();
+  for (const imu::ImuReading& s : samples) {
+    spline::KnotWindow w;
+    if (!grid.Locate(s.time_s, &w)) continue;
+    const int k = w.first_knot;
+    if (gyro) {
+      problem_->AddResidualBlock(
+          new GyroCostFunction(w, grid.inv_dt(), s.angular_velocity_radps,
+                               options_.gyro_sigma_radps),
+          nullptr, traj.rotation_knot(k), traj.rotation_knot(k + 1), traj.rotation_knot(k + 2),
+          traj.rotation_knot(k + 3), state_->gyro_bias_radps);
+      ++counts_.gyro_residuals;
+      MarkKnots(k, false);
+    }
+    if (accel) {
+      problem_->AddResidualBlock(
+          new AccelCostFunction(w, grid.inv_dt(), s.linear_acceleration_mps2,
+                                options_.accel_sigma_mps2, state_->gravity_norm_mps2),
+          nullptr,
+          {traj.rotation_knot(k), traj.rotation_knot(k + 1), traj.rotation_knot(k + 2),
+           traj.rotation_knot(k + 3), traj.position_knot(k), traj.position_knot(k + 1),
+           traj.position_knot(k + 2), traj.position_knot(k + 3), state_->gravity_direction,
+           state_->accel_bias_mps2});
+      ++counts_.accel_residuals;
+      MarkKnots(k, true);
+    }
+  }
+}
+
+void CalibrationProblem::AddLidarResiduals(const std::vector<LidarPointResidual>& points) {
+  spline::SplineTrajectory& traj = state_->trajectory;
+  const spline::UniformKnotGrid& grid = traj.grid();
+  for (const LidarPointResidual& r : points) {
+    spline::KnotWindow w;
+    if (!state_->TimeWindow(r.time_s, &w)) {
+      ++counts_.lidar_skipped;
+      continue;
+    }
+    const int k = w.first_knot;
+    problem_->AddResidualBlock(
+        new PointToPlaneCostFunction(grid.SegmentStart(k), grid.inv_dt(), r.time_s,
+                                     r.point_lidar_m, r.plane_normal, r.plane_offset_m,
+                                     options_.lidar_sigma_m),
+        lidar_loss_.get(),
+        {traj.rotation_knot(k), traj.rotation_knot(k + 1), traj.rotation_knot(k + 2),
+         traj.rotation_knot(k + 3), traj.position_knot(k), traj.position_knot(k + 1),
+         traj.position_knot(k + 2), traj.position_knot(k + 3), state_->imu_from_lidar_rotation,
+         state_->imu_from_lidar_translation, state_->time_offset_s});
+    ++counts_.lidar_residuals;
+    MarkKnots(k, true);
+  }
+}
+
+Status CalibrationProblem::AddExtraResiduals(const ExtraResidualAdder& adder) {
+  if (!adder) return Status::Ok();
+  int added = 0;
+  TILTCAL_RETURN_IF_ERROR(adder(state_, problem_.get(), &added));
+  counts_.ground_residuals += added;
+  return Status::Ok();
+}
+
+void CalibrationProblem::SetRotationKnotsConstant() {
+  for (int i = 0; i < state_->trajectory.num_knots(); ++i) {
+    problem_->SetParameterBlockConstant(state_->trajectory.rotation_knot(i));
+  }
+}
+
+void CalibrationProblem::SetPositionKnotsConstant() {
+  for (int i = 0; i < state_->trajectory.num_knots(); ++i) {
+    problem_->SetParameterBlockConstant(state_->trajectory.position_knot(i));
+  }
+}
+
+void CalibrationProblem::RemoveUnusedKnots() {
+  spline::SplineTrajectory& traj = state_->trajectory;
+  for (int i = 0; i < traj.num_knots(); ++i) {
+    if (!rotation_used_[i]) problem_->RemoveParameterBlock(traj.rotation_knot(i));
+    if (!position_used_[i]) problem_->RemoveParameterBlock(traj.position_knot(i));
+  }
+  if (counts_.lidar_residuals == 0 && counts_.ground_residuals == 0 &&
+      counts_.prior_residuals == 0) {
+    problem_->RemoveParameterBlock(state_->imu_from_lidar_rotation);
+    problem_->RemoveParameterBlock(state_->imu_from_lidar_translation);
+    problem_->RemoveParameterBlock(state_->time_offset_s);
+  }
+  if (counts_.accel_residuals == 0 && counts_.ground_residuals == 0) {
+    problem_->RemoveParameterBlock(state_->gravity_direction);
+    problem_->RemoveParameterBlock(state_->accel_bias_mps2);
+  }
+  if (counts_.gyro_residuals == 0) problem_->RemoveParameterBlock(state_->gyro_bias_radps);
+}
+
+const ProblemCounts& CalibrationProblem::counts() {
+  std::vector<double*> blocks;
+  problem_->GetParameterBlocks(&blocks);
+  int free = 0;
+  for (double* b : blocks) {
+    if (!problem_->IsParameterBlockConstant(b)) free += problem_->ParameterBlockTangentSize(b);
+  }
+  counts_.free_parameters = free;
+  return counts_;
+}
+
+ceres::Solver::Options MakeSolverOptions(int max_iterations, int num_threads,
+                                         double function_tolerance) {
+  ceres::Solver::Options options;
+  options.minimizer_type = ceres::TRUST_REGION;
+  options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
+  options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+  options.max_num_iterations = std::max(1, max_iterations);
+  options.num_threads = std::max(1, num_threads);
+  if (function_tolerance > 0.0) options.function_tolerance = function_tolerance;
+  options.logging_type = ceres::SILENT;
+  options.minimizer_progress_to_stdout = false;
+  return options;
+}
+
+void ReexpressInFirstImuFrame(CalibrationState* state) {
+  spline::SplineTrajectory& traj = state->trajectory;
+  spline::So3SplineSample rot;
+  spline::R3SplineSample pos;
+  if (!traj.Evaluate(traj.grid().t0_s(), spline::kSo3Rotation, &rot, &pos)) return;
+  const Eigen::Quaterniond g(rot.rotation.transpose());
+  const Eigen::Vector3d p0 = pos.position;
+  for (int i = 0; i < traj.num_knots(); ++i) {
+    traj.SetRotationKnot(i, (g * traj.RotationKnot(i)).normalized());
+    traj.SetPositionKnot(i, g * (traj.PositionKnot(i) - p0));
+  }
+  state->SetGravityDirection(g * state->GravityInWorld());
+}
+
+}  // namespace tiltcal::calibrate

@@ -1,0 +1,161 @@
+#ifndef TILTCAL_STAGES_CALIBRATE_PROBLEM_BUILDER_H_
+#define TILTCAL_STAGES_CALIBRATE_PROBLEM_BUILDER_H_
+
+// The ceres::Problem of the spline calibration (DESIGN §5, §6): parameter
+// blocks of a CalibrationState with their manifolds, gauge, the bound on tau,
+// and the residual blocks (all analytic, fixed-size):
+//   gyro  (gyro_cost_function.h):  one per IMU sample, weight 1/sigma_g;
+//   accel (accel_cost_function.h): one per IMU sample, weight 1/sigma_a;
+//   lidar (point_to_plane_cost_function.h): one per associated point, weight
+//         1/sigma_l, Cauchy loss of scale lidar_cauchy_scale (in units of the
+//         weighted residual, i.e. of sigma_l);
+//   more residual sets (the ground residuals of issue 6) through
+//   AddExtraResiduals, which only adds residual blocks on the state's pointers.
+//
+// Gauge (world frame a, 6 DoF): with fix_first_knots, rotation knot 0 and
+// position knot 0 are held constant (used by the IMU-only initial fits).
+// The main solve instead lets the fixed surfel planes of the map (built in a)
+// pin the world frame, as holding knot 0 there couples the gauge to physically
+// unobservable directions (on a plane: translation along the rotation axis)
+// and fakes information on them. Either way the result is re-expressed
+// afterwards so that C_ab(t0) = 1 and r_a^{ba}(t0) = 0 exactly
+// (ReexpressInFirstImuFrame).
+//
+// Optional prior on r_b^{lb} (translation_prior_sigma_m > 0): one residual
+// (r_b^{lb} - r_prior) / sigma (3), counted with the ground residuals' kind
+// "prior" in ProblemCounts::prior_residuals.
+//
+// Time offset: tau is bounded to
+//   [max(-B, tau_bin - S), min(B, tau_bin + S)],
+// B = time_offset_bound_s (|tau| <= B overall), S = time_offset_step_bound_s
+// (how far tau may move from the value tau_bin that chose the frozen knot
+// windows of the LiDAR residuals in this build). The problem is rebuilt (and
+// the windows re-chosen) at every outer iteration.
+//
+// The object owns the manifolds and the shared loss (Ceres does not), and the
+// Problem; it must outlive any ceres::Covariance computed on it.
+
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include <ceres/loss_function.h>
+#include <ceres/problem.h>
+#include <ceres/solver.h>
+#include <ceres/sphere_manifold.h>
+
+#include <Eigen/Core>
+
+#include "common/imu/imu_reading.h"
+#include "common/spline/quaternion_manifold.h"
+#include "common/status.h"
+#include "stages/calibrate/calibration_state.h"
+
+namespace tiltcal::calibrate {
+
+// One associated LiDAR point: raw point (frame l) at LiDAR time t_j and the
+// surfel plane n^T p_a + d = 0 of the map in frame a.
+struct LidarPointResidual {
+  double time_s = 0.0;  // t_j, LiDAR clock, s from the first IMU stamp
+  Eigen::Vector3d point_lidar_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d plane_normal = Eigen::Vector3d::UnitZ();
+  double plane_offset_m = 0.0;
+};
+
+struct ProblemOptions {
+  double gyro_sigma_radps = 0.01;
+  double accel_sigma_mps2 = 0.05;
+  double lidar_sigma_m = 0.02;
+  double lidar_cauchy_scale = 1.0;  // 0 = no robust loss
+  double time_offset_bound_s = 0.05;       // B
+  double time_offset_step_bound_s = 0.015;  // S
+  // Which calibration blocks are free (constant otherwise).
+  bool estimate_extrinsic = true;
+  bool estimate_time_offset = true;
+  bool estimate_gravity = true;
+  bool estimate_biases = true;
+  // Gauge by holding rotation knot 0 and position knot 0 (see above). Off
+  // when fixed map planes already pin the world frame.
+  bool fix_first_knots = true;
+  // Prior r_b^{lb} ~ N(translation_prior_m, sigma^2 I) (sigma 0 = none).
+  Eigen::Vector3d translation_prior_m = Eigen::Vector3d::Zero();
+  double translation_prior_sigma_m = 0.0;
+};
+
+// Counts of what a build added.
+struct ProblemCounts {
+  int knots = 0;
+  int gyro_residuals = 0;
+  int accel_residuals = 0;
+  int lidar_residuals = 0;
+  int lidar_skipped = 0;  // outside the spline
+  int ground_residuals = 0;
+  int prior_residuals = 0;
+  int free_parameters = 0;  // tangent dimension of the non-constant blocks
+};
+
+// Adds residual blocks (e.g. the ground residuals) to `problem` on the
+// state's blocks; returns the number of residual blocks added in *num_added.
+using ExtraResidualAdder =
+    std::function<Status(CalibrationState* state, ceres::Problem* problem, int* num_added)>;
+
+class CalibrationProblem {
+ public:
+  // Adds all blocks of *state (which must outlive this object) with their
+  // manifolds, the gauge and the tau bounds. tau is clamped into its bounds.
+  CalibrationProblem(CalibrationState* state, const ProblemOptions& options);
+  CalibrationProblem(const CalibrationProblem&) = delete;
+  CalibrationProblem& operator=(const CalibrationProblem&) = delete;
+
+  // One gyro and one accel block per sample inside the spline. Times are IMU
+  // clock seconds (the grid's clock).
+  void AddImuResiduals(const std::vector<imu::ImuReading>& samples, bool gyro, bool accel);
+  // Knot windows chosen with the current tau (frozen for this build).
+  void AddLidarResiduals(const std::vector<LidarPointResidual>& points);
+  Status AddExtraResiduals(const ExtraResidualAdder& adder);
+
+  // Holds the rotation and position knots constant (e.g. for a gyro-only or
+  // position-only fit).
+  void SetRotationKnotsConstant();
+  void SetPositionKnotsConstant();
+  // Removes the blocks that no residual added through this object uses (so
+  // the solver does not see parameters without information), keeping the
+  // state's values. Call after the last Add*; extra residual sets must only
+  // use knots that the other residuals use.
+  void RemoveUnusedKnots();
+
+  ceres::Problem* problem() { return problem_.get(); }
+  const ProblemCounts& counts();
+  double time_offset_lower_s() const { return tau_lower_; }
+  double time_offset_upper_s() const { return tau_upper_; }
+
+ private:
+  void MarkKnots(int first_knot, bool position);
+
+  CalibrationState* state_;
+  ProblemOptions options_;
+  spline::RightQuaternionManifold quaternion_manifold_;
+  ceres::SphereManifold<3> sphere_manifold_;
+  std::unique_ptr<ceres::LossFunction> lidar_loss_;
+  std::unique_ptr<ceres::Problem> problem_;
+  ProblemCounts counts_;
+  double tau_lower_ = 0.0;
+  double tau_upper_ = 0.0;
+  std::vector<char> rotation_used_;
+  std::vector<char> position_used_;
+};
+
+// Solver settings of the calibrator: LM, SPARSE_NORMAL_CHOLESKY (no Schur
+// solvers), the given threads and iteration cap.
+ceres::Solver::Options MakeSolverOptions(int max_iterations, int num_threads,
+                                         double function_tolerance);
+
+// Re-expresses the state in the gauge C_ab(t0) = 1, r_a^{ba}(t0) = 0 with
+// t0 = grid start: with G = C_ab(t0)^T and p0 = r_a^{ba}(t0), every rotation
+// knot R_i <- G R_i, position knot p_i <- G (p_i - p0), n_g <- G n_g. The
+// extrinsic, tau and the biases do not change.
+void ReexpressInFirstImuFrame(CalibrationState* state);
+
+}  // namespace tiltcal::calibrate
+
+#endif  // TILTCAL_STAGES_CALIBRATE_PROBLEM_BUILDER_H_

@@ -1,0 +1,361 @@
+// Tests of the calibration pipeline (issue 5): the problem builder's gauge,
+// tau bounds and re-expression, the covariance / observability report, and
+// an end-to-end run on a short simulated flat sequence against the
+// simulator's truth.
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include <ceres/problem.h>
+#include <ceres/solver.h>
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+#include "common/io/eigen_proto.h"
+#include "common/io/params.h"
+#include "common/io/text_proto.h"
+#include "common/spline/so3_spline.h"
+#include "stages/calibrate/calibrate.h"
+#include "stages/calibrate/calibration_state.h"
+#include "stages/calibrate/covariance_report.h"
+#include "stages/calibrate/problem_builder.h"
+#include "tests/testing/test_env.h"
+#include "tiltcal/proto/truth.pb.h"
+
+namespace tiltcal::calibrate {
+namespace {
+
+using testing::TempDir;
+
+// A smooth test trajectory on the knots: C_ab(t) = Exp(w t), r(t) = v t^2.
+CalibrationState MakeState(double duration_s) {
+  CalibrationState state(spline::UniformKnotGrid::ForDuration(0.0, duration_s, 0.05));
+  for (int i = 0; i < state.trajectory.num_knots(); ++i) {
+    const double t = (i - 1) * 0.05;
+    state.trajectory.SetRotationKnot(
+        i, Eigen::Quaterniond(Eigen::AngleAxisd(0.3 * t, Eigen::Vector3d(0.2, 0.1, 1).normalized())) *
+               Eigen::Quaterniond(Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitX())));
+    state.trajectory.SetPositionKnot(i, Eigen::Vector3d(0.5 * t * t + 0.2, 0.3 * t, 0.1));
+  }
+  state.SetGravityDirection(Eigen::Vector3d(0.1, 0.0, -1.0));
+  return state;
+}
+
+std::vector<imu::ImuReading> ImuFromState(const CalibrationState& state, double duration_s) {
+  std::vector<imu::ImuReading> out;
+  for (double t = 0.0; t < duration_s; t += 0.005) {
+    spline::So3SplineSample rot;
+    spline::R3SplineSample pos;
+    state.trajectory.Evaluate(t, spline::kSo3Rotation | spline::kSo3AngularVelocity, &rot, &pos);
+    imu::ImuReading r;
+    r.time_s = t;
+    r.angular_velocity_radps = rot.angular_velocity;
+    r.linear_acceleration_mps2 =
+        rot.rotation.transpose() * (pos.acceleration - state.GravityInWorld());
+    out.push_back(r);
+  }
+  return out;
+}
+
+TEST(ProblemBuilderTest, GaugeFixesTheFirstKnotsAndTauIsBounded) {
+  CalibrationState state = MakeState(1.0);
+  state.time_offset_s[0] = 0.03;
+  ProblemOptions options;
+  options.time_offset_bound_s = 0.04;
+  options.time_offset_step_bound_s = 0.015;
+  CalibrationProblem problem(&state, options);
+  ceres::Problem* p = problem.problem();
+  EXPECT_TRUE(p->IsParameterBlockConstant(state.trajectory.rotation_knot(0)));
+  EXPECT_TRUE(p->IsParameterBlockConstant(state.trajectory.position_knot(0)));
+  EXPECT_FALSE(p->IsParameterBlockConstant(state.trajectory.rotation_knot(1)));
+  EXPECT_FALSE(p->IsParameterBlockConstant(state.trajectory.position_knot(1)));
+  // [max(-B, tau - S), min(B, tau + S)] = [0.015, 0.04].
+  EXPECT_DOUBLE_EQ(problem.time_offset_lower_s(), 0.015);
+  EXPECT_DOUBLE_EQ(problem.time_offset_upper_s(), 0.04);
+  EXPECT_DOUBLE_EQ(p->GetParameterLowerBound(state.time_offset_s, 0), 0.015);
+  EXPECT_DOUBLE_EQ(p->GetParameterUpperBound(state.time_offset_s, 0), 0.04);
+  EXPECT_EQ(p->ParameterBlockTangentSize(state.trajectory.rotation_knot(3)), 3);
+  EXPECT_EQ(p->ParameterBlockTangentSize(state.imu_from_lidar_rotation), 3);
+  EXPECT_EQ(p->ParameterBlockTangentSize(state.gravity_direction), 2);
+
+  // A tau outside the overall bound is clamped into it.
+  CalibrationState far = MakeState(1.0);
+  far.time_offset_s[0] = 0.2;
+  CalibrationProblem clamped(&far, options);
+  EXPECT_DOUBLE_EQ(far.time_offset_s[0], 0.04);
+  EXPECT_DOUBLE_EQ(clamped.time_offset_lower_s(), 0.025);
+}
+
+TEST(ProblemBuilderTest, ImuOnlyProblemKeepsTheTruthAndDropsUnusedBlocks) {
+  CalibrationState truth = MakeState(1.0);
+  const std::vector<imu::ImuReading> imu = ImuFromState(truth, 1.0);
+  CalibrationState state = truth;
+  // Perturb the free knots; the gauge knots stay.
+  for (int i = 1; i < state.trajectory.num_knots(); ++i) {
+    state.trajectory.SetPositionKnot(i, state.trajectory.PositionKnot(i) +
+                                            Eigen::Vector3d(0.01, -0.02, 0.005));
+  }
+  ProblemOptions options;
+  options.gyro_sigma_radps = 0.01;
+  options.accel_sigma_mps2 = 0.05;
+  options.estimate_gravity = false;
+  options.estimate_biases = false;  // IMU-only: a free b_a trades with the motion
+  CalibrationProblem problem(&state, options);
+  problem.AddImuResiduals(imu, true, true);
+  problem.RemoveUnusedKnots();
+  EXPECT_FALSE(problem.problem()->HasParameterBlock(state.imu_from_lidar_rotation));
+  EXPECT_FALSE(problem.problem()->HasParameterBlock(state.time_offset_s));
+  EXPECT_TRUE(problem.problem()->HasParameterBlock(state.gravity_direction));
+  const ProblemCounts& counts = problem.counts();
+  EXPECT_EQ(counts.gyro_residuals, static_cast<int>(imu.size()));
+  EXPECT_EQ(counts.accel_residuals, static_cast<int>(imu.size()));
+  EXPECT_EQ(counts.lidar_residuals, 0);
+  ceres::Solver::Summary summary;
+  ceres::Solve(MakeSolverOptions(50, 1, 1e-14), problem.problem(), &summary);
+  EXPECT_LT(summary.final_cost, 1e-6) << summary.BriefReport();
+  // Accelerations agree with the truth (the accelerometer pins everything
+  // but a linear drift of the positions, which has no acceleration).
+  spline::R3SplineSample a, b;
+  state.trajectory.Evaluate(0.5, 0, nullptr, &a);
+  truth.trajectory.Evaluate(0.5, 0, nullptr, &b);
+  EXPECT_NEAR((a.acceleration - b.acceleration).norm(), 0.0, 1e-4);
+}
+
+TEST(ProblemBuilderTest, ReexpressionMakesTheFirstPoseTheIdentity) {
+  CalibrationState state = MakeState(1.0);
+  const CalibrationState before = state;
+  ReexpressInFirstImuFrame(&state);
+  spline::So3SplineSample r0;
+  spline::R3SplineSample p0;
+  ASSERT_TRUE(state.trajectory.Evaluate(0.0, spline::kSo3Rotation, &r0, &p0));
+  EXPECT_LT((r0.rotation - Eigen::Matrix3d::Identity()).norm(), 1e-12);
+  EXPECT_LT(p0.position.norm(), 1e-12);
+  // Relative motion and gravity in the body frame are unchanged.
+  spline::So3SplineSample ra, rb;
+  spline::R3SplineSample pa, pb;
+  state.trajectory.Evaluate(0.7, spline::kSo3Rotation | spline::kSo3AngularVelocity, &ra, &pa);
+  before.trajectory.Evaluate(0.7, spline::kSo3Rotation | spline::kSo3AngularVelocity, &rb, &pb);
+  EXPECT_LT((ra.angular_velocity - rb.angular_velocity).norm(), 1e-10);
+  EXPECT_LT((ra.rotation.transpose() * (pa.acceleration - state.GravityInWorld()) -
+             rb.rotation.transpose() * (pb.acceleration - before.GravityInWorld()))
+                .norm(),
+            1e-9);
+}
+
+TEST(CovarianceReportTest, SigmasDirectionsAndWeakNames) {
+  Matrix7d cov = Matrix7d::Zero();
+  const double deg = M_PI / 180.0;
+  cov(0, 0) = std::pow(0.01 * deg, 2);
+  cov(1, 1) = std::pow(0.02 * deg, 2);
+  cov(2, 2) = std::pow(0.2 * deg, 2);   // weak
+  cov(3, 3) = std::pow(0.001, 2);
+  cov(4, 4) = std::pow(0.002, 2);
+  cov(5, 5) = std::pow(0.05, 2);        // weak: along z
+  cov(6, 6) = std::pow(0.0002, 2);
+  MotionAxis axis;
+  axis.axis_b = Eigen::Vector3d::UnitZ();
+  ObservabilityThresholds th;
+  th.rotation_sigma_deg = 0.1;
+  th.translation_sigma_m = 0.01;
+  th.time_offset_sigma_s = 0.001;
+  proto::CalibrationResult result;
+  FillCovarianceReport(cov, Eigen::Matrix3d::Identity(), axis, th, &result);
+  ASSERT_EQ(result.covariance_size(), 49);
+  EXPECT_DOUBLE_EQ(result.covariance(5 * 7 + 5), 0.0025);
+  EXPECT_NEAR(result.rotation_sigma_deg().z(), 0.2, 1e-9);
+  EXPECT_NEAR(result.translation_sigma_m().z(), 0.05, 1e-12);
+  EXPECT_NEAR(result.time_offset_sigma_s(), 0.0002, 1e-12);
+  ASSERT_EQ(result.observability_size(), 7);
+  int weak = 0;
+  for (const proto::ObservabilityDirection& d : result.observability()) {
+    ASSERT_EQ(d.direction_size(), 7);
+    if (d.weak()) ++weak;
+  }
+  EXPECT_EQ(weak, 2);
+  // Largest translation sigma first, along z = the rotation axis.
+  const proto::ObservabilityDirection& t0 = result.observability(3);
+  EXPECT_TRUE(t0.weak());
+  EXPECT_NEAR(std::abs(t0.direction(5)), 1.0, 1e-12);
+  EXPECT_NE(t0.description().find("along the rotation axis"), std::string::npos)
+      << t0.description();
+  EXPECT_FALSE(result.observability(4).weak());
+  EXPECT_NE(result.observability(4).description().find("plane of rotation"), std::string::npos);
+}
+
+TEST(CovarianceReportTest, PrincipalAxisOfAYawingMotion) {
+  std::vector<imu::ImuReading> imu(100);
+  for (size_t i = 0; i < imu.size(); ++i) {
+    imu[i].angular_velocity_radps =
+        Eigen::Vector3d(0.01 * std::sin(i * 0.3), 0.0, -0.5 * std::cos(i * 0.05)) +
+        Eigen::Vector3d(0.001, 0.002, 0.0);
+  }
+  const MotionAxis axis = PrincipalRotationAxis(imu, Eigen::Vector3d(0.001, 0.002, 0.0));
+  EXPECT_GT(std::abs(axis.axis_b.z()), 0.999);
+  EXPECT_GT(axis.fraction, 0.99);
+}
+
+// ---- End to end on a short simulated flat sequence ----
+
+double AngleDeg(const Eigen::Quaterniond& a, const Eigen::Quaterniond& b) {
+  return Eigen::AngleAxisd(a.conjugate() * b).angle() * 180.0 / M_PI;
+}
+
+TEST(CalibratePipelineTest, ShortFlatSequenceAgainstTruth) {
+  const std::string simulate = testing::ToolPath("tiltcal_simulate");
+  const std::string decode = testing::ToolPath("tiltcal_decode");
+  const std::string ground = testing::ToolPath("tiltcal_ground");
+  if (!testing::FileExists(simulate) || !testing::FileExists(decode) ||
+      !testing::FileExists(ground)) {
+    GTEST_SKIP() << "build tiltcal_simulate, tiltcal_decode and tiltcal_ground first";
+  }
+  TempDir dir;
+  const std::string src = testing::SourceDir();
+  std::string out;
+  ASSERT_EQ(testing::RunCommand(simulate + " --params=" + src +
+                                    "/tests/stages/calibrate/short_flat_vlp16.txtpb --out_bag=" +
+                                    dir.File("s.bag") + " --out_truth=" + dir.File("truth.txtpb") +
+                                    " --out_rig=" + dir.File("rig.txtpb"),
+                                &out),
+            0)
+      << out;
+  ASSERT_EQ(testing::RunCommand(decode + " --bag=" + dir.File("s.bag") + " --params=" + src +
+                                    "/stages/decode/default_params.txtpb --rig=" +
+                                    dir.File("rig.txtpb") + " --out_imu=" + dir.File("imu.binpb") +
+                                    " --out_scans=" + dir.File("scans.binpb.lz4"),
+                                &out),
+            0)
+      << out;
+  ASSERT_EQ(testing::RunCommand(ground + " --imu=" + dir.File("imu.binpb") + " --scans=" +
+                                    dir.File("scans.binpb.lz4") + " --rig=" +
+                                    dir.File("rig.txtpb") + " --params=" + src +
+                                    "/stages/ground/default_params.txtpb --out_ground=" +
+                                    dir.File("ground.binpb"),
+                                &out),
+            0)
+      << out;
+
+  proto::CalibrateParams params;
+  ASSERT_TRUE(LoadParams(src + "/stages/calibrate/default_params.txtpb", &params).ok());
+  // LiDAR + IMU only (issue 5 item 7): no ground residuals.
+  for (proto::GroundResidualParams* g : {params.mutable_flat(), params.mutable_dist(),
+                                         params.mutable_incl(), params.mutable_up()}) {
+    g->set_mode(proto::GroundResidualParams::OFF);
+  }
+  CalibratePaths paths;
+  paths.imu = dir.File("imu.binpb");
+  paths.scans = dir.File("scans.binpb.lz4");
+  paths.ground = dir.File("ground.binpb");
+  paths.rig = dir.File("rig.txtpb");
+  paths.params = src + "/stages/calibrate/default_params.txtpb";
+  paths.out = dir.File("calibration.txtpb");
+  const Status status = calibrate::Run(paths, params, nullptr);
+  ASSERT_TRUE(status.ok()) << status.message();
+
+  proto::CalibrationResult result;
+  ASSERT_TRUE(ReadTextProto(paths.out, &result).ok());
+  proto::SimulationTruth truth;
+  ASSERT_TRUE(ReadTextProto(dir.File("truth.txtpb"), &truth).ok());
+  proto::Rig rig;
+  ASSERT_TRUE(ReadTextProto(dir.File("rig.txtpb"), &rig).ok());
+
+  const Rigid3d est = ToEigen(result.imu_from_lidar());
+  const Rigid3d tru = ToEigen(truth.imu_from_lidar());
+  const Rigid3d measured = ToEigen(rig.imu_from_lidar());
+  // Up in b at t0 (level ground: the plane of motion is perpendicular to it).
+  const Eigen::Vector3d up_b = -ToEigen(truth.gravity_in_world()).normalized();
+  const Eigen::Vector3d dt = est.translation - tru.translation;
+  const double planar_cm = (dt - dt.dot(up_b) * up_b).norm() * 100.0;
+  const double rot_deg = AngleDeg(est.rotation, tru.rotation);
+  const double rig_rot_deg = AngleDeg(measured.rotation, tru.rotation);
+  const double tau_ms = std::abs(result.time_offset_s() - truth.time_offset_s()) * 1e3;
+  const double gravity_deg = std::acos(std::clamp(
+      ToEigen(result.gravity_in_world()).normalized().dot(
+          ToEigen(truth.gravity_in_world()).normalized()), -1.0, 1.0)) * 180.0 / M_PI;
+  // Rotation error split into the angle about up (yaw, about the motion's
+  // rotation axis) and the tilt (about horizontal axes).
+  const Eigen::AngleAxisd err(est.rotation * tru.rotation.conjugate());
+  const Eigen::Vector3d phi = err.angle() * err.axis();
+  const double yaw_deg = std::abs(phi.dot(up_b)) * 180.0 / M_PI;
+  const double tilt_deg = (phi - phi.dot(up_b) * up_b).norm() * 180.0 / M_PI;
+  std::printf("LiDAR + IMU: rotation error %.4f deg (tilt %.4f, yaw %.4f; rig %.3f), planar "
+              "translation error %.3f cm, vertical %.3f cm, tau error %.3f ms, gravity %.4f deg\n",
+              rot_deg, tilt_deg, yaw_deg, rig_rot_deg, planar_cm, dt.dot(up_b) * 100.0, tau_ms,
+              gravity_deg);
+  // Tolerances for this 16 s sequence, LiDAR + IMU only. Measured (seed 3):
+  // tilt ~0.02 deg (sigma ~0.02 deg), yaw 0.4-0.65 deg (the weak angle about
+  // the vertical, sigma ~0.9 deg here), planar translation 0.9-2.6 cm (sigma
+  // ~4 cm per axis), tau ~0.13 ms (sigma ~0.7 ms), gravity ~0.3 deg. The
+  // issue's bounds (0.1 deg / 1 cm / 0.5 ms) are for 40-60 s sequences and
+  // measured by bench/calibrate.
+  EXPECT_LT(tilt_deg, 0.1);
+  EXPECT_LT(yaw_deg, 1.5);
+  EXPECT_LT(rot_deg, rig_rot_deg);  // better than the rig's measured value
+  EXPECT_LT(planar_cm, 6.0);
+  EXPECT_LT(tau_ms, 1.0);
+  EXPECT_LT(gravity_deg, 0.8);
+
+  // Result fields.
+  EXPECT_EQ(result.covariance_size(), 49);
+  EXPECT_GT(result.problem_size().knots(), 300);
+  EXPECT_GT(result.problem_size().gyro_residuals(), 3000);
+  EXPECT_GT(result.problem_size().accel_residuals(), 3000);
+  EXPECT_GT(result.problem_size().lidar_residuals(), 2000);
+  EXPECT_EQ(result.problem_size().ground_residuals(), 0);
+  EXPECT_EQ(result.ground_residuals_used_size(), 0);
+  EXPECT_FALSE(result.ground_residuals_reason().empty());
+  EXPECT_GT(result.solver().iterations(), 0);
+  EXPECT_GT(result.solver().seconds_per_iteration(), 0.0);
+  EXPECT_EQ(result.provenance().producer(), "tiltcal_calibrate");
+  EXPECT_GE(result.timings_size(), 8);
+
+  // Observability: the translation direction closest to up.
+  auto vertical_direction = [&](const proto::CalibrationResult& r) {
+    const proto::ObservabilityDirection* best = nullptr;
+    double best_dot = 0.0;
+    for (const proto::ObservabilityDirection& d : r.observability()) {
+      if (d.direction_size() != 7) continue;
+      const Eigen::Vector3d v(d.direction(3), d.direction(4), d.direction(5));
+      if (std::abs(v.dot(up_b)) > best_dot) {
+        best_dot = std::abs(v.dot(up_b));
+        best = &d;
+      }
+    }
+    EXPECT_GT(best_dot, 0.9);
+    return best;
+  };
+  // Without ground residuals the translation along the rotation axis
+  // (vertical) is weak: the data add next to nothing to the prior on r_b^{lb}.
+  const proto::ObservabilityDirection* v = vertical_direction(result);
+  ASSERT_NE(v, nullptr);
+  EXPECT_TRUE(v->weak()) << v->description();
+  EXPECT_GT(v->sigma(), 0.6 * params.extrinsic_translation_prior_sigma_m()) << v->description();
+  EXPECT_NE(v->description().find("along the rotation axis"), std::string::npos)
+      << v->description();
+
+  // With the distance residual (d_b known) it is determined to mm, the
+  // paper's point; the same inputs, read once.
+  CalibrateInputs inputs;
+  ASSERT_TRUE(ReadCalibrateInputs(paths, params, &inputs).ok());
+  params.mutable_dist()->set_mode(proto::GroundResidualParams::ON);
+  proto::CalibrationResult with_ground;
+  const Status ground_status = Calibrate(inputs, params, &with_ground, nullptr, nullptr);
+  ASSERT_TRUE(ground_status.ok()) << ground_status.message();
+  ASSERT_EQ(with_ground.ground_residuals_used_size(), 1);
+  EXPECT_EQ(with_ground.ground_residuals_used(0), "dist");
+  EXPECT_GT(with_ground.problem_size().ground_residuals(), 100);
+  const proto::ObservabilityDirection* vg = vertical_direction(with_ground);
+  ASSERT_NE(vg, nullptr);
+  EXPECT_FALSE(vg->weak()) << vg->description();
+  EXPECT_LT(vg->sigma(), 0.005) << vg->description();
+  const Eigen::Vector3d dg = ToEigen(with_ground.imu_from_lidar()).translation - tru.translation;
+  std::printf("with e_dist: vertical translation error %.3f cm, sigma %.3f cm\n",
+              dg.dot(up_b) * 100.0, vg->sigma() * 100.0);
+  EXPECT_LT(std::abs(dg.dot(up_b)), 0.01);
+}
+
+}  // namespace
+}  // namespace tiltcal::calibrate
