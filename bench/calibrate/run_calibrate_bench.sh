@@ -19,6 +19,8 @@
 #   --model MODEL      override the LiDAR model (VLP_16, VLP_32C, OS1_32)
 #   --params FILE      calibrate params (default stages/calibrate/default_params.txtpb)
 #   --threads N        num_threads of the calibrator (default 2)
+#   --ground MODE      off (default: LiDAR + IMU only, the accuracy setting of
+#                      issue 5) or auto (ground residuals as the params say)
 set -euo pipefail
 
 REPO=$(cd "$(dirname "$0")/../.." && pwd)
@@ -28,6 +30,7 @@ SCENARIO="$REPO/stages/simulate/scenarios/flat_vlp16.txtpb"
 MODEL=""
 PARAMS="$REPO/stages/calibrate/default_params.txtpb"
 THREADS=2
+GROUND=off
 while [ $# -gt 0 ]; do
   case "$1" in
     --build_dir) BUILD_DIR=$2; shift 2 ;;
@@ -36,6 +39,7 @@ while [ $# -gt 0 ]; do
     --model) MODEL=$2; shift 2 ;;
     --params) PARAMS=$2; shift 2 ;;
     --threads) THREADS=$2; shift 2 ;;
+    --ground) GROUND=$2; shift 2 ;;
     -h|--help) sed -n '2,/^set -euo/p' "$0" | sed '$d'; exit 0 ;;
     *) echo "run_calibrate_bench: unknown argument $1" >&2; exit 2 ;;
   esac
@@ -57,6 +61,9 @@ else
   cp "$SCENARIO" "$scenario"
 fi
 sed -e "s/^num_threads: .*/num_threads: $THREADS/" "$PARAMS" > "$W/calibrate_params.txtpb"
+if [ "$GROUND" = off ]; then
+  sed -i -e "s/mode: AUTO/mode: OFF/; s/mode: ON/mode: OFF/" "$W/calibrate_params.txtpb"
+fi
 
 now() { date +%s.%N; }
 declare -A WALL CPU
@@ -83,7 +90,7 @@ run calibrate "$BIN/tiltcal_calibrate" --imu="$W/imu.binpb" --scans="$W/scans.bi
   --ground="$W/ground.binpb" --gravity="$W/gravity.txtpb" --rig="$W/rig.txtpb" \
   --params="$W/calibrate_params.txtpb" --out="$W/calibration.txtpb"
 
-echo "scenario: $SCENARIO ${MODEL:+(model $MODEL)}, calibrator threads: $THREADS, nproc: $(nproc)"
+echo "scenario: $SCENARIO ${MODEL:+(model $MODEL)}, calibrator threads: $THREADS, ground residuals: $GROUND, nproc: $(nproc), load: $(cut -d' ' -f1-3 /proc/loadavg)"
 printf '%-10s %9s %9s\n' stage wall_s cpu_s
 for s in simulate decode ground gravity calibrate; do
   printf '%-10s %9.2f %9.2f\n' "$s" "${WALL[$s]}" "${CPU[$s]}"
