@@ -5,6 +5,8 @@
 #include <cstring>
 #include <string>
 
+#include "common/io/xxh32.h"
+
 namespace tiltcal::ros1 {
 
 bool ParseChunkCompression(std::string_view name, ChunkCompression* compression) {
@@ -100,6 +102,15 @@ Status ChunkDecompressor::DecompressLz4(const uint8_t* src, size_t src_size, uin
   // decode straight into it (stableDst) instead of through its own window.
   LZ4F_decompressOptions_t options = {};
   options.stableDst = 1;
+  // Frame descriptor flags (LZ4 frame format: FLG is the byte after the
+  // 4-byte magic; bit 4 = block checksums, bit 2 = content checksum). roslz4
+  // writes a content checksum and no block checksums: liblz4 is told to skip
+  // it and the content is hashed here with the faster own XXH32 after the
+  // frame decoded completely. Frames with block checksums keep liblz4's checks.
+  const bool own_content_checksum = src_size >= 4 + 3 + 4 && (src[4] & 0x04) != 0 &&
+                                    (src[4] & 0x10) == 0;
+  options.skipChecksums = own_content_checksum ? 1 : 0;
+  LZ4F_resetDecompressionContext(lz4_);  // skipChecksums sticks for a whole frame
   size_t consumed = 0;
   size_t produced = 0;
   size_t hint = 1;
@@ -134,6 +145,19 @@ Status ChunkDecompressor::DecompressLz4(const uint8_t* src, size_t src_size, uin
   if (consumed != src_size) {
     return Status::Error("lz4 frame ends " + std::to_string(src_size - consumed) +
                          " bytes before the chunk data ends");
+  }
+  if (own_content_checksum) {
+    // The frame consumed all of src, so its last 4 bytes are the content
+    // checksum: XXH32 (seed 0) of the decompressed bytes, little-endian.
+    const uint8_t* c = src + src_size - 4;
+    const uint32_t stored = uint32_t{c[0]} | (uint32_t{c[1]} << 8) | (uint32_t{c[2]} << 16) |
+                            (uint32_t{c[3]} << 24);
+    const uint32_t computed = Xxh32(dst, dst_size);
+    if (computed != stored) {
+      return Status::Error("lz4 content checksum mismatch (frame says " +
+                           std::to_string(stored) + ", data hashes to " +
+                           std::to_string(computed) + ")");
+    }
   }
   return Status::Ok();
 }

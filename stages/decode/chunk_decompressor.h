@@ -21,7 +21,8 @@ const char* ChunkCompressionName(ChunkCompression compression);
 // Decompresses chunk data into a buffer of exactly the chunk's `size` bytes.
 //   bz2: one bzip2 stream (libbz2 BZ2_bzBuffToBuffDecompress);
 //   lz4: one LZ4 frame as written by roslz4 (liblz4 LZ4F_decompress; the
-//        frame's content checksum is verified by liblz4).
+//        frame's content checksum is verified with the own XXH32, or by
+//        liblz4 when the frame also has block checksums).
 // The result must fill `dst_size` bytes exactly and consume all of `src`;
 // otherwise the error says what differed (the caller adds file and chunk).
 class ChunkDecompressor {

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <type_traits>
 
 namespace tiltcal {
 
@@ -86,6 +87,172 @@ Status RequireType(const Accessor& a, bool ok, const char* expected) {
   if (!a.present || ok) return Status::Ok();
   return Status::Error(std::string("point field '") + a.name + "' has datatype " +
                        ros1::PointFieldTypeName(a.type) + ", expected " + expected);
+}
+
+// ---------------------------------------------------------------- fast path --
+// One loop per common layout, types fixed at compile time: no per-point type
+// switch and no libm call. Every value is computed exactly as in the generic
+// loop of ConvertPointCloud2ToScan (same double intermediates, same checks in
+// the same order), so both give the same bytes.
+
+struct NoField {};
+
+template <typename T>
+inline T Load(const uint8_t* p) {
+  T value;
+  std::memcpy(&value, p, sizeof(T));
+  return value;
+}
+
+// std::llround(v) for |v| < 2^52 (half away from zero): v - trunc(v) is exact.
+inline int64_t RoundHalfAwayFromZero(double v) {
+  const int64_t i = static_cast<int64_t>(v);
+  const double fraction = v - static_cast<double>(i);
+  return i + static_cast<int64_t>(fraction >= 0.5) - static_cast<int64_t>(fraction <= -0.5);
+}
+
+enum class FastTime { kNone, kVelodyneFloat32, kOusterUint32 };
+
+struct FastColumns {
+  float* x;
+  float* y;
+  float* z;
+  float* intensity;
+  uint32_t* ring;  // null when the cloud has no ring field
+  int32_t* time_offset_ns;
+};
+
+struct FastResult {
+  int count = 0;
+  uint32_t dropped_invalid = 0;
+  uint32_t dropped_range = 0;
+};
+
+// Converts all points; false when a time offset leaves int32 (the generic
+// loop then reruns the cloud and reports the error).
+template <typename IntensityT, typename RingT, FastTime kTime>
+bool ConvertFast(const PointCloud2View& cloud, const uint32_t offsets[6], double min_range2,
+                 const FastColumns& out, FastResult* result) {
+  const uint32_t ox = offsets[0], oy = offsets[1], oz = offsets[2];
+  const uint32_t oi = offsets[3], orng = offsets[4], ot = offsets[5];
+  const uint64_t width = cloud.width;
+  const uint32_t step = cloud.point_step;
+  // Local copies: the column stores could otherwise alias `out` and `cloud`
+  // and force reloads of the pointers on every point.
+  float* const xs = out.x;
+  float* const ys = out.y;
+  float* const zs = out.z;
+  float* const is = out.intensity;
+  uint32_t* const rs = out.ring;
+  int32_t* const ts = out.time_offset_ns;
+  const uint8_t* const data = cloud.data;
+  const uint64_t height = cloud.height;
+  const uint64_t row_step = cloud.row_step;
+  uint32_t dropped_invalid = 0;
+  uint32_t dropped_range = 0;
+  int k = 0;
+  for (uint64_t r = 0; r < height; ++r) {
+    const uint8_t* p = data + r * row_step;
+    for (uint64_t c = 0; c < width; ++c, p += step) {
+      const float x = Load<float>(p + ox);
+      const float y = Load<float>(p + oy);
+      const float z = Load<float>(p + oz);
+      if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) {
+        ++dropped_invalid;
+        continue;
+      }
+      const double range2 = static_cast<double>(x) * x + static_cast<double>(y) * y +
+                            static_cast<double>(z) * z;
+      if (range2 == 0.0 || range2 < min_range2) {
+        ++dropped_range;
+        continue;
+      }
+      int64_t offset_ns = 0;
+      if constexpr (kTime == FastTime::kVelodyneFloat32) {
+        const double v = Load<float>(p + ot);  // s relative to the stamp
+        if (!(std::isfinite(v) && std::fabs(v) < 1e3)) {
+          ++dropped_invalid;
+          continue;
+        }
+        offset_ns = RoundHalfAwayFromZero(v * 1e9);
+      } else if constexpr (kTime == FastTime::kOusterUint32) {
+        offset_ns = Load<uint32_t>(p + ot);  // ns relative to the stamp, exact
+      }
+      if (offset_ns < std::numeric_limits<int32_t>::min() ||
+          offset_ns > std::numeric_limits<int32_t>::max()) {
+        return false;
+      }
+      xs[k] = x;
+      ys[k] = y;
+      zs[k] = z;
+      if constexpr (std::is_same_v<IntensityT, NoField>) {
+        is[k] = 0.0f;
+      } else {
+        is[k] = static_cast<float>(static_cast<double>(Load<IntensityT>(p + oi)));
+      }
+      if constexpr (!std::is_same_v<RingT, NoField>) {
+        rs[k] = static_cast<uint32_t>(Load<RingT>(p + orng));
+      }
+      ts[k] = static_cast<int32_t>(offset_ns);
+      ++k;
+    }
+  }
+  result->count = k;
+  result->dropped_invalid = dropped_invalid;
+  result->dropped_range = dropped_range;
+  return true;
+}
+
+using FastConverter = bool (*)(const PointCloud2View&, const uint32_t[6], double,
+                               const FastColumns&, FastResult*);
+
+template <typename IntensityT, typename RingT>
+FastConverter PickTime(FastTime time) {
+  switch (time) {
+    case FastTime::kNone: return &ConvertFast<IntensityT, RingT, FastTime::kNone>;
+    case FastTime::kVelodyneFloat32:
+      return &ConvertFast<IntensityT, RingT, FastTime::kVelodyneFloat32>;
+    case FastTime::kOusterUint32: return &ConvertFast<IntensityT, RingT, FastTime::kOusterUint32>;
+  }
+  return nullptr;
+}
+
+template <typename IntensityT>
+FastConverter PickRing(const Accessor& ring, FastTime time) {
+  if (!ring.present) return PickTime<IntensityT, NoField>(time);
+  switch (ring.type) {
+    case ros1::kUint8: return PickTime<IntensityT, uint8_t>(time);
+    case ros1::kUint16: return PickTime<IntensityT, uint16_t>(time);
+    default: return nullptr;
+  }
+}
+
+// The specialised loop for this layout, or null when the generic loop must run.
+FastConverter PickFastConverter(bool swap, const Accessor& ax, const Accessor& ay,
+                                const Accessor& az, const Accessor& intensity,
+                                const Accessor& ring, proto::PointTimeSource source,
+                                const Accessor& time) {
+  if (swap || ax.type != ros1::kFloat32 || ay.type != ros1::kFloat32 ||
+      az.type != ros1::kFloat32) {
+    return nullptr;
+  }
+  FastTime fast_time;
+  if (source == proto::POINT_TIME_NONE) {
+    fast_time = FastTime::kNone;
+  } else if (source == proto::POINT_TIME_VELODYNE_TIME && time.type == ros1::kFloat32) {
+    fast_time = FastTime::kVelodyneFloat32;
+  } else if (source == proto::POINT_TIME_OUSTER_T && time.type == ros1::kUint32) {
+    fast_time = FastTime::kOusterUint32;
+  } else {
+    return nullptr;
+  }
+  if (!intensity.present) return PickRing<NoField>(ring, fast_time);
+  switch (intensity.type) {
+    case ros1::kFloat32: return PickRing<float>(ring, fast_time);
+    case ros1::kUint8: return PickRing<uint8_t>(ring, fast_time);
+    case ros1::kUint16: return PickRing<uint16_t>(ring, fast_time);
+    default: return nullptr;
+  }
 }
 
 }  // namespace
@@ -211,7 +378,22 @@ Status ConvertPointCloud2ToScan(const PointCloud2View& cloud,
   uint32_t dropped_invalid = 0;
   uint32_t dropped_range = 0;
   int k = 0;
-  for (uint64_t r = 0; r < height; ++r) {
+  const FastConverter fast =
+      options.allow_fast_path
+          ? PickFastConverter(swap, ax, ay, az, intensity, ring, source, time)
+          : nullptr;
+  FastResult fast_result;
+  const uint32_t offsets[6] = {ax.offset,   ay.offset,   az.offset,
+                               intensity.offset, ring.offset, time.offset};
+  const bool fast_done =
+      fast != nullptr && fast(cloud, offsets, min_range2, FastColumns{xs, ys, zs, is, rs, ts},
+                              &fast_result);
+  if (fast_done) {
+    k = fast_result.count;
+    dropped_invalid = fast_result.dropped_invalid;
+    dropped_range = fast_result.dropped_range;
+  }
+  for (uint64_t r = 0; r < (fast_done ? 0 : height); ++r) {
     const uint8_t* row = cloud.data + r * cloud.row_step;
     for (uint64_t c = 0; c < width; ++c) {
       const uint8_t* p = row + c * cloud.point_step;

@@ -31,6 +31,12 @@ namespace tiltcal {
 
 struct PointConversionOptions {
   double min_range_m = 0.0;  // points with range below this are dropped, m
+  // Little-endian clouds with FLOAT32 x/y/z, an absent / FLOAT32 / UINT8 /
+  // UINT16 intensity, an absent / UINT8 / UINT16 ring and no time, a FLOAT32
+  // `time` (Velodyne) or a UINT32 `t` (Ouster) go through a loop compiled for
+  // exactly that layout; its output is byte-identical to the generic loop
+  // (false forces the generic loop, for tests and comparisons).
+  bool allow_fast_path = true;
 };
 
 // Fills stamp_ns, frame_id, the point columns, time_source and the dropped
