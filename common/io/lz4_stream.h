@@ -7,6 +7,8 @@
 
 #include <google/protobuf/io/zero_copy_stream_impl_lite.h>
 
+#include "common/io/xxh32.h"
+
 struct LZ4F_cctx_s;
 struct LZ4F_dctx_s;
 
@@ -15,8 +17,13 @@ namespace tiltcal {
 // First four bytes of every LZ4 frame (0x184D2204, little-endian).
 inline constexpr unsigned char kLz4FrameMagic[4] = {0x04, 0x22, 0x4D, 0x18};
 
+// Block size of the frames Lz4FrameOutput writes (LZ4F_max256KB). Writes of
+// exactly this size are compressed without an extra copy.
+inline constexpr size_t kLz4FrameBlockBytes = 256 * 1024;
+
 // Compresses everything written into one standard LZ4 frame on `file`
-// (content checksum on), so `lz4 -dc` gives back the plain bytes.
+// (content checksum on, computed with the own XXH32), so `lz4 -dc` gives back
+// the plain bytes and detects corruption.
 // Close() writes the end mark; the caller owns and closes `file`.
 class Lz4FrameOutput : public google::protobuf::io::CopyingOutputStream {
  public:
@@ -29,6 +36,7 @@ class Lz4FrameOutput : public google::protobuf::io::CopyingOutputStream {
   bool Flush(size_t bytes);
   std::FILE* file_;
   LZ4F_cctx_s* context_ = nullptr;
+  Xxh32State checksum_;  // of everything written: the frame's content checksum
   std::vector<char> out_;
   bool failed_ = false;
 };

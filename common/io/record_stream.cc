@@ -39,8 +39,10 @@ Status RecordWriter::Open(const std::string& path, const std::string& payload_ty
   TILTCAL_RETURN_IF_ERROR(impl_->file.Open(path));
   if (compress) {
     impl_->lz4 = std::make_unique<Lz4FrameOutput>(impl_->file.file());
-    impl_->lz4_adaptor = std::make_unique<pbio::CopyingOutputStreamAdaptor>(impl_->lz4.get(),
-                                                                            1 << 16);
+    // One LZ4 block (256 KiB) per Write(): liblz4 then compresses straight
+    // from this buffer instead of first copying the input into its own.
+    impl_->lz4_adaptor = std::make_unique<pbio::CopyingOutputStreamAdaptor>(
+        impl_->lz4.get(), static_cast<int>(kLz4FrameBlockBytes));
   } else {
     std::fflush(impl_->file.file());
     impl_->plain = std::make_unique<pbio::FileOutputStream>(::fileno(impl_->file.file()));
