@@ -6,6 +6,7 @@
 #include "common/imu/static_detection.h"
 
 #include <cmath>
+#include <cstdio>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -110,6 +111,7 @@ TEST(CalibrateGyroIntegratorTest, MatchesAnalyticAttitudeAtAndBetweenSamples) {
     const Eigen::Matrix3d truth = c0.transpose() * m.Rotation(t, nullptr);  // C_ab(t), a = b(t0)
     worst_deg = std::max(worst_deg, RotationErrorDeg(integrator.Rotation(100.0 + t), truth));
   }
+  std::printf("gyro integration: worst error %.5f deg over 10 s at 200 Hz\n", worst_deg);
   EXPECT_LT(worst_deg, 0.01) << "midpoint integration error after 10 s at 200 Hz";
   EXPECT_LT(RotationErrorDeg(integrator.Rotation(100.0), Eigen::Matrix3d::Identity()), 1e-12);
   // Relative rotation is consistent with the absolute ones.
@@ -172,6 +174,9 @@ TEST(CalibrateImuInitialisationTest, StaticStartGivesBiasAndGravityWithinNoise) 
   EXPECT_LT((init.gyro_bias_radps - bias).norm(), 5e-4) << init.gyro_bias_radps.transpose();
   // Gravity in a = b(t0): C_wb(0)^T g_w.
   const Eigen::Vector3d g_truth = m.Rotation(0.0, nullptr).transpose() * Eigen::Vector3d(0.0, 0.0, -9.81);
+  std::printf("static start: end %.3f s (motion at 103 s), |bias error| %.2e rad/s, gravity error %.4f deg\n",
+              init.static_start.end_s, (init.gyro_bias_radps - bias).norm(),
+              AngleBetweenDeg(init.gravity_in_world_mps2, g_truth));
   EXPECT_NEAR(init.gravity_in_world_mps2.norm(), 9.81, 1e-9);
   EXPECT_LT(AngleBetweenDeg(init.gravity_in_world_mps2, g_truth), 0.05);
   EXPECT_NEAR(init.accel_norm_mismatch_mps2, 0.0, 0.01);
@@ -198,6 +203,7 @@ TEST(CalibrateImuInitialisationTest, DetectsNoStaticStartWhenMovingAndFallsBack)
   const Eigen::Vector3d g_truth = m.Rotation(0.0, nullptr).transpose() * Eigen::Vector3d(0.0, 0.0, -9.81);
   // Rotation-compensated mean of pure-rotation data: the unmodelled gyro bias
   // (~0.005 rad/s over 2 s) is the main error.
+  std::printf("no static start: gravity error %.3f deg\n", AngleBetweenDeg(init.gravity_in_world_mps2, g_truth));
   EXPECT_LT(AngleBetweenDeg(init.gravity_in_world_mps2, g_truth), 1.0);
   EXPECT_NEAR(init.averaging_end_s - init.averaging_begin_s, 2.0, 0.01);
 }
