@@ -82,6 +82,25 @@ TEST(ProblemBuilderTest, GaugeFixesTheFirstKnotsAndTauIsBounded) {
   EXPECT_EQ(p->ParameterBlockTangentSize(state.imu_from_lidar_rotation), 3);
   EXPECT_EQ(p->ParameterBlockTangentSize(state.gravity_direction), 2);
 
+  // Map-pinned gauge (the main solve): no knot held; the translation prior
+  // is one residual block at the given value.
+  CalibrationState free_state = MakeState(1.0);
+  ProblemOptions free_options = options;
+  free_options.fix_first_knots = false;
+  free_options.translation_prior_m = Eigen::Vector3d(0.1, 0.2, 0.3);
+  free_options.translation_prior_sigma_m = 0.05;
+  free_state.SetImuFromLidarTranslation(Eigen::Vector3d(0.1, 0.2, 0.4));
+  CalibrationProblem free_problem(&free_state, free_options);
+  EXPECT_FALSE(free_problem.problem()->IsParameterBlockConstant(
+      free_state.trajectory.rotation_knot(0)));
+  EXPECT_FALSE(free_problem.problem()->IsParameterBlockConstant(
+      free_state.trajectory.position_knot(0)));
+  EXPECT_EQ(free_problem.counts().prior_residuals, 1);
+  double cost = 0.0;
+  ASSERT_TRUE(free_problem.problem()->Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr,
+                                               nullptr, nullptr));
+  EXPECT_NEAR(cost, 0.5 * std::pow(0.1 / 0.05, 2), 1e-12);  // 0.1 m off in z
+
   // A tau outside the overall bound is clamped into it.
   CalibrationState far = MakeState(1.0);
   far.time_offset_s[0] = 0.2;
