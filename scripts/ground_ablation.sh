@@ -14,8 +14,10 @@
 #   ABLATION_DIR=/tmp/ablation ABLATION_DURATION_S=30 ABLATION_SETS="none dist" \
 #     ABLATION_MISINIT=0 scripts/ground_ablation.sh build-x/bin
 #
-# Outputs in $ABLATION_DIR: the sequences, runs/<name>/{calibration,truth}.txtpb,
-# errors.csv (tiltcal_report), table.txt (what is printed).
+# Outputs in $ABLATION_DIR: the sequences, base_calibrate_params.txtpb (the
+# defaults every run starts from, copied once), runs/<name>/{params,
+# calibration,truth}.txtpb, errors.csv (tiltcal_report), table.txt (printed).
+# Existing sequences and runs in $ABLATION_DIR are reused.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ROOT=$(pwd)
@@ -32,6 +34,9 @@ for tool in simulate decode ground gravity calibrate report; do
 done
 mkdir -p "$WORK"
 log() { echo "ground_ablation: $*" >&2; }
+# Every run starts from the same snapshot of the calibrate defaults.
+[ -s "$WORK/base_calibrate_params.txtpb" ] ||
+  cp "$ROOT/stages/calibrate/default_params.txtpb" "$WORK/base_calibrate_params.txtpb"
 
 # --- sequences ----------------------------------------------------------------
 
@@ -69,7 +74,7 @@ write_params() {  # set out_file
     [[ "+$set+" == *"+$r+"* ]] && mode=ON
     script+=(-e "s/^$r \\{ mode: [A-Z]+/$r { mode: $mode/")
   done
-  sed -E "${script[@]}" "$ROOT/stages/calibrate/default_params.txtpb" > "$out"
+  sed -E "${script[@]}" "$WORK/base_calibrate_params.txtpb" > "$out"
   for r in flat dist incl up; do
     grep -q "^$r { mode: " "$out" || { log "no '$r { mode: ...' line in the default params"; exit 1; }
   done
@@ -130,6 +135,49 @@ fi
 
 # --- table --------------------------------------------------------------------
 
+# Rotation error split about the ground normal: phi = Log(C_true^T C_est)
+# (LiDAR frame), yaw = phi . n_l with n_l = C_true^T g~_f (the plane normal of
+# a rigid vehicle, from the truth's g_f), tilt = |phi - yaw n_l|, in deg.
+rotation_split() {  # calibration.txtpb truth.txtpb
+  awk '
+    function field(v) { sub(/^[^:]*:[[:space:]]*/, "", v); return v + 0 }
+    FNR == 1 { file++; block = ""; depth = 0 }
+    /^imu_from_lidar[[:space:]]*\{/ { block = "x"; depth = 1; next }
+    /^gravity_flat_in_imu[[:space:]]*\{/ { block = "g"; depth = 1; next }
+    block != "" && /\{/ { depth++; sub_block = $1; next }
+    block != "" && /\}/ { depth--; if (depth == 0) block = ""; sub_block = ""; next }
+    block == "x" && sub_block == "rotation" && /^[[:space:]]*[wxyz]:/ {
+      k = $1; sub(/:/, "", k); q[file, k] = field($0)
+    }
+    block == "g" && /^[[:space:]]*[xyz]:/ { k = $1; sub(/:/, "", k); g[k] = field($0) }
+    END {
+      # e = conj(t) * c, t = truth (file 2), c = calibration (file 1).
+      tw = q[2, "w"]; tx = -q[2, "x"]; ty = -q[2, "y"]; tz = -q[2, "z"]
+      cw = q[1, "w"]; cx = q[1, "x"]; cy = q[1, "y"]; cz = q[1, "z"]
+      ew = tw * cw - tx * cx - ty * cy - tz * cz
+      ex = tw * cx + tx * cw + ty * cz - tz * cy
+      ey = tw * cy - tx * cz + ty * cw + tz * cx
+      ez = tw * cz + tx * cy - ty * cx + tz * cw
+      if (ew < 0) { ew = -ew; ex = -ex; ey = -ey; ez = -ez }
+      n = sqrt(ex * ex + ey * ey + ez * ez)
+      a = n > 1e-15 ? 2 * atan2(n, ew) / n : 2
+      px = a * ex; py = a * ey; pz = a * ez
+      # n_b = -g_f / |g_f|, n_l = C_true^T n_b (rotate by conj(truth)).
+      gn = sqrt(g["x"] ^ 2 + g["y"] ^ 2 + g["z"] ^ 2)
+      bx = -g["x"] / gn; by = -g["y"] / gn; bz = -g["z"] / gn
+      # v_l = R(t)^T v_b with t = (w, -x, -y, -z) already conjugated: R(conj) v.
+      ux = tx; uy = ty; uz = tz
+      cxv = uy * bz - uz * by; cyv = uz * bx - ux * bz; czv = ux * by - uy * bx
+      lx = bx + 2 * (tw * cxv + uy * czv - uz * cyv)
+      ly = by + 2 * (tw * cyv + uz * cxv - ux * czv)
+      lz = bz + 2 * (tw * czv + ux * cyv - uy * cxv)
+      yaw = px * lx + py * ly + pz * lz
+      tx2 = px - yaw * lx; ty2 = py - yaw * ly; tz2 = pz - yaw * lz
+      r2d = 180 / atan2(0, -1)
+      printf "%.3f %.3f\n", yaw * r2d, sqrt(tx2 * tx2 + ty2 * ty2 + tz2 * tz2) * r2d
+    }' "$1" "$2"
+}
+
 DIRS=()
 for run in "${RUNS[@]}"; do
   [ -s "$WORK/runs/$run/calibration.txtpb" ] && DIRS+=("$WORK/runs/$run")
@@ -143,7 +191,10 @@ done
   echo "Errors = estimate - truth. misinit: tilted, rig r_b^{lb} off by [${MISINIT_OFFSET[*]}] m."
   echo "Measured rig (initial guess) is off by (0.5, -0.7, 1.5) deg and (2, -3, 2.5) cm."
   echo
-  printf '%-8s %-11s %9s %8s %8s %8s %9s %6s  %s\n' sequence residuals rot_deg dx_cm dy_cm dz_cm tau_ms time_s "ground residuals used"
+  echo "rot = |Log(C_true^T C_est)|, split into yaw (about the ground normal) and tilt."
+  echo
+  printf '%-8s %-11s %7s %7s %7s %8s %8s %8s %8s %6s  %s\n' sequence residuals rot_deg \
+    yaw_deg tilt_deg dx_cm dy_cm dz_cm tau_ms time_s "ground residuals used"
   for run in "${RUNS[@]}"; do
     seq=${run%%__*}
     set=${run#*__}
@@ -154,8 +205,10 @@ done
     fi
     used=$({ grep -E '^ground_residuals_used:' "$dir/calibration.txtpb" || true; } |
       sed -E 's/.*"(.*)"/\1/' | paste -sd+ -)
-    awk -F, -v name="$run" -v seq="$seq" -v set="$set" -v secs="$(cat "$dir/seconds.txt")" -v used="${used:-none}" '
-      $1 == name { printf "%-8s %-11s %9.3f %8.2f %8.2f %8.2f %9.3f %6d  %s\n", seq, set, $9, $10, $11, $12, $13, secs, used }' \
-      "$WORK/errors.csv"
+    read -r yaw tilt < <(rotation_split "$dir/calibration.txtpb" "$dir/truth.txtpb")
+    awk -F, -v name="$run" -v seq="$seq" -v set="$set" -v secs="$(cat "$dir/seconds.txt")" \
+      -v used="${used:-none}" -v yaw="$yaw" -v tilt="$tilt" '
+      $1 == name { printf "%-8s %-11s %7.3f %7.3f %7.3f %8.2f %8.2f %8.2f %8.3f %6d  %s\n",
+                   seq, set, $9, yaw, tilt, $10, $11, $12, $13, secs, used }' "$WORK/errors.csv"
   done
 } | tee "$WORK/table.txt"

@@ -65,7 +65,7 @@ namespace tiltcal::calibrate {
 // Built-in sigmas, used when params.k.sigma is 0.
 inline constexpr double kDefaultFlatSigma = 0.02;   // unit-vector units (~1.1 deg)
 inline constexpr double kDefaultDistSigmaM = 0.02;  // m
-inline constexpr double kDefaultInclSigma = 0.005;  // cosine units
+inline constexpr double kDefaultInclSigma = 0.001;  // cosine units (~sin(slope) x normal error)
 inline constexpr double kDefaultUpSigma = 0.02;     // unit-vector units (~1.1 deg)
 
 // What the dataset says about the sequence.
