@@ -57,8 +57,10 @@ TEST(Params, AboveMaximumAndZeroLeftByAForgottenField) {
 
 TEST(Params, RepeatedElementsAreCheckedWithTheirIndex) {
   proto::GroundParams params;
-  params.add_zone_rings(2);
-  params.add_zone_rings(0);
+  ASSERT_TRUE(
+      LoadParams(testing::SourceDir() + "/stages/ground/default_params.txtpb", &params).ok());
+  ASSERT_GE(params.zone_rings_size(), 2);
+  params.set_zone_rings(1, 0);
   const Status status = ValidateAgainstSchema(params);
   ASSERT_FALSE(status.ok());
   EXPECT_NE(status.message().find("zone_rings[1] = 0"), std::string::npos) << status.message();
