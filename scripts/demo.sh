@@ -49,7 +49,16 @@ simulate_dataset() {  # base_scenario dataset_dir prefix count
   done | xargs -P 2 -I{} sh -c '{}'
 }
 
-phase "setup and build" scripts/build.sh
+build_tools() {
+  scripts/setup.sh
+  if [ ! -f build/build.ninja ]; then
+    cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release > /dev/null
+  fi
+  cmake --build build -j "$(nproc)" --target tiltcal_simulate tiltcal_decode tiltcal_ground \
+    tiltcal_gravity tiltcal_calibrate tiltcal_report tiltcal_inspect
+}
+
+phase "setup and build" build_tools
 phase "simulate flat dataset (3 x ${DURATION_S} s)" \
   simulate_dataset stages/simulate/scenarios/flat_vlp16.txtpb "$FLAT" flat 3
 phase "simulate tilted dataset (5 x ${DURATION_S} s)" \
