@@ -28,7 +28,7 @@ clouds are byte-identical and lz4 sees realistic float data.
 
 The bag is written until the file reaches --size_gb * 1e9 bytes (record time
 starts at --start_s). Existing output is replaced atomically (written to
-OUT.partial, then renamed); OUT.meta gets bytes, clouds, points, imu counts.
+OUT.partial.PID, then renamed); OUT.meta gets bytes, clouds, points, imu counts.
 """
 
 import argparse
@@ -254,7 +254,7 @@ def main():
     points['time'] = point_time
     fields = point_fields()
     target_bytes = int(args.size_gb * 1e9)
-    partial = args.out + '.partial'
+    partial = '%s.partial.%d' % (args.out, os.getpid())  # private to this process
     for stale in (partial, args.out + '.meta'):
         if os.path.exists(stale):
             os.remove(stale)
@@ -311,10 +311,11 @@ def main():
     os.replace(partial, args.out)
     size = os.path.getsize(args.out)
     # Sidecar with the bag's contents, read by run_decode_bench.sh.
-    with open(args.out + '.meta.tmp', 'w') as meta:
+    meta_tmp = '%s.meta.tmp.%d' % (args.out, os.getpid())
+    with open(meta_tmp, 'w') as meta:
         meta.write('bytes=%d\nclouds=%d\npoints=%d\nimu=%d\ncompression=%s\n' %
                    (size, num_scans, num_points, num_imu, args.compression))
-    os.replace(args.out + '.meta.tmp', args.out + '.meta')
+    os.replace(meta_tmp, args.out + '.meta')
     print('make_vlp16_bag: wrote %s: %d bytes, %d clouds, %d points, %d imu messages, '
           '%.1f s of data, %.0f s' % (args.out, size, num_scans, num_points, num_imu,
                                       num_scans * SCAN_PERIOD_S, time.time() - wall0),

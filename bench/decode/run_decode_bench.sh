@@ -56,8 +56,10 @@ done
 DEBIAN_PYTHON=/usr/bin/python3
 BENCH_DIR="$REPO/bench/decode"
 WORK="$SCRATCH/tiltcal_decode_bench"
-LOGS="$WORK/logs"
-rm -rf "$LOGS"
+# One directory per run (logs and the decode output), so that two runs at
+# the same time do not clobber each other; the bags are shared.
+RUN_DIR="$WORK/run-$(date -u +%Y%m%dT%H%M%S)-$$"
+LOGS="$RUN_DIR/logs"
 mkdir -p "$LOGS"
 log() { echo "run_decode_bench: $*" >&2; }
 
@@ -164,7 +166,7 @@ warm() { cat "$1" >/dev/null; }
 
 PARAMS="$REPO/stages/decode/default_params.txtpb"
 run_decode() {  # LABEL BAG REPEAT
-  local outdir="$WORK/out"
+  local outdir="$RUN_DIR/out"
   mkdir -p "$outdir"
   run_timed "$1" "$2" "$3" "$DECODE" --bag="$2" --params="$PARAMS" \
     --out_imu="$outdir/imu.binpb" --out_scans="$outdir/scans.binpb.lz4"
