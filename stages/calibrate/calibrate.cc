@@ -13,6 +13,7 @@
 #include "common/io/imu_stream.h"
 #include "common/io/provenance.h"
 #include "common/io/record_stream.h"
+#include "common/io/static_detection_params.h"
 #include "common/io/text_proto.h"
 #include "stages/calibrate/covariance_report.h"
 #include "stages/calibrate/ground_residuals.h"
@@ -65,13 +66,7 @@ InitialisationOptions MakeInitialisationOptions(const proto::CalibrateParams& pa
   o.odometry.max_range_m = params.lidar_max_range_m();
   o.hand_eye.min_excitation_rad = params.hand_eye_min_excitation_rad();
   o.time_offset_search_s = params.time_offset_bound_s();
-  imu::StaticDetectionOptions& st = o.imu.static_detection;
-  st.window_s = params.static_window_s();
-  st.hop_s = params.static_hop_s();
-  st.max_gyro_std_radps = params.static_max_gyro_std_radps();
-  st.max_accel_std_mps2 = params.static_max_accel_std_mps2();
-  st.max_gyro_mean_radps = params.static_max_gyro_mean_radps();
-  st.min_duration_s = params.static_min_duration_s();
+  o.imu.static_detection = ToStaticDetectionOptions(params.static_detection());
   o.imu.fallback_window_s = params.init_fallback_window_s();
   o.odometry.max_iterations = static_cast<int>(params.odometry_max_iterations());
   o.odometry.keyframe_distance_m = params.odometry_keyframe_distance_m();

@@ -11,6 +11,7 @@
 #include "common/io/imu_stream.h"
 #include "common/io/provenance.h"
 #include "common/io/record_stream.h"
+#include "common/io/static_detection_params.h"
 #include "common/io/text_proto.h"
 
 namespace tiltcal::gravity {
@@ -21,17 +22,6 @@ constexpr double kRadToDeg = 180.0 / M_PI;
 
 double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   return kRadToDeg * std::atan2(a.cross(b).norm(), a.dot(b));
-}
-
-imu::StaticDetectionOptions StaticOptions(const proto::GravityParams& params) {
-  imu::StaticDetectionOptions options;
-  options.window_s = params.static_window_s();
-  options.hop_s = params.static_hop_s();
-  options.max_gyro_std_radps = params.static_gyro_std_max_radps();
-  options.max_accel_std_mps2 = params.static_accel_std_max_mps2();
-  options.max_gyro_mean_radps = params.static_gyro_mean_max_radps();
-  options.min_duration_s = params.static_min_duration_s();
-  return options;
 }
 
 // Linear-interpolated percentile (0..100) of non-empty `values`.
@@ -55,7 +45,7 @@ Status EstimateGravityReference(const GravityInputs& inputs, const proto::Gravit
                                 proto::GravityReference* out) {
   const double g = params.gravity_norm_mps2();
   imu::ImuInitialisationOptions init_options;
-  init_options.static_detection = StaticOptions(params);
+  init_options.static_detection = ToStaticDetectionOptions(params.static_detection());
   init_options.gravity_norm_mps2 = g;
   init_options.fallback_window_s = params.fallback_window_s();
   imu::ImuInitialisation init;

@@ -15,6 +15,7 @@
 #include "common/io/imu_stream.h"
 #include "common/io/provenance.h"
 #include "common/io/record_stream.h"
+#include "common/io/static_detection_params.h"
 #include "common/io/text_proto.h"
 #include "stages/ground/deskew.h"
 #include "stages/ground/ground_segmentation.h"
@@ -89,13 +90,8 @@ Status Run(const GroundPaths& paths, const proto::GroundParams& params,
   if (params.deskew()) {
     TILTCAL_RETURN_IF_ERROR(ReadImuReadings(paths.imu, &readings, &imu_origin_ns));
   }
-  imu::StaticDetectionOptions static_options;
-  static_options.window_s = params.static_window_s();
-  static_options.hop_s = params.static_window_s() / 5.0;
-  static_options.max_gyro_std_radps = params.static_gyro_std_max_radps();
-  static_options.max_accel_std_mps2 = params.static_accel_std_max_mps2();
-  static_options.max_gyro_mean_radps = params.static_gyro_max_radps();
-  static_options.min_duration_s = params.static_min_duration_s();
+  const imu::StaticDetectionOptions static_options =
+      ToStaticDetectionOptions(params.static_detection());
   const imu::StaticInterval static_start = readings.empty()
                                                ? imu::StaticInterval()
                                                : imu::DetectStaticStart(readings, static_options);

@@ -1,0 +1,16 @@
+#include "common/io/static_detection_params.h"
+
+namespace tiltcal {
+
+imu::StaticDetectionOptions ToStaticDetectionOptions(const proto::StaticDetectionParams& params) {
+  imu::StaticDetectionOptions options;
+  options.window_s = params.window_s();
+  options.hop_s = params.hop_s();
+  options.max_gyro_std_radps = params.max_gyro_std_radps();
+  options.max_accel_std_mps2 = params.max_accel_std_mps2();
+  options.max_gyro_mean_radps = params.max_gyro_mean_radps();
+  options.min_duration_s = params.min_duration_s();
+  return options;
+}
+
+}  // namespace tiltcal
