@@ -333,7 +333,8 @@ Status MakeGroundResidualAdder(
   GroundResidualSelection selection;
   TILTCAL_RETURN_IF_ERROR(SelectGroundResiduals(params, info, &selection));
   if (planes.empty()) {
-    *reason = "ground residuals none: no ground planes given (" + selection.reason + ")";
+    *reason = "ground residuals none: no ground planes given (with planes: " +
+              selection.Names() + ")";
     return Status::Ok();
   }
   *reason = selection.reason;
