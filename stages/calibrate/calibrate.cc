@@ -79,6 +79,7 @@ InitialisationOptions MakeInitialisationOptions(const proto::CalibrateParams& pa
   o.hand_eye_pair_step = static_cast<int>(params.hand_eye_pair_step());
   o.odometry_scan_step = static_cast<int>(std::max(1u, params.odometry_scan_step()));
   o.hand_eye.consistent_angle_deg = params.hand_eye_consistent_angle_deg();
+  o.odometry_rotation_sigma_rad = params.init_odometry_rotation_sigma_deg() * M_PI / 180.0;
   return o;
 }
 
@@ -222,7 +223,12 @@ Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& pa
   bool converged = false;
   std::string termination;
   const int outer = static_cast<int>(params.outer_iterations());
+  int outer_done = 0;
+  double moved_deg = 0.0, moved_m = 0.0, moved_s = 0.0;
   for (int it = 0; it < outer; ++it) {
+    const Eigen::Quaterniond rotation_before = state.ImuFromLidarRotation();
+    const Eigen::Vector3d translation_before = state.ImuFromLidarTranslation();
+    const double tau_before = state.time_offset_s[0];
     AssociationStageSummary assoc;
     BuildMapAndAssociate(state, inputs.scans, assoc_options, &lidar, &assoc);
     map_s += assoc.map_seconds;
@@ -258,6 +264,19 @@ Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& pa
                     state.time_offset_s[0] * 1e3, r.x()) +
                  Format("%.4f, %.4f) m", r.y(), r.z()));
     // tau at its per-iteration bound: more outer iterations re-bin and go on.
+    outer_done = it + 1;
+    moved_deg =
+        Eigen::AngleAxisd(rotation_before.conjugate() * state.ImuFromLidarRotation()).angle() *
+        180.0 / M_PI;
+    moved_m = (state.ImuFromLidarTranslation() - translation_before).norm();
+    moved_s = std::abs(state.time_offset_s[0] - tau_before);
+    if (it >= 1 && moved_deg < params.outer_stop_rotation_deg() &&
+        moved_m < params.outer_stop_translation_m() &&
+        moved_s < params.outer_stop_time_offset_s()) {
+      Log(log, Format("outer %.0f: extrinsic moved %.4f deg, %.2f mm, tau %.3f ms: stop", it + 1,
+                      moved_deg, moved_m * 1e3, moved_s * 1e3));
+      break;
+    }
   }
   AddTiming("map", map_s, result);
   AddTiming("association", assoc_s, result);
@@ -284,6 +303,10 @@ Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& pa
   solver->set_final_cost(summary.final_cost);
   solver->set_seconds_per_iteration(total_iterations > 0 ? solve_s / total_iterations : 0.0);
   solver->set_brief_report(summary.BriefReport());
+  solver->set_outer_iterations(outer_done);
+  solver->set_last_outer_rotation_change_deg(moved_deg);
+  solver->set_last_outer_translation_change_m(moved_m);
+  solver->set_last_outer_time_offset_change_s(moved_s);
 
   // Covariance and observability on the last problem (the extrinsic and tau
   // do not depend on the world gauge).

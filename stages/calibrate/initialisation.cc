@@ -11,6 +11,7 @@
 #include "common/imu/gyro_integrator.h"
 #include "common/spline/cubic_basis.h"
 #include "common/spline/so3_spline.h"
+#include "stages/calibrate/orientation_sample_cost_function.h"
 #include "stages/calibrate/problem_builder.h"
 
 namespace tiltcal::calibrate {
@@ -166,6 +167,37 @@ double FitRotationSplineToGyro(const std::vector<imu::ImuReading>& imu_samples,
   return RmsResidual(summary);
 }
 
+double RefineRotationSpline(const std::vector<double>& times_s,
+                            const std::vector<Eigen::Quaterniond>& orientations_a_from_b,
+                            const std::vector<imu::ImuReading>& imu_samples,
+                            const InitialisationOptions& options, CalibrationState* state) {
+  spline::SplineTrajectory& traj = state->trajectory;
+  const spline::UniformKnotGrid& grid = traj.grid();
+  CalibrationProblem problem(state, FitOptions(options));
+  problem.AddImuResiduals(imu_samples, /*gyro=*/true, /*accel=*/false);
+  const double sigma = options.odometry_rotation_sigma_rad;
+  Status status = problem.AddExtraResiduals([&](CalibrationState* s, ceres::Problem* p, int* added) {
+    for (size_t k = 0; k < times_s.size(); ++k) {
+      spline::KnotWindow w;
+      if (!grid.Locate(times_s[k], &w)) continue;
+      const int f = w.first_knot;
+      p->AddResidualBlock(
+          new OrientationSampleCostFunction(w, grid.inv_dt(), orientations_a_from_b[k], sigma),
+          nullptr, s->trajectory.rotation_knot(f), s->trajectory.rotation_knot(f + 1),
+          s->trajectory.rotation_knot(f + 2), s->trajectory.rotation_knot(f + 3));
+      ++*added;
+    }
+    return Status::Ok();
+  });
+  (void)status;
+  problem.RemoveUnusedKnots();
+  ceres::Solver::Options solver =
+      MakeSolverOptions(options.solver_iterations, options.num_threads, 1e-10);
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver, problem.problem(), &summary);
+  return RmsResidual(summary);
+}
+
 double FitPositionSpline(const std::vector<double>& times_s,
                          const std::vector<Eigen::Vector3d>& positions_a,
                          const std::vector<imu::ImuReading>& imu_samples,
@@ -176,7 +208,13 @@ double FitPositionSpline(const std::vector<double>& times_s,
   for (int i = 0; i < traj.num_knots(); ++i) {
     traj.SetPositionKnot(i, Interpolate(times_s, positions_a, grid.t0_s() + (i - 1) * grid.dt_s()));
   }
-  CalibrationProblem problem(state, FitOptions(options));
+  // The accelerometer bias and g_a are estimated with the positions: with
+  // the bias held at 0, its double integral (~ b t^2 / 2, metres within
+  // seconds) would bend the positions away from the odometry's.
+  ProblemOptions fit = FitOptions(options);
+  fit.estimate_biases = true;
+  fit.estimate_gravity = true;
+  CalibrationProblem problem(state, fit);
   problem.SetRotationKnotsConstant();
   problem.AddImuResiduals(imu_samples, /*gyro=*/false, /*accel=*/true);
   const double sigma = options.position_sigma_m;
@@ -322,6 +360,36 @@ Status InitialiseState(const std::vector<imu::ImuReading>& imu_samples,
     state->time_offset_s[0] = report->time_offset_init_s;
   }
 
+  // 4c. Heading: the rotation spline refitted to the gyro and the
+  // odometry's orientations carried to b, C_ab(t_k + tau) =
+  // C_ab(t_f + tau) C_bl C_{l0 lk} C_bl^T (f: the first registered scan).
+  start = std::chrono::steady_clock::now();
+  const Eigen::Quaterniond c_bl_q = c_bl_init.normalized();
+  Eigen::Quaterniond anchor = Eigen::Quaterniond::Identity();  // C_ab(t_f + tau)
+  {
+    std::vector<double> times;
+    std::vector<Eigen::Quaterniond> orientations;
+    bool have_anchor = false;
+    for (size_t i = 0; i < poses.size(); ++i) {
+      if (i > 0 && !poses[i].registered) continue;
+      const double t_imu = scans[scan_of_pose[i]].stamp_s + state->time_offset_s[0];
+      spline::So3SplineSample rot;
+      if (!traj.Evaluate(t_imu, spline::kSo3Rotation, &rot, nullptr)) continue;
+      if (!have_anchor) {
+        anchor = Eigen::Quaterniond(rot.rotation);
+        have_anchor = true;
+      }
+      times.push_back(t_imu);
+      orientations.push_back(anchor * c_bl_q * Eigen::Quaterniond(poses[i].l0_from_lidar.rotation()) *
+                             c_bl_q.conjugate());
+    }
+    if (options.odometry_rotation_sigma_rad > 0.0 && times.size() >= 2) {
+      report->rotation_refit_rms =
+          RefineRotationSpline(times, orientations, imu_samples, options, state);
+    }
+  }
+  report->rotation_fit_seconds += Seconds(start);
+
   // 5. Position spline from the odometry and the accelerometer.
   start = std::chrono::steady_clock::now();
   const Eigen::Matrix3d c_bl_m = c_bl_init.toRotationMatrix();
@@ -336,7 +404,7 @@ Status InitialiseState(const std::vector<imu::ImuReading>& imu_samples,
     spline::So3SplineSample rot;
     if (!traj.Evaluate(t_imu, spline::kSo3Rotation, &rot, nullptr)) continue;
     times.push_back(t_imu);
-    positions.push_back(c_ab_first * (c_bl_m * r_odo + r_bl) - rot.rotation * r_bl);
+    positions.push_back(anchor * (c_bl_m * r_odo + r_bl) - rot.rotation * r_bl);
   }
   report->position_fit_rms = FitPositionSpline(times, positions, imu_samples, options, state);
   report->position_fit_seconds = Seconds(start);

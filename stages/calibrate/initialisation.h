@@ -18,6 +18,9 @@
 //     tilt angles, keeps the rig's angle about the axis);
 //  4b. coarse tau by a grid search of the odometry's scan-to-scan rotations
 //     against the gyro spline (SearchTimeOffset);
+//  4c. the rotation spline refitted to the gyro and the odometry's
+//     orientations carried to b (RefineRotationSpline), so that its heading
+//     follows the LiDAR instead of the integrated gyro bias error;
 //  5. position spline r_a^{ba}(t): with C_ab from step 2, the odometry gives
 //     the IMU positions at the scan times,
 //       r_a(t_k) = C_ab(t_f) (C_bl r_{l0}^{lk l0} + r_b^{lb}) - C_ab(t_k) r_b^{lb}
@@ -48,6 +51,7 @@ struct InitialisationOptions {
   double gyro_sigma_radps = 0.01;
   double accel_sigma_mps2 = 0.05;
   double position_sigma_m = 0.05;    // odometry position samples
+  double odometry_rotation_sigma_rad = 0.0017;  // odometry orientation samples (0 = off)
   double deskew_node_spacing_s = 0.005;
   int solver_iterations = 10;
   int num_threads = 1;
@@ -69,6 +73,7 @@ struct InitialisationReport {
   int odometry_registered = 0;
   double odometry_mean_fitness_m = 0.0;
   double gyro_fit_rms = 0.0;      // RMS weighted gyro residual after the fit
+  double rotation_refit_rms = 0.0;  // RMS weighted residual of step 4c
   double position_fit_rms = 0.0;  // RMS weighted residual of the position fit
   bool axis_alignment_applied = false;
   double axis_alignment_deg = 0.0;  // correction of the rig's C_bl by the axis alignment
@@ -107,6 +112,14 @@ double SearchTimeOffset(const CalibrationState& state, const std::vector<double>
 // gyro-only LM fit. Returns the RMS weighted gyro residual.
 double FitRotationSplineToGyro(const std::vector<imu::ImuReading>& imu_samples,
                                const InitialisationOptions& options, CalibrationState* state);
+
+// Step 4c alone: LM fit of the rotation knots (from their current values) to
+// the gyro and to orientations C_ab at IMU times (OrientationSampleCostFunction,
+// sigma options.odometry_rotation_sigma_rad). Returns the RMS weighted residual.
+double RefineRotationSpline(const std::vector<double>& times_s,
+                            const std::vector<Eigen::Quaterniond>& orientations_a_from_b,
+                            const std::vector<imu::ImuReading>& imu_samples,
+                            const InitialisationOptions& options, CalibrationState* state);
 
 // Step 5 alone: position knots from IMU positions r_a(t) at IMU times (knots
 // first interpolated linearly, then the LM fit with the accelerometer).

@@ -305,17 +305,15 @@ TEST(CalibratePipelineTest, ShortFlatSequenceAgainstTruth) {
               rot_deg, tilt_deg, yaw_deg, rig_rot_deg, planar_cm, dt.dot(up_b) * 100.0, tau_ms,
               gravity_deg);
   // Tolerances for this 16 s sequence, LiDAR + IMU only. Measured (seed 3):
-  // tilt ~0.02 deg (sigma ~0.02 deg), yaw 0.4-0.65 deg (the weak angle about
-  // the vertical, sigma ~0.9 deg here), planar translation 0.9-2.6 cm (sigma
-  // ~4 cm per axis), tau ~0.13 ms (sigma ~0.7 ms), gravity ~0.3 deg. The
-  // issue's bounds (0.1 deg / 1 cm / 0.5 ms) are for 40-60 s sequences and
-  // measured by bench/calibrate.
-  EXPECT_LT(tilt_deg, 0.1);
-  EXPECT_LT(yaw_deg, 1.5);
-  EXPECT_LT(rot_deg, rig_rot_deg);  // better than the rig's measured value
-  EXPECT_LT(planar_cm, 6.0);
-  EXPECT_LT(tau_ms, 1.0);
-  EXPECT_LT(gravity_deg, 0.8);
+  // tilt 0.006 deg, yaw 0.08 deg, planar translation 0.5 cm, tau 0.01 ms,
+  // gravity 0.01 deg, i.e. within the bounds (0.1 deg / 1 cm /
+  // 0.5 ms, stated for 40-60 s sequences and measured by bench/calibrate)
+  // already here; the margins below allow for another machine's rounding.
+  EXPECT_LT(tilt_deg, 0.05);
+  EXPECT_LT(yaw_deg, 0.25);
+  EXPECT_LT(planar_cm, 1.5);
+  EXPECT_LT(tau_ms, 0.5);
+  EXPECT_LT(gravity_deg, 0.1);
 
   // Result fields.
   EXPECT_EQ(result.covariance_size(), 49);

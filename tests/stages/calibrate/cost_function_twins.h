@@ -16,6 +16,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "common/geometry/so3.h"
 #include "tests/common/spline/spline_reference.h"
 
 namespace tiltcal::testing {
@@ -111,7 +112,27 @@ struct PointToPlaneTwinT {
   using AutoDiff = ceres::AutoDiffCostFunction<PointToPlaneTwinT, 1, 4, 4, 4, 4, 3, 3, 3, 3, 4, 3, 1>;
 };
 
+// r = Log(C_m^T C(t)) / sigma.
+template <bool kSommer>
+struct OrientationTwinT {
+  double u, inv_dt, sigma;
+  Eigen::Quaterniond measured;
+  template <typename T>
+  bool operator()(const T* const q0, const T* const q1, const T* const q2, const T* const q3,
+                  T* residual) const {
+    Eigen::Quaternion<T> q[4];
+    LoadQuaternions(q0, q1, q2, q3, q);
+    const auto s = EvaluateSo3<kSommer>(q, T(u), inv_dt);
+    const Eigen::Matrix<T, 3, 1> phi =
+        geometry::LogQuaternion<T>(measured.cast<T>().conjugate() * s.q);
+    for (int r = 0; r < 3; ++r) residual[r] = phi[r] / sigma;
+    return true;
+  }
+  using AutoDiff = ceres::AutoDiffCostFunction<OrientationTwinT, 3, 4, 4, 4, 4>;
+};
+
 using GyroTwin = GyroTwinT<false>;
+using OrientationTwin = OrientationTwinT<false>;
 using AccelTwin = AccelTwinT<false>;
 using PointToPlaneTwin = PointToPlaneTwinT<false>;
 
