@@ -10,9 +10,13 @@
 # The tilted sequence takes its flat-ground gravity g_f from the level run
 # (rig gravity_reference -> level/gravity.txtpb), as a real dataset would.
 #
+# A set is residual names joined by "+"; a name with the suffix "L2" (e.g.
+# "flatL2") is that residual without its robust loss (cauchy_scale 0), which
+# shows what the Cauchy loss hides: the flat residual's bias on tilted ground.
+#
 #   scripts/ground_ablation.sh [BIN_DIR]
-#   ABLATION_DIR=/tmp/ablation ABLATION_DURATION_S=30 ABLATION_SETS="none dist" \
-#     ABLATION_MISINIT=0 scripts/ground_ablation.sh build-x/bin
+#   ABLATION_DIR=/tmp/ablation ABLATION_DURATION_S=30 ABLATION_SEED=2 \
+#     ABLATION_SETS="none dist" ABLATION_MISINIT=0 scripts/ground_ablation.sh build-x/bin
 #
 # Outputs in $ABLATION_DIR: the sequences, base_calibrate_params.txtpb (the
 # defaults every run starts from, copied once), runs/<name>/{params,
@@ -24,7 +28,8 @@ ROOT=$(pwd)
 BIN=$(cd "${1:-$ROOT/build/bin}" && pwd)
 WORK=${ABLATION_DIR:-/tmp/tiltcal_ground_ablation}
 DURATION_S=${ABLATION_DURATION_S:-30}
-SETS=${ABLATION_SETS:-"none flat dist incl dist+incl dist+up flat+dist"}
+SEED=${ABLATION_SEED:-1}  # simulator seed of both sequences (noise, world)
+SETS=${ABLATION_SETS:-"none flat flatL2 dist incl dist+incl dist+up flat+dist"}
 MISINIT=${ABLATION_MISINIT:-1}
 MISINIT_SETS=${ABLATION_MISINIT_SETS:-"none dist incl dist+incl dist+up"}
 MISINIT_OFFSET=(-0.6 1.0 0.6)  # m, added to the rig's r_b^{lb}
@@ -45,6 +50,7 @@ prepare() {  # name base_scenario
   if [ -s "$dir/gravity.txtpb" ]; then log "$name: reusing $dir"; return; fi
   mkdir -p "$dir"
   sed -E -e "s/^duration_s: .*/duration_s: $DURATION_S/" -e "s/^num_threads: .*/num_threads: 2/" \
+    -e "s/^seed: .*/seed: $SEED/" \
     "$base" > "$dir/scenario.txtpb"
   log "$name: simulate ($DURATION_S s)"
   "$BIN/tiltcal_simulate" --quiet --params="$dir/scenario.txtpb" --out_bag="$dir/seq.bag" \
@@ -71,8 +77,9 @@ write_params() {  # set out_file
   local set=$1 out=$2 script=()
   for r in flat dist incl up; do
     local mode=OFF
-    [[ "+$set+" == *"+$r+"* ]] && mode=ON
+    [[ "+$set+" == *"+$r+"* || "+$set+" == *"+${r}L2+"* ]] && mode=ON
     script+=(-e "s/^$r \\{ mode: [A-Z]+/$r { mode: $mode/")
+    [[ "+$set+" == *"+${r}L2+"* ]] && script+=(-e "/^$r \\{/s/cauchy_scale: [0-9.eE+-]+/cauchy_scale: 0/")
   done
   sed -E "${script[@]}" "$WORK/base_calibrate_params.txtpb" > "$out"
   for r in flat dist incl up; do
@@ -187,7 +194,7 @@ done
   "${DIRS[@]}" > /dev/null
 
 {
-  echo "Ground-residual ablation: ${DURATION_S} s Husky-like VLP-16 sequences (level; tilted 8 deg pitch, 3 deg roll)."
+  echo "Ground-residual ablation: ${DURATION_S} s Husky-like VLP-16 sequences (level; tilted 8 deg pitch, 3 deg roll), seed $SEED."
   echo "Errors = estimate - truth. misinit: tilted, rig r_b^{lb} off by [${MISINIT_OFFSET[*]}] m."
   echo "Measured rig (initial guess) is off by (0.5, -0.7, 1.5) deg and (2, -3, 2.5) cm."
   echo

@@ -80,6 +80,7 @@ InitialisationOptions MakeInitialisationOptions(const proto::CalibrateParams& pa
   o.odometry_scan_step = static_cast<int>(std::max(1u, params.odometry_scan_step()));
   o.hand_eye.consistent_angle_deg = params.hand_eye_consistent_angle_deg();
   o.odometry_rotation_sigma_rad = params.init_odometry_rotation_sigma_deg() * M_PI / 180.0;
+  o.translation_prior_sigma_m = params.extrinsic_translation_prior_sigma_m();
   return o;
 }
 
@@ -194,6 +195,10 @@ Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& pa
   Log(log, Format("init: rotation-axis alignment %.0f (%.3f deg), coarse tau %.2f ms",
                   init.axis_alignment_applied ? 1 : 0, init.axis_alignment_deg,
                   init.time_offset_init_s * 1e3));
+  {
+    const Eigen::Vector3d r = state.ImuFromLidarTranslation();
+    Log(log, Format("init: r_bl (%.4f, %.4f, %.4f) m from the position fit", r.x(), r.y(), r.z()));
+  }
 
   // Ground residuals (issue 6, ground_residuals.h): selected from the params
   // (AUTO / ON / OFF), the rig's d_b and the gravity reference.
@@ -211,6 +216,7 @@ Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& pa
   const AssociationStageOptions assoc_options = MakeAssociationOptions(params);
   ProblemOptions problem_options = MakeProblemOptions(params);
   problem_options.translation_prior_m = measured.translation;
+  problem_options.translation_prior_axis_b = init.rotation_axis_b;
   const ceres::Solver::Options solver_options =
       MakeSolverOptions(static_cast<int>(params.max_solver_iterations()),
                         static_cast<int>(params.num_threads()), params.function_tolerance());

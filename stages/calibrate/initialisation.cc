@@ -11,6 +11,7 @@
 #include "common/imu/gyro_integrator.h"
 #include "common/spline/cubic_basis.h"
 #include "common/spline/so3_spline.h"
+#include "stages/calibrate/covariance_report.h"
 #include "stages/calibrate/orientation_sample_cost_function.h"
 #include "stages/calibrate/problem_builder.h"
 
@@ -21,30 +22,41 @@ double Seconds(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-// r = (sum_j b_j(u) p_{s+j} - p_measured) / sigma   (3), position knots s..s+3.
-class PositionSampleCost final : public ceres::SizedCostFunction<3, 3, 3, 3, 3> {
+// LiDAR position sample at IMU time t, with C_ab(t) held (rotation knots
+// constant in the position fit):
+//   r = (sum_j b_j(u) p_{s+j} + C_ab(t) r_b^{lb} - p_l,measured) / sigma   (3),
+// parameter blocks: position knots s..s+3, then r_b^{lb}.
+class LidarPositionSampleCost final : public ceres::SizedCostFunction<3, 3, 3, 3, 3, 3> {
  public:
-  PositionSampleCost(double u, double inv_dt, const Eigen::Vector3d& measured, double sigma)
-      : basis_(spline::UniformCubicBasis(u, inv_dt)), measured_(measured), inv_sigma_(1.0 / sigma) {}
+  LidarPositionSampleCost(double u, double inv_dt, const Eigen::Matrix3d& a_from_b,
+                          const Eigen::Vector3d& measured, double sigma)
+      : basis_(spline::UniformCubicBasis(u, inv_dt)),
+        a_from_b_(a_from_b),
+        measured_(measured),
+        inv_sigma_(1.0 / sigma) {}
 
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override {
-    Eigen::Vector3d p = -measured_;
+    Eigen::Vector3d p = a_from_b_ * Eigen::Map<const Eigen::Vector3d>(parameters[4]) - measured_;
     for (int j = 0; j < 4; ++j) p += basis_.value[j] * Eigen::Map<const Eigen::Vector3d>(parameters[j]);
     Eigen::Map<Eigen::Vector3d> r(residuals);
     r = inv_sigma_ * p;
-    if (jacobians != nullptr) {
-      for (int j = 0; j < 4; ++j) {
-        if (jacobians[j] == nullptr) continue;
-        Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> jac(jacobians[j]);
-        jac = (inv_sigma_ * basis_.value[j]) * Eigen::Matrix3d::Identity();
-      }
+    if (jacobians == nullptr) return true;
+    for (int j = 0; j < 4; ++j) {
+      if (jacobians[j] == nullptr) continue;
+      Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> jac(jacobians[j]);
+      jac = (inv_sigma_ * basis_.value[j]) * Eigen::Matrix3d::Identity();
+    }
+    if (jacobians[4] != nullptr) {
+      Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> jac(jacobians[4]);
+      jac = inv_sigma_ * a_from_b_;
     }
     return true;
   }
 
  private:
   spline::CubicBasis basis_;
+  Eigen::Matrix3d a_from_b_;
   Eigen::Vector3d measured_;
   double inv_sigma_;
 };
@@ -199,46 +211,78 @@ double RefineRotationSpline(const std::vector<double>& times_s,
 }
 
 double FitPositionSpline(const std::vector<double>& times_s,
-                         const std::vector<Eigen::Vector3d>& positions_a,
+                         const std::vector<Eigen::Vector3d>& lidar_positions_a,
                          const std::vector<imu::ImuReading>& imu_samples,
                          const InitialisationOptions& options, CalibrationState* state) {
   spline::SplineTrajectory& traj = state->trajectory;
   const spline::UniformKnotGrid& grid = traj.grid();
-  if (times_s.empty()) return 0.0;
+  // C_ab at the sample times (held) and the IMU positions they imply with
+  // the current r_b^{lb}, for the starting knots.
+  std::vector<double> times;
+  std::vector<Eigen::Matrix3d> rotations;
+  std::vector<Eigen::Vector3d> lidar_positions, imu_positions;
+  const Eigen::Vector3d r_bl = state->ImuFromLidarTranslation();
+  for (size_t k = 0; k < times_s.size(); ++k) {
+    spline::So3SplineSample rot;
+    if (!traj.Evaluate(times_s[k], spline::kSo3Rotation, &rot, nullptr)) continue;
+    times.push_back(times_s[k]);
+    rotations.push_back(rot.rotation);
+    lidar_positions.push_back(lidar_positions_a[k]);
+    imu_positions.push_back(lidar_positions_a[k] - rot.rotation * r_bl);
+  }
+  if (times.empty()) return 0.0;
   for (int i = 0; i < traj.num_knots(); ++i) {
-    traj.SetPositionKnot(i, Interpolate(times_s, positions_a, grid.t0_s() + (i - 1) * grid.dt_s()));
+    traj.SetPositionKnot(i, Interpolate(times, imu_positions, grid.t0_s() + (i - 1) * grid.dt_s()));
   }
   // The accelerometer bias and g_a are estimated with the positions: with
   // the bias held at 0, its double integral (~ b t^2 / 2, metres within
-  // seconds) would bend the positions away from the odometry's.
+  // seconds) would bend the positions away from the odometry's. So is the
+  // lever arm r_b^{lb} (prior at its current value): a wrong one makes the
+  // IMU positions p_l - C_ab r_b^{lb} swing with the heading, which the
+  // accelerometer contradicts.
   ProblemOptions fit = FitOptions(options);
   fit.estimate_biases = true;
   fit.estimate_gravity = true;
+  fit.fix_first_knots = false;  // the position samples pin the gauge
+  const bool lever_arm = options.translation_prior_sigma_m > 0.0;
+  fit.estimate_extrinsic = lever_arm;
+  fit.translation_prior_m = r_bl;
+  fit.translation_prior_sigma_m = options.translation_prior_sigma_m;
+  fit.translation_prior_axis_b = options.translation_prior_axis_b;
   CalibrationProblem problem(state, fit);
   problem.SetRotationKnotsConstant();
   problem.AddImuResiduals(imu_samples, /*gyro=*/false, /*accel=*/true);
   const double sigma = options.position_sigma_m;
   Status status = problem.AddExtraResiduals(
       [&](CalibrationState* s, ceres::Problem* p, int* added) {
-        for (size_t k = 0; k < times_s.size(); ++k) {
+        for (size_t k = 0; k < times.size(); ++k) {
           spline::KnotWindow w;
-          if (!grid.Locate(times_s[k], &w)) continue;
+          if (!grid.Locate(times[k], &w)) continue;
           const int f = w.first_knot;
-          p->AddResidualBlock(new PositionSampleCost(w.u, grid.inv_dt(), positions_a[k], sigma),
-                              nullptr, s->trajectory.position_knot(f),
-                              s->trajectory.position_knot(f + 1),
-                              s->trajectory.position_knot(f + 2),
-                              s->trajectory.position_knot(f + 3));
+          p->AddResidualBlock(
+              new LidarPositionSampleCost(w.u, grid.inv_dt(), rotations[k], lidar_positions[k],
+                                          sigma),
+              nullptr,
+              {s->trajectory.position_knot(f), s->trajectory.position_knot(f + 1),
+               s->trajectory.position_knot(f + 2), s->trajectory.position_knot(f + 3),
+               s->imu_from_lidar_translation});
           ++*added;
         }
         return Status::Ok();
       });
   (void)status;
   problem.RemoveUnusedKnots();
+  // Only the lever arm of the extrinsic is fitted here.
+  ceres::Problem& p = *problem.problem();
+  if (p.HasParameterBlock(state->imu_from_lidar_rotation)) {
+    p.RemoveParameterBlock(state->imu_from_lidar_rotation);
+  }
+  if (p.HasParameterBlock(state->time_offset_s)) p.RemoveParameterBlock(state->time_offset_s);
+  if (!lever_arm) p.SetParameterBlockConstant(state->imu_from_lidar_translation);
   ceres::Solver::Options solver =
       MakeSolverOptions(options.solver_iterations, options.num_threads, 1e-10);
   ceres::Solver::Summary summary;
-  ceres::Solve(solver, problem.problem(), &summary);
+  ceres::Solve(solver, &p, &summary);
   return RmsResidual(summary);
 }
 
@@ -257,6 +301,10 @@ Status InitialiseState(const std::vector<imu::ImuReading>& imu_samples,
   state->SetImuFromLidarTranslation(measured_imu_from_lidar.translation);
   state->time_offset_s[0] = 0.0;
   report->imu_seconds = Seconds(start);
+
+  const MotionAxis axis = PrincipalRotationAxis(imu_samples, report->imu.gyro_bias_radps);
+  report->rotation_axis_b = axis.axis_b;
+  report->rotation_axis_fraction = axis.fraction;
 
   // 2. Rotation spline from the gyro.
   start = std::chrono::steady_clock::now();
@@ -390,23 +438,21 @@ Status InitialiseState(const std::vector<imu::ImuReading>& imu_samples,
   }
   report->rotation_fit_seconds += Seconds(start);
 
-  // 5. Position spline from the odometry and the accelerometer.
+  // 5. Position spline (and lever arm) from the odometry's LiDAR positions,
+  // p_l(t_k) = C_ab(t_f + tau) C_bl r_{l0}^{lk l0} (the LiDAR at the first
+  // registered scan as origin), and the accelerometer.
   start = std::chrono::steady_clock::now();
   const Eigen::Matrix3d c_bl_m = c_bl_init.toRotationMatrix();
-  const Eigen::Vector3d r_bl = state->ImuFromLidarTranslation();
   std::vector<double> times;
   std::vector<Eigen::Vector3d> positions;
   for (size_t i = 0; i < poses.size(); ++i) {
     if (i > 0 && !poses[i].registered) continue;
-    const Eigen::Vector3d r_odo = poses[i].l0_from_lidar.translation();
-    // IMU time of the scan with the coarse tau; C_ab there from the spline.
-    const double t_imu = scans[scan_of_pose[i]].stamp_s + state->time_offset_s[0];
-    spline::So3SplineSample rot;
-    if (!traj.Evaluate(t_imu, spline::kSo3Rotation, &rot, nullptr)) continue;
-    times.push_back(t_imu);
-    positions.push_back(anchor * (c_bl_m * r_odo + r_bl) - rot.rotation * r_bl);
+    times.push_back(scans[scan_of_pose[i]].stamp_s + state->time_offset_s[0]);
+    positions.push_back(anchor * (c_bl_m * poses[i].l0_from_lidar.translation()));
   }
-  report->position_fit_rms = FitPositionSpline(times, positions, imu_samples, options, state);
+  InitialisationOptions fit_options = options;
+  fit_options.translation_prior_axis_b = axis.axis_b;
+  report->position_fit_rms = FitPositionSpline(times, positions, imu_samples, fit_options, state);
   report->position_fit_seconds = Seconds(start);
   return Status::Ok();
 }

@@ -21,12 +21,13 @@
 //  4c. the rotation spline refitted to the gyro and the odometry's
 //     orientations carried to b (RefineRotationSpline), so that its heading
 //     follows the LiDAR instead of the integrated gyro bias error;
-//  5. position spline r_a^{ba}(t): with C_ab from step 2, the odometry gives
-//     the IMU positions at the scan times,
-//       r_a(t_k) = C_ab(t_f) (C_bl r_{l0}^{lk l0} + r_b^{lb}) - C_ab(t_k) r_b^{lb}
-//     (t_f: the first registered scan, r_a(t_f) taken as 0; scan k at IMU
-//     time t_k + tau), fitted by LM together with the accelerometer
-//     residuals (rotation, gravity, biases held).
+//  5. position spline r_a^{ba}(t) and the lever arm r_b^{lb}: the odometry
+//     gives the LiDAR positions at the scan times (scan k at IMU time
+//     t_k + tau; the LiDAR at the first registered scan f as origin),
+//       p_l(t_k) = C_ab(t_f) C_bl r_{l0}^{lk l0} = r_a^{ba}(t_k) + C_ab(t_k) r_b^{lb},
+//     fitted by LM together with the accelerometer residuals (rotation held;
+//     gravity direction, accelerometer bias and r_b^{lb} free, the latter
+//     with a prior at the rig's value).
 // The odometry registers every odometry_scan_step-th scan.
 
 #include <vector>
@@ -52,6 +53,10 @@ struct InitialisationOptions {
   double accel_sigma_mps2 = 0.05;
   double position_sigma_m = 0.05;    // odometry position samples
   double odometry_rotation_sigma_rad = 0.0017;  // odometry orientation samples (0 = off)
+  // Prior on r_b^{lb} at the rig's value in the position fit, along the
+  // motion's principal rotation axis (0: r_b^{lb} held).
+  double translation_prior_sigma_m = 0.05;
+  Eigen::Vector3d translation_prior_axis_b = Eigen::Vector3d::Zero();  // 0: isotropic
   double deskew_node_spacing_s = 0.005;
   int solver_iterations = 10;
   int num_threads = 1;
@@ -78,6 +83,10 @@ struct InitialisationReport {
   bool axis_alignment_applied = false;
   double axis_alignment_deg = 0.0;  // correction of the rig's C_bl by the axis alignment
   double time_offset_init_s = 0.0;  // coarse tau
+  // Principal rotation axis of the (bias-corrected) gyro, frame b, and the
+  // share of sum omega omega^T along it (covariance_report.h).
+  Eigen::Vector3d rotation_axis_b = Eigen::Vector3d::UnitZ();
+  double rotation_axis_fraction = 0.0;
   double imu_seconds = 0.0;
   double rotation_fit_seconds = 0.0;
   double odometry_seconds = 0.0;
@@ -121,11 +130,12 @@ double RefineRotationSpline(const std::vector<double>& times_s,
                             const std::vector<imu::ImuReading>& imu_samples,
                             const InitialisationOptions& options, CalibrationState* state);
 
-// Step 5 alone: position knots from IMU positions r_a(t) at IMU times (knots
-// first interpolated linearly, then the LM fit with the accelerometer).
-// Returns the RMS weighted residual.
+// Step 5 alone: position knots, r_b^{lb}, g_a and b_a from LiDAR positions
+// p_l(t) in a at IMU times and the accelerometer, rotation knots held
+// (knots first interpolated linearly from p_l - C_ab r_b^{lb}). Returns the
+// RMS weighted residual.
 double FitPositionSpline(const std::vector<double>& times_s,
-                         const std::vector<Eigen::Vector3d>& positions_a,
+                         const std::vector<Eigen::Vector3d>& lidar_positions_a,
                          const std::vector<imu::ImuReading>& imu_samples,
                          const InitialisationOptions& options, CalibrationState* state);
 

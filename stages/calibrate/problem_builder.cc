@@ -11,23 +11,29 @@
 namespace tiltcal::calibrate {
 namespace {
 
-// r = (t - t_prior) / sigma  (3).
+// r = W (t - t_prior)  (3), W = I / sigma or a a^T / sigma (prior along a only).
 class TranslationPriorCost final : public ceres::SizedCostFunction<3, 3> {
  public:
-  TranslationPriorCost(const Eigen::Vector3d& prior, double sigma)
-      : prior_(prior), inv_sigma_(1.0 / sigma) {}
+  TranslationPriorCost(const Eigen::Vector3d& prior, double sigma, const Eigen::Vector3d& axis)
+      : prior_(prior) {
+    weight_ = axis.norm() > 0.0 ? Eigen::Matrix3d(axis.normalized() * axis.normalized().transpose())
+                                : Eigen::Matrix3d::Identity();
+    weight_ /= sigma;
+  }
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override {
-    for (int i = 0; i < 3; ++i) residuals[i] = (parameters[0][i] - prior_[i]) * inv_sigma_;
+    Eigen::Map<Eigen::Vector3d> r(residuals);
+    r = weight_ * (Eigen::Map<const Eigen::Vector3d>(parameters[0]) - prior_);
     if (jacobians != nullptr && jacobians[0] != nullptr) {
-      for (int i = 0; i < 9; ++i) jacobians[0][i] = (i % 4 == 0) ? inv_sigma_ : 0.0;
+      Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> j(jacobians[0]);
+      j = weight_;
     }
     return true;
   }
 
  private:
   Eigen::Vector3d prior_;
-  double inv_sigma_;
+  Eigen::Matrix3d weight_;
 };
 
 }  // namespace
@@ -85,7 +91,8 @@ CalibrationProblem::CalibrationProblem(CalibrationState* state, const ProblemOpt
   }
   if (options_.translation_prior_sigma_m > 0.0 && options_.estimate_extrinsic) {
     p.AddResidualBlock(new TranslationPriorCost(options_.translation_prior_m,
-                                                options_.translation_prior_sigma_m),
+                                                options_.translation_prior_sigma_m,
+                                                options_.translation_prior_axis_b),
                        nullptr, state_->imu_from_lidar_translation);
     counts_.prior_residuals = 1;
   }

@@ -22,8 +22,11 @@
 // (ReexpressInFirstImuFrame).
 //
 // Optional prior on r_b^{lb} (translation_prior_sigma_m > 0): one residual
-// (r_b^{lb} - r_prior) / sigma (3), counted with the ground residuals' kind
-// "prior" in ProblemCounts::prior_residuals.
+// (r_b^{lb} - r_prior) / sigma (3), or, with a unit translation_prior_axis_b,
+// only its component along that axis, a^T (r_b^{lb} - r_prior) / sigma (the
+// motion's principal rotation axis: the direction planar motion cannot
+// observe, while in-plane directions are left to the data). Counted in
+// ProblemCounts::prior_residuals.
 //
 // Time offset: tau is bounded to
 //   [max(-B, tau_bin - S), min(B, tau_bin + S)],
@@ -77,9 +80,11 @@ struct ProblemOptions {
   // Gauge by holding rotation knot 0 and position knot 0 (see above). Off
   // when fixed map planes already pin the world frame.
   bool fix_first_knots = true;
-  // Prior r_b^{lb} ~ N(translation_prior_m, sigma^2 I) (sigma 0 = none).
+  // Prior r_b^{lb} ~ N(translation_prior_m, sigma^2 I) (sigma 0 = none), or
+  // only along translation_prior_axis_b when that is non-zero (unit, frame b).
   Eigen::Vector3d translation_prior_m = Eigen::Vector3d::Zero();
   double translation_prior_sigma_m = 0.0;
+  Eigen::Vector3d translation_prior_axis_b = Eigen::Vector3d::Zero();
 };
 
 // Counts of what a build added.

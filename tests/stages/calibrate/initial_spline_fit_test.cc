@@ -2,13 +2,14 @@
 //  - step 4c: a gyro-only rotation spline drifts in heading when the gyro
 //    bias it was given is off; refitted to the gyro and orientation samples
 //    (10 Hz, as from the LiDAR odometry) it follows the samples;
-//  - step 5: the position spline fitted to position samples and the
-//    accelerometer recovers an accelerometer bias and keeps the positions,
-//    where a bias held at zero would bend them.
+//  - step 5: the position spline fitted to LiDAR position samples and the
+//    accelerometer recovers the accelerometer bias and a lever arm given
+//    half a metre off, and keeps the positions, where a bias held at zero
+//    would bend them.
 //
 // Truth (closed form, C_ab(0) = 1 as the gyro integration starts): planar
 // driving with a wobble,
-//   C_ab(t) = Exp(phi(t)),  phi = (0.02 sin 3t, 0.02 sin 2t, 0.5 sin 0.3t),
+//   C_ab(t) = Exp(phi(t)),  phi = (0.02 sin 3t, 0.02 sin 2t, 1.2 sin 0.5t),
 //   omega_b = J_r(phi) phi',
 //   r_a(t) = (2 sin 0.4t, 1.5 (cos 0.3t - 1), 0),  f_b = C_ab^T (r_a'' - g_a).
 
@@ -31,10 +32,10 @@ constexpr double kImuRate = 200.0;
 const Eigen::Vector3d kGravity(0.0, 0.0, -9.81);
 
 Eigen::Vector3d Phi(double t) {
-  return {0.02 * std::sin(3.0 * t), 0.02 * std::sin(2.0 * t), 0.5 * std::sin(0.3 * t)};
+  return {0.02 * std::sin(3.0 * t), 0.02 * std::sin(2.0 * t), 1.2 * std::sin(0.5 * t)};
 }
 Eigen::Vector3d PhiDot(double t) {
-  return {0.06 * std::cos(3.0 * t), 0.04 * std::cos(2.0 * t), 0.15 * std::cos(0.3 * t)};
+  return {0.06 * std::cos(3.0 * t), 0.04 * std::cos(2.0 * t), 0.6 * std::cos(0.5 * t)};
 }
 Eigen::Matrix3d Rotation(double t) { return geometry::ExpMatrix(Phi(t)); }
 Eigen::Vector3d Position(double t) {
@@ -78,7 +79,7 @@ InitialisationOptions Options() {
   o.accel_sigma_mps2 = 0.02;
   o.position_sigma_m = 0.02;
   o.odometry_rotation_sigma_rad = 0.0017;
-  o.solver_iterations = 20;
+  o.solver_iterations = 30;  // init_solver_iterations default
   o.num_threads = 2;
   return o;
 }
@@ -109,29 +110,38 @@ TEST(InitialSplineFitTest, OrientationSamplesRemoveTheHeadingDriftOfAWrongGyroBi
   EXPECT_LT(MaxRotationError(state), 0.003) << "gyro only: " << gyro_only;
 }
 
-TEST(InitialSplineFitTest, PositionFitEstimatesTheAccelerometerBias) {
+TEST(InitialSplineFitTest, PositionFitEstimatesTheAccelerometerBiasAndTheLeverArm) {
   std::mt19937 rng(11);
   const Eigen::Vector3d gyro_bias(0.002, -0.003, 0.0015);
   const Eigen::Vector3d accel_bias(0.05, -0.03, 0.08);
+  const Eigen::Vector3d r_bl(0.2477, -0.0699, -0.4636);  // r_b^{lb}, m
   const std::vector<imu::ImuReading> imu = Imu(gyro_bias, accel_bias, &rng);
   const spline::UniformKnotGrid grid = spline::UniformKnotGrid::ForDuration(0.0, kDuration, 0.05);
   CalibrationState state(grid);
   state.SetGyroBias(gyro_bias);
   state.SetGravityDirection(kGravity + Eigen::Vector3d(0.2, -0.1, 0.0));  // off by ~1.3 deg
+  const Eigen::Vector3d r_bl_given = r_bl + Eigen::Vector3d(-0.3, 0.4, 0.0);
+  state.SetImuFromLidarTranslation(r_bl_given);
   FitRotationSplineToGyro(imu, Options(), &state);
   ASSERT_LT(MaxRotationError(state), 0.01);
 
+  // LiDAR positions p_l = r_a^{ba} + C_ab r_b^{lb}, 1 cm noise, 10 Hz.
   std::normal_distribution<double> n(0.0, 1.0);
   std::vector<double> times;
   std::vector<Eigen::Vector3d> positions;
   for (double t = 0.1; t < kDuration - 0.1; t += 0.1) {
     times.push_back(t);
-    positions.push_back(Position(t) + 0.01 * Eigen::Vector3d(n(rng), n(rng), n(rng)));
+    positions.push_back(Position(t) + Rotation(t) * r_bl +
+                        0.01 * Eigen::Vector3d(n(rng), n(rng), n(rng)));
   }
   FitPositionSpline(times, positions, imu, Options(), &state);
-  // The residual rotation error of the gyro fit (~mrad) tilts g_b by as much:
+  // The gyro-only rotation's tilt error (~1 mrad) tilts g_b by as much:
   // ~0.01 m/s^2 of bias.
   EXPECT_LT((state.AccelBias() - accel_bias).norm(), 0.02) << state.AccelBias().transpose();
+  // In the plane of the turns the lever arm is observable (centripetal and
+  // angular accelerations); along the yaw axis it stays near the given value.
+  const Eigen::Vector3d dr = state.ImuFromLidarTranslation() - r_bl;
+  EXPECT_LT(dr.head<2>().norm(), 0.02) << "r_b^{lb} error " << dr.transpose();
   double sum_sq = 0.0;
   int count = 0;
   for (double t = 0.5; t < kDuration - 0.5; t += 0.1) {
@@ -140,9 +150,9 @@ TEST(InitialSplineFitTest, PositionFitEstimatesTheAccelerometerBias) {
     sum_sq += (pos.position - Position(t)).squaredNorm();
     ++count;
   }
-  // The gyro-only rotation's tilt error (~1 mrad) leaks ~0.01 m/s^2 of
-  // gravity, which the 10 Hz samples hold to 1-2 cm RMS; with the bias held
-  // at zero the positions are 6 cm RMS off here.
+  // The gravity leak of the ~1 mrad tilt error is held by the 10 Hz samples
+  // to 1-2 cm RMS; with the bias held at zero the positions are several
+  // centimetres off.
   EXPECT_LT(std::sqrt(sum_sq / count), 0.03)
       << "bias " << state.AccelBias().transpose() << " g " << state.GravityInWorld().transpose();
 }
