@@ -94,9 +94,18 @@ def main():
         get(cal, 'solver.iterations'), get(cal, 'solver.seconds_per_iteration'),
         get(cal, 'solver.converged', False), get(cal, 'solver.termination', '')))
     if wall is not None:
-        print('calibrate wall %.2f s (target <= 60 s), x_realtime %.2f (sequence %.0f s)' % (
-            wall, 60.0 / wall if wall > 0 else 0.0, 60.0))
-    up = vec(truth, 'gravity_in_world')
+        print('calibrate wall %.2f s (target <= 60 s), outer rounds %d (last moved %.4f deg, '
+              '%.2f mm, %.3f ms), x_realtime %.2f (sequence %.0f s)' % (
+            wall, get(cal, 'solver.outer_iterations'),
+            get(cal, 'solver.last_outer_rotation_change_deg'),
+            get(cal, 'solver.last_outer_translation_change_m') * 1e3,
+            get(cal, 'solver.last_outer_time_offset_change_s') * 1e3,
+            60.0 / wall if wall > 0 else 0.0, 60.0))
+    # Normal of the plane of motion in b: gravity-up on flat ground (g_f, the
+    # same on tilted ground for a rigid vehicle), else gravity at t0 (a = b(t0)).
+    up = vec(truth, 'gravity_flat_in_imu')
+    if not any(up):
+        up = vec(truth, 'gravity_in_world')
     n = math.sqrt(sum(x * x for x in up))
     up = [-x / n for x in up]
     est_t = vec(cal, 'imu_from_lidar.translation')
@@ -114,7 +123,7 @@ def main():
     print('  translation b-x/y/z %.3f / %.3f / %.3f cm   (rig: %.1f / %.1f / %.1f cm)' % (
         dt[0] * 100, dt[1] * 100, dt[2] * 100, (rig_t[0] - tru_t[0]) * 100,
         (rig_t[1] - tru_t[1]) * 100, (rig_t[2] - tru_t[2]) * 100))
-    print('  translation in the plane of motion %.3f cm, along up (weak) %.3f cm' % (
+    print('  translation in the plane of motion %.3f cm, along its normal %.3f cm' % (
         planar * 100, vertical * 100))
     print('  tau                 %.3f ms   (truth %.2f ms)' % (tau, get(truth, 'time_offset_s') * 1e3))
     g_est = vec(cal, 'gravity_in_world')

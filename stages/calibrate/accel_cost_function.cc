@@ -19,10 +19,7 @@ AccelCostFunction::AccelCostFunction(const spline::KnotWindow& window, double in
 
 bool AccelCostFunction::Evaluate(double const* const* parameters, double* residuals,
                                  double** jacobians) const {
-  bool rotation_jacobians = false;
-  if (jacobians != nullptr) {
-    for (int i = 0; i < 4; ++i) rotation_jacobians |= jacobians[i] != nullptr;
-  }
+  const bool rotation_jacobians = KnotJacobiansRequested(jacobians);
   spline::So3SplineSample s;
   spline::EvaluateSo3Spline(
       parameters, u_, inv_dt_,

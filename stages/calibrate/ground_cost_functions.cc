@@ -12,12 +12,8 @@ namespace {
 // Which spline outputs a residual needs, given the requested Jacobians
 // (blocks 0..3 are the rotation knots, block 6 is tau).
 int SplineOutputs(double** jacobians, bool* knot_jacobians, bool* tau_jacobian) {
-  *knot_jacobians = false;
-  *tau_jacobian = false;
-  if (jacobians != nullptr) {
-    for (int i = 0; i < 4; ++i) *knot_jacobians |= jacobians[i] != nullptr;
-    *tau_jacobian = jacobians[6] != nullptr;
-  }
+  *knot_jacobians = KnotJacobiansRequested(jacobians);
+  *tau_jacobian = jacobians != nullptr && jacobians[6] != nullptr;
   return spline::kSo3Rotation | (*knot_jacobians ? spline::kSo3RotationJacobian : 0) |
          (*tau_jacobian ? spline::kSo3AngularVelocity : 0);
 }

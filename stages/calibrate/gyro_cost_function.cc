@@ -11,10 +11,7 @@ GyroCostFunction::GyroCostFunction(const spline::KnotWindow& window, double inv_
 
 bool GyroCostFunction::Evaluate(double const* const* parameters, double* residuals,
                                 double** jacobians) const {
-  bool knot_jacobians = false;
-  if (jacobians != nullptr) {
-    for (int i = 0; i < 4; ++i) knot_jacobians |= jacobians[i] != nullptr;
-  }
+  const bool knot_jacobians = KnotJacobiansRequested(jacobians);
   spline::So3SplineSample s;
   spline::EvaluateSo3Spline(
       parameters, u_, inv_dt_,

@@ -25,6 +25,16 @@ inline void WriteJacobian(const Eigen::MatrixBase<Derived>& value, double* jacob
   out = value;
 }
 
+// Whether Ceres asked for the Jacobian of any of the four knot blocks
+// 0..3 (the first parameter blocks of every spline residual).
+inline bool KnotJacobiansRequested(double** jacobians) {
+  if (jacobians == nullptr) return false;
+  for (int i = 0; i < 4; ++i) {
+    if (jacobians[i] != nullptr) return true;
+  }
+  return false;
+}
+
 // Tangent Jacobian (kRows x 3) of a quaternion block q -> ambient kRows x 4.
 template <int kRows>
 inline void WriteQuaternionJacobian(const Eigen::Matrix<double, kRows, 3>& tangent,

@@ -16,10 +16,7 @@ OrientationSampleCostFunction::OrientationSampleCostFunction(
 
 bool OrientationSampleCostFunction::Evaluate(double const* const* parameters, double* residuals,
                                              double** jacobians) const {
-  bool knot_jacobians = false;
-  if (jacobians != nullptr) {
-    for (int i = 0; i < 4; ++i) knot_jacobians |= jacobians[i] != nullptr;
-  }
+  const bool knot_jacobians = KnotJacobiansRequested(jacobians);
   spline::So3SplineSample s;
   spline::EvaluateSo3Spline(
       parameters, u_, inv_dt_,

@@ -25,10 +25,7 @@ bool PointToPlaneCostFunction::Evaluate(double const* const* parameters, double*
   const double tau = parameters[10][0];
   const double u = (time_in_segment_s_ + tau) * inv_dt_;
 
-  bool rotation_jacobians = false;
-  if (jacobians != nullptr) {
-    for (int i = 0; i < 4; ++i) rotation_jacobians |= jacobians[i] != nullptr;
-  }
+  const bool rotation_jacobians = KnotJacobiansRequested(jacobians);
   const bool tau_jacobian = jacobians != nullptr && jacobians[10] != nullptr;
   spline::So3SplineSample s;
   spline::EvaluateSo3Spline(parameters, u, inv_dt_,
