@@ -276,13 +276,13 @@ Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& pa
         180.0 / M_PI;
     moved_m = (state.ImuFromLidarTranslation() - translation_before).norm();
     moved_s = std::abs(state.time_offset_s[0] - tau_before);
-    if (it >= 1 && moved_deg < params.outer_stop_rotation_deg() &&
-        moved_m < params.outer_stop_translation_m() &&
-        moved_s < params.outer_stop_time_offset_s()) {
-      Log(log, Format("outer %.0f: extrinsic moved %.4f deg, %.2f mm, tau %.3f ms: stop", it + 1,
-                      moved_deg, moved_m * 1e3, moved_s * 1e3));
-      break;
-    }
+    const bool settled = it >= 1 && moved_deg < params.outer_stop_rotation_deg() &&
+                         moved_m < params.outer_stop_translation_m() &&
+                         moved_s < params.outer_stop_time_offset_s();
+    Log(log, Format("outer %.0f: extrinsic moved %.4f deg, %.2f mm, tau %.3f ms", it + 1,
+                    moved_deg, moved_m * 1e3, moved_s * 1e3) +
+                 (settled ? ": stop" : ""));
+    if (settled) break;
   }
   AddTiming("map", map_s, result);
   AddTiming("association", assoc_s, result);

@@ -77,6 +77,15 @@ double RmsResidual(const ceres::Solver::Summary& summary) {
                                    : 0.0;
 }
 
+// LM on one of the initial fits; returns the RMS weighted residual.
+double SolveFit(const InitialisationOptions& options, ceres::Problem* problem) {
+  const ceres::Solver::Options solver =
+      MakeSolverOptions(options.solver_iterations, options.num_threads, 1e-10);
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver, problem, &summary);
+  return RmsResidual(summary);
+}
+
 // Linear interpolation of (times, values) at t, clamped at the ends.
 Eigen::Vector3d Interpolate(const std::vector<double>& times,
                             const std::vector<Eigen::Vector3d>& values, double t) {
@@ -172,11 +181,7 @@ double FitRotationSplineToGyro(const std::vector<imu::ImuReading>& imu_samples,
   CalibrationProblem problem(state, FitOptions(options));
   problem.AddImuResiduals(imu_samples, /*gyro=*/true, /*accel=*/false);
   problem.RemoveUnusedKnots();
-  ceres::Solver::Options solver =
-      MakeSolverOptions(options.solver_iterations, options.num_threads, 1e-10);
-  ceres::Solver::Summary summary;
-  ceres::Solve(solver, problem.problem(), &summary);
-  return RmsResidual(summary);
+  return SolveFit(options, problem.problem());
 }
 
 double RefineRotationSpline(const std::vector<double>& times_s,
@@ -203,11 +208,7 @@ double RefineRotationSpline(const std::vector<double>& times_s,
   });
   (void)status;
   problem.RemoveUnusedKnots();
-  ceres::Solver::Options solver =
-      MakeSolverOptions(options.solver_iterations, options.num_threads, 1e-10);
-  ceres::Solver::Summary summary;
-  ceres::Solve(solver, problem.problem(), &summary);
-  return RmsResidual(summary);
+  return SolveFit(options, problem.problem());
 }
 
 double FitPositionSpline(const std::vector<double>& times_s,
@@ -279,11 +280,7 @@ double FitPositionSpline(const std::vector<double>& times_s,
   }
   if (p.HasParameterBlock(state->time_offset_s)) p.RemoveParameterBlock(state->time_offset_s);
   if (!lever_arm) p.SetParameterBlockConstant(state->imu_from_lidar_translation);
-  ceres::Solver::Options solver =
-      MakeSolverOptions(options.solver_iterations, options.num_threads, 1e-10);
-  ceres::Solver::Summary summary;
-  ceres::Solve(solver, &p, &summary);
-  return RmsResidual(summary);
+  return SolveFit(options, &p);
 }
 
 Status InitialiseState(const std::vector<imu::ImuReading>& imu_samples,
