@@ -197,7 +197,8 @@ Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& pa
                   init.time_offset_init_s * 1e3));
   {
     const Eigen::Vector3d r = state.ImuFromLidarTranslation();
-    Log(log, Format("init: r_bl (%.4f, %.4f, %.4f) m from the position fit", r.x(), r.y(), r.z()));
+    Log(log, Format("init: rotation refit rms %.3f; r_bl (%.4f, %.4f, %.4f) m from the position fit",
+                    init.rotation_refit_rms, r.x(), r.y(), r.z()));
   }
 
   // Ground residuals (issue 6, ground_residuals.h): selected from the params

@@ -245,8 +245,7 @@ double FitPositionSpline(const std::vector<double>& times_s,
   fit.estimate_biases = true;
   fit.estimate_gravity = true;
   fit.fix_first_knots = false;  // the position samples pin the gauge
-  const bool lever_arm = options.translation_prior_sigma_m > 0.0;
-  fit.estimate_extrinsic = lever_arm;
+  fit.estimate_extrinsic = options.translation_prior_sigma_m > 0.0;
   fit.translation_prior_m = r_bl;
   fit.translation_prior_sigma_m = options.translation_prior_sigma_m;
   fit.translation_prior_axis_b = options.translation_prior_axis_b;
@@ -272,15 +271,8 @@ double FitPositionSpline(const std::vector<double>& times_s,
         return Status::Ok();
       });
   (void)status;
-  problem.RemoveUnusedKnots();
-  // Only the lever arm of the extrinsic is fitted here.
-  ceres::Problem& p = *problem.problem();
-  if (p.HasParameterBlock(state->imu_from_lidar_rotation)) {
-    p.RemoveParameterBlock(state->imu_from_lidar_rotation);
-  }
-  if (p.HasParameterBlock(state->time_offset_s)) p.RemoveParameterBlock(state->time_offset_s);
-  if (!lever_arm) p.SetParameterBlockConstant(state->imu_from_lidar_translation);
-  return SolveFit(options, &p);
+  problem.RemoveUnusedKnots();  // C_bl and tau: no residual here uses them
+  return SolveFit(options, problem.problem());
 }
 
 Status InitialiseState(const std::vector<imu::ImuReading>& imu_samples,

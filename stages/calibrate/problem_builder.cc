@@ -190,17 +190,16 @@ void CalibrationProblem::RemoveUnusedKnots() {
     if (!rotation_used_[i]) problem_->RemoveParameterBlock(traj.rotation_knot(i));
     if (!position_used_[i]) problem_->RemoveParameterBlock(traj.position_knot(i));
   }
-  if (counts_.lidar_residuals == 0 && counts_.ground_residuals == 0 &&
-      counts_.prior_residuals == 0) {
-    problem_->RemoveParameterBlock(state_->imu_from_lidar_rotation);
-    problem_->RemoveParameterBlock(state_->imu_from_lidar_translation);
-    problem_->RemoveParameterBlock(state_->time_offset_s);
+  // The calibration blocks: asked of Ceres (a scan of the residual blocks
+  // each; there are six), so extra residual sets are accounted for exactly.
+  std::vector<ceres::ResidualBlockId> users;
+  for (double* block : {state_->imu_from_lidar_rotation, state_->imu_from_lidar_translation,
+                        state_->time_offset_s, state_->gravity_direction,
+                        state_->gyro_bias_radps, state_->accel_bias_mps2}) {
+    users.clear();
+    problem_->GetResidualBlocksForParameterBlock(block, &users);
+    if (users.empty()) problem_->RemoveParameterBlock(block);
   }
-  if (counts_.accel_residuals == 0 && counts_.ground_residuals == 0) {
-    problem_->RemoveParameterBlock(state_->gravity_direction);
-    problem_->RemoveParameterBlock(state_->accel_bias_mps2);
-  }
-  if (counts_.gyro_residuals == 0) problem_->RemoveParameterBlock(state_->gyro_bias_radps);
 }
 
 const ProblemCounts& CalibrationProblem::counts() {

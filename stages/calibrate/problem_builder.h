@@ -123,10 +123,10 @@ class CalibrationProblem {
   // position-only fit).
   void SetRotationKnotsConstant();
   void SetPositionKnotsConstant();
-  // Removes the blocks that no residual added through this object uses (so
-  // the solver does not see parameters without information), keeping the
-  // state's values. Call after the last Add*; extra residual sets must only
-  // use knots that the other residuals use.
+  // Removes the blocks that no residual uses (so the solver does not see
+  // parameters without information), keeping the state's values. Call after
+  // the last Add*; extra residual sets must only use knots that the other
+  // residuals use (knot use is tracked by the Add* calls).
   void RemoveUnusedKnots();
 
   ceres::Problem* problem() { return problem_.get(); }

@@ -228,8 +228,8 @@ double AngleDeg(const Eigen::Quaterniond& a, const Eigen::Quaterniond& b) {
 // Simulates `scenario` (tests/stages/calibrate/<name>, with the text
 // replacements `edits` applied) into `dir` and runs decode, ground and, with
 // `gravity`, tiltcal_gravity: imu.binpb, scans.binpb.lz4, ground.binpb,
-// [gravity.txtpb], rig.txtpb and truth.txtpb. False (and a skip or failure
-// recorded) when a tool is missing or fails.
+// [gravity.txtpb], rig.txtpb and truth.txtpb. False (and a failure recorded)
+// when a tool is missing or fails.
 bool PrepareSequence(const std::string& scenario,
                      const std::vector<std::pair<std::string, std::string>>& edits, bool gravity,
                      const TempDir& dir) {
