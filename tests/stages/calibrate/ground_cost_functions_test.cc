@@ -12,15 +12,12 @@
 #include <vector>
 
 #include <ceres/autodiff_cost_function.h>
-#include <ceres/gradient_checker.h>
-#include <ceres/manifold.h>
-#include <ceres/sphere_manifold.h>
 #include <gtest/gtest.h>
 
 #include "common/geometry/so3.h"
-#include "common/spline/quaternion_manifold.h"
 #include "stages/calibrate/ground_cost_functions.h"
 #include "tests/common/spline/spline_reference.h"
+#include "tests/stages/calibrate/jacobian_checks.h"
 
 namespace tiltcal::calibrate {
 namespace {
@@ -153,129 +150,11 @@ Eigen::Matrix3d RandomWeight(std::mt19937* rng) {
   return 20.0 * w;
 }
 
-enum class Block { kQuaternion, kSphere, kEuclidean };
-
-const ceres::Manifold* ManifoldOf(Block b) {
-  static const spline::RightQuaternionManifold quaternion;
-  static const ceres::SphereManifold<3> sphere;
-  switch (b) {
-    case Block::kQuaternion:
-      return &quaternion;
-    case Block::kSphere:
-      return &sphere;
-    default:
-      return nullptr;
-  }
-}
-
-using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-
-// Residuals and ambient Jacobians (m x size each) of a cost function.
-void EvaluateAll(const ceres::CostFunction& cost, const std::vector<double*>& params,
-                 Eigen::VectorXd* residual, std::vector<RowMajor>* jacobians) {
-  const int m = cost.num_residuals();
-  const auto& sizes = cost.parameter_block_sizes();
-  jacobians->assign(sizes.size(), RowMajor());
-  std::vector<double*> ptr(sizes.size());
-  for (size_t i = 0; i < sizes.size(); ++i) {
-    (*jacobians)[i].setConstant(m, sizes[i], std::nan(""));
-    ptr[i] = (*jacobians)[i].data();
-  }
-  residual->resize(m);
-  ASSERT_TRUE(cost.Evaluate(params.data(), residual->data(), ptr.data()));
-}
-
-// Tangent Jacobian = ambient Jacobian * PlusJacobian.
-Eigen::MatrixXd Tangent(const RowMajor& ambient, Block b, const double* x) {
-  const ceres::Manifold* mf = ManifoldOf(b);
-  if (mf == nullptr) return ambient;
-  RowMajor plus(mf->AmbientSize(), mf->TangentSize());
-  EXPECT_TRUE(mf->PlusJacobian(x, plus.data()));
-  return ambient * plus;
-}
-
-// Analytic vs autodiff twin: residuals and tangent Jacobians.
-void ExpectMatchesTwin(const ceres::CostFunction& analytic, const ceres::CostFunction& twin,
-                       const std::vector<double*>& params, const std::vector<Block>& blocks,
-                       const std::string& label) {
-  ASSERT_EQ(analytic.num_residuals(), twin.num_residuals());
-  ASSERT_EQ(analytic.parameter_block_sizes(), twin.parameter_block_sizes());
-  Eigen::VectorXd ra, rt;
-  std::vector<RowMajor> ja, jt;
-  EvaluateAll(analytic, params, &ra, &ja);
-  EvaluateAll(twin, params, &rt, &jt);
-  EXPECT_LT((ra - rt).norm(), 1e-10 * (1.0 + rt.norm())) << label;
-  for (size_t i = 0; i < blocks.size(); ++i) {
-    ASSERT_TRUE(ja[i].allFinite()) << label << " block " << i << " not written";
-    const Eigen::MatrixXd la = Tangent(ja[i], blocks[i], params[i]);
-    const Eigen::MatrixXd lt = Tangent(jt[i], blocks[i], params[i]);
-    EXPECT_LT((la - lt).norm(), 1e-9 * (1.0 + lt.norm()))
-        << label << " block " << i << "\nanalytic\n" << la << "\nautodiff\n" << lt;
-  }
-}
-
-// Central differences through each block's manifold Plus.
-void ExpectTangentDifferencesMatch(const ceres::CostFunction& cost,
-                                   const std::vector<double*>& params,
-                                   const std::vector<Block>& blocks, const std::string& label) {
-  Eigen::VectorXd r0;
-  std::vector<RowMajor> jac;
-  EvaluateAll(cost, params, &r0, &jac);
-  const int m = cost.num_residuals();
-  const auto& sizes = cost.parameter_block_sizes();
-  for (size_t i = 0; i < blocks.size(); ++i) {
-    const ceres::Manifold* mf = ManifoldOf(blocks[i]);
-    const int tangent = mf ? mf->TangentSize() : sizes[i];
-    const Eigen::MatrixXd analytic = Tangent(jac[i], blocks[i], params[i]);
-    const Eigen::VectorXd x0 = Eigen::Map<const Eigen::VectorXd>(params[i], sizes[i]);
-    Eigen::MatrixXd numeric(m, tangent);
-    const double h = 1e-6;
-    for (int k = 0; k < tangent; ++k) {
-      Eigen::VectorXd r[2];
-      for (int sign = 0; sign < 2; ++sign) {
-        Eigen::VectorXd delta = Eigen::VectorXd::Zero(tangent);
-        delta[k] = sign == 0 ? h : -h;
-        Eigen::Map<Eigen::VectorXd> x(params[i], sizes[i]);
-        if (mf != nullptr) {
-          Eigen::VectorXd moved(sizes[i]);
-          ASSERT_TRUE(mf->Plus(x0.data(), delta.data(), moved.data()));
-          x = moved;
-        } else {
-          x = x0 + delta;
-        }
-        r[sign].resize(m);
-        ASSERT_TRUE(cost.Evaluate(params.data(), r[sign].data(), nullptr));
-        x = x0;
-      }
-      numeric.col(k) = (r[0] - r[1]) / (2 * h);
-    }
-    const double tol = 1e-6 * (1.0 + numeric.norm()) + 1e-14 * r0.norm() / h;
-    EXPECT_LT((analytic - numeric).norm(), tol)
-        << label << " block " << i << "\nanalytic\n" << analytic << "\nnumeric\n" << numeric;
-  }
-}
-
-// ceres::GradientChecker, judged block-wise (its own verdict is entry-wise
-// relative and flags noise on exact zeros). Not used with the size-1 tau
-// block: Ceres 2.1.0's numeric Jacobian of a size-1 block is wrong
-// (see spline_cost_functions_test.cc).
-void ExpectGradientCheckerPasses(const ceres::CostFunction& cost,
-                                 const std::vector<double*>& params,
-                                 const std::vector<Block>& blocks, const std::string& label) {
-  std::vector<const ceres::Manifold*> manifolds;
-  for (Block b : blocks) manifolds.push_back(ManifoldOf(b));
-  ceres::NumericDiffOptions options;
-  ceres::GradientChecker checker(&cost, &manifolds, options);
-  ceres::GradientChecker::ProbeResults results;
-  checker.Probe(params.data(), 1e-6, &results);
-  ASSERT_TRUE(results.return_value) << label;
-  for (size_t i = 0; i < blocks.size(); ++i) {
-    const ceres::Matrix& user = results.local_jacobians[i];
-    const ceres::Matrix& numeric = results.local_numeric_jacobians[i];
-    EXPECT_LT((user - numeric).norm(), 1e-6 * (1.0 + numeric.norm()))
-        << label << " block " << i << "\nanalytic\n" << user << "\nnumeric\n" << numeric;
-  }
-}
+using testing::Block;
+using testing::EvaluateAll;
+using testing::ExpectGradientCheckerPasses;
+using testing::ExpectTangentDifferencesMatch;
+using testing::RowMajor;
 
 const double kSpacings[] = {0.02, 0.05, 0.1};
 // Normalised time of t_k + tau in the frozen window, including tau pushing it
@@ -307,7 +186,7 @@ TEST(FlatGroundCostFunctionTest, MatchesAutodiffTwinAndNumericDifferences) {
       FlatTwin::AutoDiff twin(new FlatTwin{scan_time - segment_start, 1.0 / dt, normal, w});
       const std::string label = "flat dt " + std::to_string(dt) + " u " + std::to_string(u);
       const std::vector<double*> params = SplineParams(&s);
-      ExpectMatchesTwin(analytic, twin, params, kSplineBlocks, label);
+      testing::ExpectSameTangentJacobians(analytic, twin, params, kSplineBlocks, 1e-9, label);
       ExpectTangentDifferencesMatch(analytic, params, kSplineBlocks, label);
     }
   }
@@ -329,7 +208,7 @@ TEST(InclinationCostFunctionTest, MatchesAutodiffTwinAndNumericDifferences) {
           new InclTwin{scan_time - segment_start, 1.0 / dt, normal, gravity_flat, w});
       const std::string label = "incl dt " + std::to_string(dt) + " u " + std::to_string(u);
       const std::vector<double*> params = SplineParams(&s);
-      ExpectMatchesTwin(analytic, twin, params, kSplineBlocks, label);
+      testing::ExpectSameTangentJacobians(analytic, twin, params, kSplineBlocks, 1e-9, label);
       ExpectTangentDifferencesMatch(analytic, params, kSplineBlocks, label);
     }
   }
@@ -346,7 +225,7 @@ TEST(DistanceCostFunctionTest, MatchesAutodiffTwinGradientCheckerAndNumericDiffe
     DistTwin::AutoDiff twin(new DistTwin{normal, d_l, d_b, w});
     const std::vector<double*> params = {s.q_bl.coeffs().data(), s.r_b_lb.data()};
     const std::string label = "dist trial " + std::to_string(trial);
-    ExpectMatchesTwin(analytic, twin, params, blocks, label);
+    testing::ExpectSameTangentJacobians(analytic, twin, params, blocks, 1e-9, label);
     ExpectTangentDifferencesMatch(analytic, params, blocks, label);
     ExpectGradientCheckerPasses(analytic, params, blocks, label);
   }
@@ -364,7 +243,7 @@ TEST(UpCostFunctionTest, MatchesAutodiffTwinGradientCheckerAndNumericDifferences
     UpTwin::AutoDiff twin(new UpTwin{normal, gravity_flat, w});
     const std::vector<double*> params = {s.q_bl.coeffs().data()};
     const std::string label = "up trial " + std::to_string(trial);
-    ExpectMatchesTwin(analytic, twin, params, blocks, label);
+    testing::ExpectSameTangentJacobians(analytic, twin, params, blocks, 1e-9, label);
     ExpectTangentDifferencesMatch(analytic, params, blocks, label);
     ExpectGradientCheckerPasses(analytic, params, blocks, label);
   }

@@ -9,18 +9,15 @@
 #include <string>
 #include <vector>
 
-#include <ceres/gradient_checker.h>
-#include <ceres/manifold.h>
-#include <ceres/sphere_manifold.h>
 #include <gtest/gtest.h>
 
 #include "common/geometry/so3.h"
-#include "common/spline/quaternion_manifold.h"
 #include "stages/calibrate/accel_cost_function.h"
 #include "stages/calibrate/gyro_cost_function.h"
 #include "stages/calibrate/orientation_sample_cost_function.h"
 #include "stages/calibrate/point_to_plane_cost_function.h"
 #include "tests/stages/calibrate/cost_function_twins.h"
+#include "tests/stages/calibrate/jacobian_checks.h"
 
 namespace tiltcal::calibrate {
 namespace {
@@ -60,136 +57,9 @@ State RandomState(std::mt19937* rng, double dt) {
   return s;
 }
 
-enum class Block { kQuaternion, kSphere, kEuclidean };
-
-// Compares residuals and tangent-space Jacobians (ambient Jacobian times the
-// manifold's PlusJacobian) of two cost functions.
-void ExpectSameLocalJacobians(const ceres::CostFunction& analytic, const ceres::CostFunction& twin,
-                              const std::vector<double*>& params, const std::vector<Block>& blocks,
-                              double tol, const std::string& label) {
-  const int m = analytic.num_residuals();
-  ASSERT_EQ(m, twin.num_residuals());
-  const auto& sizes = analytic.parameter_block_sizes();
-  ASSERT_EQ(sizes, twin.parameter_block_sizes());
-  std::vector<Eigen::MatrixXd> ja(sizes.size()), jt(sizes.size());
-  std::vector<double*> pa(sizes.size()), pt(sizes.size());
-  for (size_t i = 0; i < sizes.size(); ++i) {
-    // Ceres Jacobian blocks are row-major m x size; store transposed (size x m) col-major.
-    ja[i].resize(sizes[i], m);
-    jt[i].resize(sizes[i], m);
-    pa[i] = ja[i].data();
-    pt[i] = jt[i].data();
-  }
-  Eigen::VectorXd ra(m), rt(m);
-  ASSERT_TRUE(analytic.Evaluate(params.data(), ra.data(), pa.data()));
-  ASSERT_TRUE(twin.Evaluate(params.data(), rt.data(), pt.data()));
-  EXPECT_LT((ra - rt).norm(), 1e-10 * (1.0 + rt.norm())) << label;
-  spline::RightQuaternionManifold quaternion;
-  ceres::SphereManifold<3> sphere;
-  for (size_t i = 0; i < sizes.size(); ++i) {
-    const Eigen::MatrixXd a = ja[i].transpose(), t = jt[i].transpose();
-    Eigen::MatrixXd plus = Eigen::MatrixXd::Identity(sizes[i], sizes[i]);
-    if (blocks[i] != Block::kEuclidean) {
-      const ceres::Manifold& mf = blocks[i] == Block::kQuaternion
-                                      ? static_cast<const ceres::Manifold&>(quaternion)
-                                      : static_cast<const ceres::Manifold&>(sphere);
-      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> pj(mf.AmbientSize(), mf.TangentSize());
-      ASSERT_TRUE(mf.PlusJacobian(params[i], pj.data()));
-      plus = pj;
-    }
-    const Eigen::MatrixXd la = a * plus, lt = t * plus;
-    EXPECT_LT((la - lt).norm(), tol * (1.0 + lt.norm()))
-        << label << " block " << i << "\nanalytic\n" << la << "\nautodiff\n" << lt;
-  }
-}
-
-// GradientChecker: numeric central differences in the tangent spaces.
-void ExpectGradientCheckerPasses(const ceres::CostFunction& cost, const std::vector<double*>& params,
-                                 const std::vector<Block>& blocks, const std::string& label) {
-  spline::RightQuaternionManifold quaternion;
-  ceres::SphereManifold<3> sphere;
-  std::vector<const ceres::Manifold*> manifolds;
-  for (Block b : blocks) {
-    manifolds.push_back(b == Block::kQuaternion ? static_cast<const ceres::Manifold*>(&quaternion)
-                        : b == Block::kSphere   ? static_cast<const ceres::Manifold*>(&sphere)
-                                                : nullptr);
-  }
-  ceres::NumericDiffOptions options;
-  ceres::GradientChecker checker(&cost, &manifolds, options);
-  ceres::GradientChecker::ProbeResults results;
-  // Probe's own verdict is entry-wise relative, which flags numeric noise on
-  // entries that are exactly zero (e.g. knot s at u = 1); judge block-wise
-  // in the Frobenius norm instead.
-  checker.Probe(params.data(), 1e-6, &results);
-  ASSERT_TRUE(results.return_value) << label;
-  ASSERT_EQ(results.local_jacobians.size(), blocks.size());
-  for (size_t i = 0; i < blocks.size(); ++i) {
-    const ceres::Matrix& user = results.local_jacobians[i];
-    const ceres::Matrix& numeric = results.local_numeric_jacobians[i];
-    EXPECT_LT((user - numeric).norm(), 1e-6 * (1.0 + numeric.norm()))
-        << label << " block " << i << "\nanalytic\n" << user << "\nnumeric\n" << numeric;
-  }
-}
-
-// Central differences in the tangent space of every block (quaternions
-// q Exp(delta), sphere via its Plus, Euclidean additively) against the
-// analytic Jacobian mapped by the manifold's PlusJacobian.
-void ExpectTangentFiniteDifferencesMatch(const ceres::CostFunction& cost,
-                                         const std::vector<double*>& params,
-                                         const std::vector<Block>& blocks, const std::string& label) {
-  spline::RightQuaternionManifold quaternion;
-  ceres::SphereManifold<3> sphere;
-  const int m = cost.num_residuals();
-  const auto& sizes = cost.parameter_block_sizes();
-  std::vector<Eigen::MatrixXd> ambient(sizes.size());
-  std::vector<double*> jac(sizes.size());
-  for (size_t i = 0; i < sizes.size(); ++i) {
-    ambient[i].resize(sizes[i], m);  // transposed row-major
-    jac[i] = ambient[i].data();
-  }
-  Eigen::VectorXd r0(m);
-  ASSERT_TRUE(cost.Evaluate(params.data(), r0.data(), jac.data()));
-  for (size_t i = 0; i < sizes.size(); ++i) {
-    const ceres::Manifold* mf = blocks[i] == Block::kQuaternion ? static_cast<const ceres::Manifold*>(&quaternion)
-                                : blocks[i] == Block::kSphere   ? static_cast<const ceres::Manifold*>(&sphere)
-                                                                : nullptr;
-    const int tangent = mf ? mf->TangentSize() : sizes[i];
-    Eigen::MatrixXd plus = Eigen::MatrixXd::Identity(sizes[i], tangent);
-    if (mf) {
-      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> pj(sizes[i], tangent);
-      ASSERT_TRUE(mf->PlusJacobian(params[i], pj.data()));
-      plus = pj;
-    }
-    const Eigen::MatrixXd analytic = ambient[i].transpose() * plus;
-    Eigen::MatrixXd numeric(m, tangent);
-    const Eigen::VectorXd x0 = Eigen::Map<const Eigen::VectorXd>(params[i], sizes[i]);
-    const double h = 1e-6;
-    for (int k = 0; k < tangent; ++k) {
-      Eigen::VectorXd r[2];
-      for (int sign = 0; sign < 2; ++sign) {
-        Eigen::VectorXd delta = Eigen::VectorXd::Zero(tangent);
-        delta[k] = sign == 0 ? h : -h;
-        Eigen::Map<Eigen::VectorXd> x(params[i], sizes[i]);
-        if (mf) {
-          Eigen::VectorXd moved(sizes[i]);
-          ASSERT_TRUE(mf->Plus(x0.data(), delta.data(), moved.data()));
-          x = moved;
-        } else {
-          x = x0 + delta;
-        }
-        r[sign].resize(m);
-        ASSERT_TRUE(cost.Evaluate(params.data(), r[sign].data(), nullptr));
-        x = x0;
-      }
-      numeric.col(k) = (r[0] - r[1]) / (2 * h);
-    }
-    // Truncation O(h^2) plus rounding ~ eps |r| / h (the random states give
-    // residuals of up to ~1e4 sigma).
-    const double tol = 1e-6 * (1.0 + numeric.norm()) + 1e-14 * r0.norm() / h;
-    EXPECT_LT((analytic - numeric).norm(), tol)
-        << label << " block " << i << "\nanalytic\n" << analytic << "\nnumeric\n" << numeric;
-  }
-}
+using testing::Block;
+using testing::ExpectGradientCheckerPasses;
+using testing::ExpectTangentDifferencesMatch;
 
 TEST(GyroCostFunctionTest, MatchesAutodiffTwinAndNumericDifferences) {
   std::mt19937 rng(41);
@@ -207,10 +77,10 @@ TEST(GyroCostFunctionTest, MatchesAutodiffTwinAndNumericDifferences) {
       const std::vector<Block> blocks = {Block::kQuaternion, Block::kQuaternion, Block::kQuaternion,
                                          Block::kQuaternion, Block::kEuclidean};
       const std::string label = "dt " + std::to_string(dt) + " u " + std::to_string(u);
-      ExpectSameLocalJacobians(analytic, twin, params, blocks, 1e-9, label);
-      ExpectSameLocalJacobians(analytic, sommer, params, blocks, 1e-9, label + " sommer");
+      testing::ExpectSameTangentJacobians(analytic, twin, params, blocks, 1e-9, label);
+      testing::ExpectSameTangentJacobians(analytic, sommer, params, blocks, 1e-9, label + " sommer");
       ExpectGradientCheckerPasses(analytic, params, blocks, label);
-      ExpectTangentFiniteDifferencesMatch(analytic, params, blocks, label);
+      ExpectTangentDifferencesMatch(analytic, params, blocks, label);
     }
   }
 }
@@ -237,13 +107,13 @@ TEST(OrientationSampleCostFunctionTest, MatchesAutodiffTwinAndNumericDifferences
       const std::vector<Block> blocks = {Block::kQuaternion, Block::kQuaternion, Block::kQuaternion,
                                          Block::kQuaternion};
       const std::string label = "dt " + std::to_string(dt) + " u " + std::to_string(u);
-      ExpectSameLocalJacobians(analytic, twin, params, blocks, 1e-8, label);
-      ExpectSameLocalJacobians(analytic, sommer, params, blocks, 1e-8, label + " sommer");
+      testing::ExpectSameTangentJacobians(analytic, twin, params, blocks, 1e-8, label);
+      testing::ExpectSameTangentJacobians(analytic, sommer, params, blocks, 1e-8, label + " sommer");
       // No ceres::GradientChecker here: it differentiates in the ambient
       // quaternion space, where off the unit sphere the spline's C(t) is not
       // a rotation and Log of it is not smooth; the tangent differences below
       // stay on the manifold.
-      ExpectTangentFiniteDifferencesMatch(analytic, params, blocks, label);
+      ExpectTangentDifferencesMatch(analytic, params, blocks, label);
     }
   }
 }
@@ -268,10 +138,10 @@ TEST(AccelCostFunctionTest, MatchesAutodiffTwinAndNumericDifferences) {
                                          Block::kEuclidean,  Block::kEuclidean,  Block::kSphere,
                                          Block::kEuclidean};
       const std::string label = "dt " + std::to_string(dt) + " u " + std::to_string(u);
-      ExpectSameLocalJacobians(analytic, twin, params, blocks, 1e-9, label);
-      ExpectSameLocalJacobians(analytic, sommer, params, blocks, 1e-9, label + " sommer");
+      testing::ExpectSameTangentJacobians(analytic, twin, params, blocks, 1e-9, label);
+      testing::ExpectSameTangentJacobians(analytic, sommer, params, blocks, 1e-9, label + " sommer");
       ExpectGradientCheckerPasses(analytic, params, blocks, label);
-      ExpectTangentFiniteDifferencesMatch(analytic, params, blocks, label);
+      ExpectTangentDifferencesMatch(analytic, params, blocks, label);
     }
   }
 }
@@ -311,13 +181,13 @@ TEST(PointToPlaneCostFunctionTest, MatchesAutodiffTwinAndNumericDifferences) {
           point_time - segment_start, 1.0 / dt, sigma, offset, point, normal});
       const std::vector<double*> params = PlaneParams(&s, 0);
       const std::string label = "dt " + std::to_string(dt) + " u " + std::to_string(u);
-      ExpectSameLocalJacobians(analytic, twin, params, kPlaneBlocks, 1e-9, label);
-      ExpectSameLocalJacobians(analytic, sommer, params, kPlaneBlocks, 1e-9, label + " sommer");
+      testing::ExpectSameTangentJacobians(analytic, twin, params, kPlaneBlocks, 1e-9, label);
+      testing::ExpectSameTangentJacobians(analytic, sommer, params, kPlaneBlocks, 1e-9, label + " sommer");
       // Not ceres::GradientChecker here: in Ceres 2.1.0 its numeric Jacobian of
       // a size-1 parameter block (tau) is wrong even for r = sin(50 t) (it
       // reports ~8.5 instead of 50), so the tangent-space central differences
       // below are used instead.
-      ExpectTangentFiniteDifferencesMatch(analytic, params, kPlaneBlocks, label);
+      ExpectTangentDifferencesMatch(analytic, params, kPlaneBlocks, label);
     }
   }
 }
