@@ -1,6 +1,7 @@
 #include "stages/calibrate/calibrate.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -55,6 +56,7 @@ InitialisationOptions MakeInitialisationOptions(const proto::CalibrateParams& pa
   o.imu.gravity_norm_mps2 = params.gravity_norm_mps2();
   o.gyro_sigma_radps = params.gyro_sigma_radps();
   o.accel_sigma_mps2 = params.accel_sigma_mps2();
+  o.accel_bias_random_walk = params.accel_bias_random_walk_mps3_sqrthz();
   o.solver_iterations = static_cast<int>(params.init_solver_iterations());
   o.num_threads = static_cast<int>(params.num_threads());
   o.odometry.method = params.odometry_method() == proto::CalibrateParams::NDT
@@ -106,6 +108,7 @@ ProblemOptions MakeProblemOptions(const proto::CalibrateParams& params) {
   ProblemOptions o;
   o.gyro_sigma_radps = params.gyro_sigma_radps();
   o.accel_sigma_mps2 = params.accel_sigma_mps2();
+  o.accel_bias_random_walk = params.accel_bias_random_walk_mps3_sqrthz();
   o.lidar_sigma_m = params.lidar_sigma_m();
   o.lidar_cauchy_scale = params.lidar_cauchy_scale();
   o.time_offset_bound_s = params.time_offset_bound_s();
@@ -172,6 +175,7 @@ Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& pa
       spline::UniformKnotGrid::ForDuration(t0, duration, params.knot_spacing_s());
   CalibrationState state(grid);
   state.gravity_norm_mps2 = params.gravity_norm_mps2();
+  state.SetAccelBiasSegments(params.accel_bias_segment_s());
 
   // Initialisation.
   auto start = Clock::now();
@@ -232,6 +236,9 @@ Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& pa
   const int outer = static_cast<int>(params.outer_iterations());
   int outer_done = 0;
   double moved_deg = 0.0, moved_m = 0.0, moved_s = 0.0;
+  const Eigen::Vector3d axis_b = init.rotation_axis_b.normalized();
+  const bool translation_along_axis_observed =
+      std::find(ground_used.begin(), ground_used.end(), "dist") != ground_used.end();
   for (int it = 0; it < outer; ++it) {
     const Eigen::Quaterniond rotation_before = state.ImuFromLidarRotation();
     const Eigen::Vector3d translation_before = state.ImuFromLidarTranslation();
@@ -275,7 +282,12 @@ Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& pa
     moved_deg =
         Eigen::AngleAxisd(rotation_before.conjugate() * state.ImuFromLidarRotation()).angle() *
         180.0 / M_PI;
-    moved_m = (state.ImuFromLidarTranslation() - translation_before).norm();
+    // Without the distance residual the translation along the motion's
+    // rotation axis is held only by its prior (planar motion): it wanders by
+    // millimetres per round and takes no part in the stop test.
+    Eigen::Vector3d moved_b = state.ImuFromLidarTranslation() - translation_before;
+    if (!translation_along_axis_observed) moved_b -= axis_b * axis_b.dot(moved_b);
+    moved_m = moved_b.norm();
     moved_s = std::abs(state.time_offset_s[0] - tau_before);
     const bool settled = it >= 1 && moved_deg < params.outer_stop_rotation_deg() &&
                          moved_m < params.outer_stop_translation_m() &&
@@ -347,6 +359,10 @@ Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& pa
   *result->mutable_gravity_in_world() = ToProto(state.GravityInWorld());
   *result->mutable_gyro_bias_radps() = ToProto(state.GyroBias());
   *result->mutable_accel_bias_mps2() = ToProto(state.AccelBias());
+  for (const std::array<double, 3>& b : state.accel_bias_segments) {
+    *result->add_accel_bias_segments_mps2() = ToProto(Eigen::Vector3d(b[0], b[1], b[2]));
+  }
+  result->set_accel_bias_segment_s(state.accel_bias_segment_s);
   for (const std::string& g : ground_used) result->add_ground_residuals_used(g);
   result->set_ground_residuals_reason(ground_reason);
   AddTiming("total", Seconds(total_start), result);

@@ -24,7 +24,12 @@
 //                                (g_a = gravity_norm_mps2 * n_g),
 //                                ceres::SphereManifold<3>;
 //   gyro_bias_radps              3 doubles, b_g, rad/s;
-//   accel_bias_mps2              3 doubles, b_a, m/s^2.
+//   accel_bias_segments[i]       3 doubles, b_a over [t0 + i S, t0 + (i+1) S),
+//                                m/s^2, S = accel_bias_segment_s (piecewise
+//                                constant: the bias of a real accelerometer
+//                                wanders, and a constant one would bend the
+//                                trajectory and the yaw of C_bl; one segment
+//                                for the whole sequence when S = 0).
 // Gauge (DESIGN §5: C_ab(t0) = 1, r_a^{ba}(t0) = 0): the builder holds the
 // first knots constant (see problem_builder.h).
 //
@@ -39,6 +44,11 @@
 // blocks itself, change their manifolds or bounds, or hold the pointers
 // beyond the life of the Problem.
 
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <vector>
+
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
@@ -48,7 +58,8 @@
 namespace tiltcal::calibrate {
 
 struct CalibrationState {
-  explicit CalibrationState(const spline::UniformKnotGrid& grid) : trajectory(grid) {}
+  explicit CalibrationState(const spline::UniformKnotGrid& grid)
+      : trajectory(grid), accel_bias_segments(1, {0.0, 0.0, 0.0}) {}
   CalibrationState(const CalibrationState&) = default;
   CalibrationState& operator=(const CalibrationState&) = default;
 
@@ -59,7 +70,37 @@ struct CalibrationState {
   double gravity_direction[3] = {0.0, 0.0, -1.0};            // n_g, unit, frame a, down
   double gravity_norm_mps2 = 9.81;                           // |g_a|, fixed
   double gyro_bias_radps[3] = {0.0, 0.0, 0.0};               // b_g
-  double accel_bias_mps2[3] = {0.0, 0.0, 0.0};               // b_a
+  // b_a per time segment (see above); at least one.
+  std::vector<std::array<double, 3>> accel_bias_segments;
+  double accel_bias_segment_s = 0.0;  // S, s; 0 = one segment
+
+  // Splits b_a into ceil(spline duration / segment_s) segments (one when
+  // segment_s <= 0), each set to the current mean. Call before a Problem
+  // refers to the state.
+  void SetAccelBiasSegments(double segment_s) {
+    const Eigen::Vector3d mean = AccelBias();
+    const double duration = trajectory.grid().end_s() - trajectory.grid().t0_s();
+    int count = 1;
+    if (segment_s > 0.0 && duration > segment_s) {
+      count = static_cast<int>(std::ceil(duration / segment_s));
+    }
+    accel_bias_segment_s = count > 1 ? segment_s : 0.0;
+    accel_bias_segments.assign(count, {mean.x(), mean.y(), mean.z()});
+  }
+  // Index of the b_a segment at IMU time t_s (clamped to the segments).
+  int AccelBiasSegment(double t_s) const {
+    if (accel_bias_segment_s <= 0.0) return 0;
+    const int last = static_cast<int>(accel_bias_segments.size()) - 1;
+    const double i = std::floor((t_s - trajectory.grid().t0_s()) / accel_bias_segment_s);
+    return static_cast<int>(std::clamp(i, 0.0, static_cast<double>(last)));
+  }
+  double* AccelBiasBlock(double t_s) {
+    return accel_bias_segments[AccelBiasSegment(t_s)].data();
+  }
+  Eigen::Vector3d AccelBiasAt(double t_s) const {
+    const std::array<double, 3>& b = accel_bias_segments[AccelBiasSegment(t_s)];
+    return Eigen::Vector3d(b[0], b[1], b[2]);
+  }
 
   // Convenience accessors (copies).
   Eigen::Quaterniond ImuFromLidarRotation() const {
@@ -80,8 +121,13 @@ struct CalibrationState {
   Eigen::Vector3d GyroBias() const {
     return Eigen::Vector3d(gyro_bias_radps[0], gyro_bias_radps[1], gyro_bias_radps[2]);
   }
+  // Mean of b_a over the segments.
   Eigen::Vector3d AccelBias() const {
-    return Eigen::Vector3d(accel_bias_mps2[0], accel_bias_mps2[1], accel_bias_mps2[2]);
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (const std::array<double, 3>& b : accel_bias_segments) {
+      sum += Eigen::Vector3d(b[0], b[1], b[2]);
+    }
+    return sum / static_cast<double>(accel_bias_segments.size());
   }
 
   void SetImuFromLidarRotation(const Eigen::Quaterniond& q) {
@@ -102,8 +148,11 @@ struct CalibrationState {
   void SetGyroBias(const Eigen::Vector3d& b) {
     for (int i = 0; i < 3; ++i) gyro_bias_radps[i] = b[i];
   }
+  // Sets every b_a segment to b.
   void SetAccelBias(const Eigen::Vector3d& b) {
-    for (int i = 0; i < 3; ++i) accel_bias_mps2[i] = b[i];
+    for (std::array<double, 3>& segment : accel_bias_segments) {
+      for (int i = 0; i < 3; ++i) segment[i] = b[i];
+    }
   }
 
   // The frozen knot window of a residual at LiDAR time t_lidar_s, chosen with

@@ -65,6 +65,7 @@ ProblemOptions FitOptions(const InitialisationOptions& options) {
   ProblemOptions p;
   p.gyro_sigma_radps = options.gyro_sigma_radps;
   p.accel_sigma_mps2 = options.accel_sigma_mps2;
+  p.accel_bias_random_walk = options.accel_bias_random_walk;
   p.estimate_extrinsic = false;
   p.estimate_time_offset = false;
   p.estimate_gravity = false;

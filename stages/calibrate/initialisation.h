@@ -51,6 +51,7 @@ struct InitialisationOptions {
   int odometry_scan_step = 1;        // register every this-many-th scan
   double gyro_sigma_radps = 0.01;
   double accel_sigma_mps2 = 0.05;
+  double accel_bias_random_walk = 0.0;  // m/s^3/sqrt(Hz), ties the b_a segments
   double position_sigma_m = 0.05;    // odometry position samples
   double odometry_rotation_sigma_rad = 0.0017;  // odometry orientation samples (0 = off)
   // Prior on r_b^{lb} at the rig's value in the position fit, along the

@@ -1,10 +1,12 @@
 #include "stages/calibrate/problem_builder.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "common/spline/so3_spline.h"
 #include "stages/calibrate/accel_cost_function.h"
+#include "stages/calibrate/bias_random_walk_cost_function.h"
 #include "stages/calibrate/gyro_cost_function.h"
 #include "stages/calibrate/point_to_plane_cost_function.h"
 
@@ -66,7 +68,7 @@ CalibrationProblem::CalibrationProblem(CalibrationState* state, const ProblemOpt
   p.AddParameterBlock(state_->time_offset_s, 1);
   p.AddParameterBlock(state_->gravity_direction, 3, &sphere_manifold_);
   p.AddParameterBlock(state_->gyro_bias_radps, 3);
-  p.AddParameterBlock(state_->accel_bias_mps2, 3);
+  for (std::array<double, 3>& b : state_->accel_bias_segments) p.AddParameterBlock(b.data(), 3);
 
   // tau bounds around the binning value; tau clamped into them.
   const double bound = std::abs(options_.time_offset_bound_s);
@@ -87,14 +89,25 @@ CalibrationProblem::CalibrationProblem(CalibrationState* state, const ProblemOpt
   if (!options_.estimate_gravity) p.SetParameterBlockConstant(state_->gravity_direction);
   if (!options_.estimate_biases) {
     p.SetParameterBlockConstant(state_->gyro_bias_radps);
-    p.SetParameterBlockConstant(state_->accel_bias_mps2);
+    for (std::array<double, 3>& b : state_->accel_bias_segments) {
+      p.SetParameterBlockConstant(b.data());
+    }
+  } else if (options_.accel_bias_random_walk > 0.0) {
+    // Consecutive b_a segments tied by the random walk over one segment.
+    for (size_t i = 0; i + 1 < state_->accel_bias_segments.size(); ++i) {
+      p.AddResidualBlock(new BiasRandomWalkCostFunction(options_.accel_bias_random_walk,
+                                                        state_->accel_bias_segment_s),
+                         nullptr, state_->accel_bias_segments[i].data(),
+                         state_->accel_bias_segments[i + 1].data());
+      ++counts_.prior_residuals;
+    }
   }
   if (options_.translation_prior_sigma_m > 0.0 && options_.estimate_extrinsic) {
     p.AddResidualBlock(new TranslationPriorCost(options_.translation_prior_m,
                                                 options_.translation_prior_sigma_m,
                                                 options_.translation_prior_axis_b),
                        nullptr, state_->imu_from_lidar_translation);
-    counts_.prior_residuals = 1;
+    ++counts_.prior_residuals;
   }
   counts_.knots = traj.num_knots();
   rotation_used_.assign(traj.num_knots(), 0);
@@ -133,7 +146,7 @@ void CalibrationProblem::AddImuResiduals(const std::vector<imu::ImuReading>& sam
           {traj.rotation_knot(k), traj.rotation_knot(k + 1), traj.rotation_knot(k + 2),
            traj.rotation_knot(k + 3), traj.position_knot(k), traj.position_knot(k + 1),
            traj.position_knot(k + 2), traj.position_knot(k + 3), state_->gravity_direction,
-           state_->accel_bias_mps2});
+           state_->AccelBiasBlock(s.time_s)});
       ++counts_.accel_residuals;
       MarkKnots(k, true);
     }
@@ -191,11 +204,14 @@ void CalibrationProblem::RemoveUnusedKnots() {
     if (!position_used_[i]) problem_->RemoveParameterBlock(traj.position_knot(i));
   }
   // The calibration blocks: asked of Ceres (a scan of the residual blocks
-  // each; there are six), so extra residual sets are accounted for exactly.
+  // each; there are a handful), so extra residual sets are accounted for
+  // exactly.
   std::vector<ceres::ResidualBlockId> users;
-  for (double* block : {state_->imu_from_lidar_rotation, state_->imu_from_lidar_translation,
-                        state_->time_offset_s, state_->gravity_direction,
-                        state_->gyro_bias_radps, state_->accel_bias_mps2}) {
+  std::vector<double*> blocks = {state_->imu_from_lidar_rotation,
+                                 state_->imu_from_lidar_translation, state_->time_offset_s,
+                                 state_->gravity_direction, state_->gyro_bias_radps};
+  for (std::array<double, 3>& b : state_->accel_bias_segments) blocks.push_back(b.data());
+  for (double* block : blocks) {
     users.clear();
     problem_->GetResidualBlocksForParameterBlock(block, &users);
     if (users.empty()) problem_->RemoveParameterBlock(block);

@@ -21,6 +21,9 @@
 // afterwards so that C_ab(t0) = 1 and r_a^{ba}(t0) = 0 exactly
 // (ReexpressInFirstImuFrame).
 //
+// Accelerometer bias: one block per segment of the state; with more than one,
+// a random-walk prior between consecutive segments (accel_bias_random_walk).
+//
 // Optional prior on r_b^{lb} (translation_prior_sigma_m > 0): one residual
 // (r_b^{lb} - r_prior) / sigma (3), or, with a unit translation_prior_axis_b,
 // only its component along that axis, a^T (r_b^{lb} - r_prior) / sigma (the
@@ -77,6 +80,11 @@ struct ProblemOptions {
   bool estimate_time_offset = true;
   bool estimate_gravity = true;
   bool estimate_biases = true;
+  // Random walk of the accelerometer bias, m/s^3/sqrt(Hz): ties consecutive
+  // b_a segments (CalibrationState::accel_bias_segments) by
+  // BiasRandomWalkCostFunction; 0 = segments independent. Counted in
+  // ProblemCounts::prior_residuals.
+  double accel_bias_random_walk = 0.0;
   // Gauge by holding rotation knot 0 and position knot 0 (see above). Off
   // when fixed map planes already pin the world frame.
   bool fix_first_knots = true;
