@@ -2,7 +2,8 @@
 // (tests/stages/calibrate/cost_function_twins.h) and vs ceres::GradientChecker
 // (numeric differences through the manifolds), at several knot spacings and
 // normalised times including segment ends, and the time-offset window
-// behaviour of the point-to-plane residual at a segment boundary.
+// behaviour of the point-to-plane residual at a segment boundary; the
+// random-walk prior between accelerometer bias segments.
 
 #include <memory>
 #include <random>
@@ -13,6 +14,7 @@
 
 #include "common/geometry/so3.h"
 #include "stages/calibrate/accel_cost_function.h"
+#include "stages/calibrate/bias_random_walk_cost_function.h"
 #include "stages/calibrate/gyro_cost_function.h"
 #include "stages/calibrate/orientation_sample_cost_function.h"
 #include "stages/calibrate/point_to_plane_cost_function.h"
@@ -239,6 +241,23 @@ TEST(PointToPlaneCostFunctionTest, FrozenWindowAtSegmentBoundary) {
     // And they are small for a realistic excursion (2% of a segment).
     EXPECT_LT(std::abs(err_r[0]), 1e-3) << "dt " << dt;
   }
+}
+
+TEST(BiasRandomWalkCostFunctionTest, ValueAndJacobians) {
+  // sigma_rw 0.01 over 4 s: sigma of the step 0.02.
+  const BiasRandomWalkCostFunction cost(0.01, 4.0);
+  double b0[3] = {1.0, 2.0, 3.0};
+  double b1[3] = {1.5, 1.0, 3.0};
+  const std::vector<double*> params = {b0, b1};
+  Eigen::VectorXd r;
+  std::vector<testing::RowMajor> jacobians;
+  testing::EvaluateAll(cost, params, &r, &jacobians);
+  EXPECT_TRUE(r.isApprox(Eigen::Vector3d(25.0, -50.0, 0.0), 1e-12)) << r.transpose();
+  EXPECT_TRUE(jacobians[0].isApprox(-50.0 * Eigen::Matrix3d::Identity()));
+  EXPECT_TRUE(jacobians[1].isApprox(50.0 * Eigen::Matrix3d::Identity()));
+  const std::vector<Block> blocks = {Block::kEuclidean, Block::kEuclidean};
+  ExpectTangentDifferencesMatch(cost, params, blocks, "bias random walk");
+  ExpectGradientCheckerPasses(cost, params, blocks, "bias random walk");
 }
 
 }  // namespace
