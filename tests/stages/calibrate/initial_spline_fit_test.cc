@@ -77,6 +77,17 @@ double MaxRotationError(const CalibrationState& state) {
   return worst;
 }
 
+// LiDAR positions p_l = r_a^{ba} + C_ab r_b^{lb} at 10 Hz, 1 cm noise.
+void LidarPositions(const Eigen::Vector3d& r_bl, std::mt19937* rng, std::vector<double>* times,
+                    std::vector<Eigen::Vector3d>* positions) {
+  std::normal_distribution<double> n(0.0, 1.0);
+  for (double t = 0.1; t < kDuration - 0.1; t += 0.1) {
+    times->push_back(t);
+    positions->push_back(Position(t) + Rotation(t) * r_bl +
+                         0.01 * Eigen::Vector3d(n(*rng), n(*rng), n(*rng)));
+  }
+}
+
 InitialisationOptions Options() {
   InitialisationOptions o;
   o.gyro_sigma_radps = 0.003;
@@ -129,15 +140,9 @@ TEST(InitialSplineFitTest, PositionFitEstimatesTheAccelerometerBiasAndTheLeverAr
   FitRotationSplineToGyro(imu, Options(), &state);
   ASSERT_LT(MaxRotationError(state), 0.01);
 
-  // LiDAR positions p_l = r_a^{ba} + C_ab r_b^{lb}, 1 cm noise, 10 Hz.
-  std::normal_distribution<double> n(0.0, 1.0);
   std::vector<double> times;
   std::vector<Eigen::Vector3d> positions;
-  for (double t = 0.1; t < kDuration - 0.1; t += 0.1) {
-    times.push_back(t);
-    positions.push_back(Position(t) + Rotation(t) * r_bl +
-                        0.01 * Eigen::Vector3d(n(rng), n(rng), n(rng)));
-  }
+  LidarPositions(r_bl, &rng, &times, &positions);
   FitPositionSpline(times, positions, imu, Options(), &state);
   // The gyro-only rotation's tilt error (~1 mrad) tilts g_b by as much:
   // ~0.01 m/s^2 of bias.
@@ -179,14 +184,9 @@ double WorstAccelBiasSegmentError(double segment_s, const Eigen::Vector3d& accel
   InitialisationOptions options = Options();
   options.accel_bias_random_walk = 1e-3;
   FitRotationSplineToGyro(imu, options, &state);
-  std::normal_distribution<double> n(0.0, 1.0);
   std::vector<double> times;
   std::vector<Eigen::Vector3d> positions;
-  for (double t = 0.1; t < kDuration - 0.1; t += 0.1) {
-    times.push_back(t);
-    positions.push_back(Position(t) + Rotation(t) * r_bl +
-                        0.01 * Eigen::Vector3d(n(rng), n(rng), n(rng)));
-  }
+  LidarPositions(r_bl, &rng, &times, &positions);
   FitPositionSpline(times, positions, imu, options, &state);
   double worst = 0.0;
   for (double t = 2.5; t < kDuration; t += 5.0) {
