@@ -276,6 +276,32 @@ bool PrepareSequence(const std::string& scenario,
   return true;
 }
 
+// The calibrate stage's paths for the files PrepareSequence wrote into
+// `dir` (gravity.txtpb only when `gravity`).
+CalibratePaths SequencePaths(const TempDir& dir, bool gravity) {
+  CalibratePaths paths;
+  paths.imu = dir.File("imu.binpb");
+  paths.scans = dir.File("scans.binpb.lz4");
+  paths.ground = dir.File("ground.binpb");
+  if (gravity) paths.gravity = dir.File("gravity.txtpb");
+  paths.rig = dir.File("rig.txtpb");
+  paths.params = testing::SourceDir() + "/stages/calibrate/default_params.txtpb";
+  paths.out = dir.File("calibration.txtpb");
+  return paths;
+}
+
+// Runs the calibrate stage and reads its result and the simulator's truth
+// (dir/truth.txtpb). False (and a failure recorded) when a step fails.
+bool CalibrateSequence(const TempDir& dir, const CalibratePaths& paths,
+                       const proto::CalibrateParams& params, proto::CalibrationResult* result,
+                       proto::SimulationTruth* truth) {
+  Status status = calibrate::Run(paths, params, nullptr);
+  if (status.ok()) status = ReadTextProto(paths.out, result);
+  if (status.ok()) status = ReadTextProto(dir.File("truth.txtpb"), truth);
+  if (!status.ok()) ADD_FAILURE() << status.message();
+  return status.ok();
+}
+
 TEST(CalibratePipelineTest, ShortFlatSequenceAgainstTruth) {
   TempDir dir;
   const std::string src = testing::SourceDir();
@@ -288,20 +314,10 @@ TEST(CalibratePipelineTest, ShortFlatSequenceAgainstTruth) {
                                          params.mutable_incl(), params.mutable_up()}) {
     g->set_mode(proto::GroundResidualParams::OFF);
   }
-  CalibratePaths paths;
-  paths.imu = dir.File("imu.binpb");
-  paths.scans = dir.File("scans.binpb.lz4");
-  paths.ground = dir.File("ground.binpb");
-  paths.rig = dir.File("rig.txtpb");
-  paths.params = src + "/stages/calibrate/default_params.txtpb";
-  paths.out = dir.File("calibration.txtpb");
-  const Status status = calibrate::Run(paths, params, nullptr);
-  ASSERT_TRUE(status.ok()) << status.message();
-
   proto::CalibrationResult result;
-  ASSERT_TRUE(ReadTextProto(paths.out, &result).ok());
   proto::SimulationTruth truth;
-  ASSERT_TRUE(ReadTextProto(dir.File("truth.txtpb"), &truth).ok());
+  const CalibratePaths paths = SequencePaths(dir, /*gravity=*/false);
+  ASSERT_TRUE(CalibrateSequence(dir, paths, params, &result, &truth));
   proto::Rig rig;
   ASSERT_TRUE(ReadTextProto(dir.File("rig.txtpb"), &rig).ok());
 
@@ -410,19 +426,10 @@ TEST(CalibratePipelineTest, ShortTiltedSequenceWithTheDefaultsAgainstTruth) {
                               /*gravity=*/true, dir));
   proto::CalibrateParams params;
   ASSERT_TRUE(LoadParams(src + "/stages/calibrate/default_params.txtpb", &params).ok());
-  CalibratePaths paths;
-  paths.imu = dir.File("imu.binpb");
-  paths.scans = dir.File("scans.binpb.lz4");
-  paths.ground = dir.File("ground.binpb");
-  paths.gravity = dir.File("gravity.txtpb");
-  paths.rig = dir.File("rig.txtpb");
-  paths.out = dir.File("calibration.txtpb");
-  const Status status = calibrate::Run(paths, params, nullptr);
-  ASSERT_TRUE(status.ok()) << status.message();
   proto::CalibrationResult result;
-  ASSERT_TRUE(ReadTextProto(paths.out, &result).ok());
   proto::SimulationTruth truth;
-  ASSERT_TRUE(ReadTextProto(dir.File("truth.txtpb"), &truth).ok());
+  ASSERT_TRUE(
+      CalibrateSequence(dir, SequencePaths(dir, /*gravity=*/true), params, &result, &truth));
 
   std::vector<std::string> used(result.ground_residuals_used().begin(),
                                 result.ground_residuals_used().end());
