@@ -2,7 +2,7 @@
 """Prints the calibrator's timings, problem size and errors against the
 simulator's truth (bench/calibrate/run_calibrate_bench.sh).
 
-Usage: calibration_errors.py calibration.txtpb truth.txtpb rig.txtpb [calibrate_wall_s]
+Usage: calibration_errors.py calibration.txtpb truth.txtpb rig.txtpb [calibrate_wall_s [sequence_s, default 60]]
 
 Parses the protobuf text format with a small reader (no protobuf module
 needed): nested messages become dicts, repeated fields lists.
@@ -82,6 +82,7 @@ def main():
     truth = parse(open(sys.argv[2]).read())
     rig = parse(open(sys.argv[3]).read())
     wall = float(sys.argv[4]) if len(sys.argv) > 4 else None
+    duration = float(sys.argv[5]) if len(sys.argv) > 5 else 60.0  # sequence length, s
     print('calibrator phases (s):')
     for t in cal.get('timings', []):
         print('  %-22s %8.2f' % (get(t, 'phase', ''), get(t, 'seconds')))
@@ -100,7 +101,7 @@ def main():
             get(cal, 'solver.last_outer_rotation_change_deg'),
             get(cal, 'solver.last_outer_translation_change_m') * 1e3,
             get(cal, 'solver.last_outer_time_offset_change_s') * 1e3,
-            60.0 / wall if wall > 0 else 0.0, 60.0))
+            duration / wall if wall > 0 else 0.0, duration))
     # Normal of the plane of motion in b: gravity-up on flat ground (g_f, the
     # same on tilted ground for a rigid vehicle), else gravity at t0 (a = b(t0)).
     up = vec(truth, 'gravity_flat_in_imu')

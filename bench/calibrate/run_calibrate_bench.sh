@@ -8,8 +8,8 @@
 #   - seconds per LM iteration and the problem size (knots, residuals by kind);
 #   - the errors against the simulator's truth: rotation (deg), translation
 #     per axis of b and in the plane of motion (cm), tau (ms).
-# Anchor measured in the same run: the sequence length (x_realtime = 60 s /
-# calibrate wall). Targets of issue 5: whole stage <= 60 s wall on 2 cores,
+# Anchor measured in the same run: the sequence length (x_realtime =
+# duration_s / calibrate wall). Targets of issue 5: whole stage <= 60 s wall on 2 cores,
 # <= 0.25 s per LM iteration.
 #
 # Usage: bench/calibrate/run_calibrate_bench.sh [options]
@@ -99,6 +99,7 @@ printf '%-10s %9s %9s\n' stage wall_s cpu_s
 for s in simulate decode ground gravity calibrate; do
   printf '%-10s %9.2f %9.2f\n' "$s" "${WALL[$s]}" "${CPU[$s]}"
 done
+duration_s=$(sed -nE 's/^duration_s: *([0-9.]+).*/\1/p' "$scenario")
 python3 "$REPO/bench/calibrate/calibration_errors.py" "$W/calibration.txtpb" "$W/truth.txtpb" \
-  "$W/rig.txtpb" "${WALL[calibrate]}"
+  "$W/rig.txtpb" "${WALL[calibrate]}" "$duration_s"
 echo "stderr of tiltcal_calibrate: $W/log_calibrate.txt"

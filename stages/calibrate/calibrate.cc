@@ -108,6 +108,7 @@ ProblemOptions MakeProblemOptions(const proto::CalibrateParams& params) {
   ProblemOptions o;
   o.gyro_sigma_radps = params.gyro_sigma_radps();
   o.accel_sigma_mps2 = params.accel_sigma_mps2();
+  o.gyro_bias_random_walk = params.gyro_bias_random_walk_radps2_sqrthz();
   o.accel_bias_random_walk = params.accel_bias_random_walk_mps3_sqrthz();
   o.lidar_sigma_m = params.lidar_sigma_m();
   o.lidar_cauchy_scale = params.lidar_cauchy_scale();
@@ -175,7 +176,7 @@ Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& pa
       spline::UniformKnotGrid::ForDuration(t0, duration, params.knot_spacing_s());
   CalibrationState state(grid);
   state.gravity_norm_mps2 = params.gravity_norm_mps2();
-  state.SetAccelBiasSegments(params.accel_bias_segment_s());
+  state.SetBiasSegments(params.gyro_bias_segment_s(), params.accel_bias_segment_s());
 
   // Initialisation.
   auto start = Clock::now();
@@ -359,10 +360,14 @@ Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& pa
   *result->mutable_gravity_in_world() = ToProto(state.GravityInWorld());
   *result->mutable_gyro_bias_radps() = ToProto(state.GyroBias());
   *result->mutable_accel_bias_mps2() = ToProto(state.AccelBias());
-  for (const std::array<double, 3>& b : state.accel_bias_segments) {
-    *result->add_accel_bias_segments_mps2() = ToProto(Eigen::Vector3d(b[0], b[1], b[2]));
+  for (int i = 0; i < state.gyro_bias.size(); ++i) {
+    *result->add_gyro_bias_segments_radps() = ToProto(state.gyro_bias.Value(i));
   }
-  result->set_accel_bias_segment_s(state.accel_bias_segment_s);
+  result->set_gyro_bias_segment_s(state.gyro_bias.segment_s);
+  for (int i = 0; i < state.accel_bias.size(); ++i) {
+    *result->add_accel_bias_segments_mps2() = ToProto(state.accel_bias.Value(i));
+  }
+  result->set_accel_bias_segment_s(state.accel_bias.segment_s);
   for (const std::string& g : ground_used) result->add_ground_residuals_used(g);
   result->set_ground_residuals_reason(ground_reason);
   AddTiming("total", Seconds(total_start), result);

@@ -23,13 +23,14 @@
 //   gravity_direction            3 doubles, unit vector n_g in a pointing DOWN
 //                                (g_a = gravity_norm_mps2 * n_g),
 //                                ceres::SphereManifold<3>;
-//   gyro_bias_radps              3 doubles, b_g, rad/s;
-//   accel_bias_segments[i]       3 doubles, b_a over [t0 + i S, t0 + (i+1) S),
-//                                m/s^2, S = accel_bias_segment_s (piecewise
-//                                constant: the bias of a real accelerometer
-//                                wanders, and a constant one would bend the
-//                                trajectory and the yaw of C_bl; one segment
-//                                for the whole sequence when S = 0).
+//   gyro_bias.values[i]          3 doubles, b_g over segment i, rad/s;
+//   accel_bias.values[i]         3 doubles, b_a over segment i, m/s^2.
+//                                Both biases are piecewise constant in time
+//                                (bias_segments.h): a real IMU's biases
+//                                wander, and a constant b_a would bend the
+//                                trajectory and the yaw of C_bl, a constant
+//                                b_g its tilt; one segment for the whole
+//                                sequence when the segment length is 0.
 // Gauge (DESIGN §5: C_ab(t0) = 1, r_a^{ba}(t0) = 0): the builder holds the
 // first knots constant (see problem_builder.h).
 //
@@ -54,12 +55,13 @@
 
 #include "common/spline/knot_grid.h"
 #include "common/spline/spline_trajectory.h"
+#include "stages/calibrate/bias_segments.h"
 
 namespace tiltcal::calibrate {
 
 struct CalibrationState {
   explicit CalibrationState(const spline::UniformKnotGrid& grid)
-      : trajectory(grid), accel_bias_segments(1, {0.0, 0.0, 0.0}) {}
+      : trajectory(grid) {}
   CalibrationState(const CalibrationState&) = default;
   CalibrationState& operator=(const CalibrationState&) = default;
 
@@ -69,37 +71,17 @@ struct CalibrationState {
   double time_offset_s[1] = {0.0};                           // tau, s
   double gravity_direction[3] = {0.0, 0.0, -1.0};            // n_g, unit, frame a, down
   double gravity_norm_mps2 = 9.81;                           // |g_a|, fixed
-  double gyro_bias_radps[3] = {0.0, 0.0, 0.0};               // b_g
-  // b_a per time segment (see above); at least one.
-  std::vector<std::array<double, 3>> accel_bias_segments;
-  double accel_bias_segment_s = 0.0;  // S, s; 0 = one segment
+  BiasSegments gyro_bias;   // b_g, rad/s
+  BiasSegments accel_bias;  // b_a, m/s^2
 
-  // Splits b_a into ceil(spline duration / segment_s) segments (one when
-  // segment_s <= 0), each set to the current mean. Call before a Problem
-  // refers to the state.
-  void SetAccelBiasSegments(double segment_s) {
-    const Eigen::Vector3d mean = AccelBias();
-    const double duration = trajectory.grid().end_s() - trajectory.grid().t0_s();
-    int count = 1;
-    if (segment_s > 0.0 && duration > segment_s) {
-      count = static_cast<int>(std::ceil(duration / segment_s));
-    }
-    accel_bias_segment_s = count > 1 ? segment_s : 0.0;
-    accel_bias_segments.assign(count, {mean.x(), mean.y(), mean.z()});
-  }
-  // Index of the b_a segment at IMU time t_s (clamped to the segments).
-  int AccelBiasSegment(double t_s) const {
-    if (accel_bias_segment_s <= 0.0) return 0;
-    const int last = static_cast<int>(accel_bias_segments.size()) - 1;
-    const double i = std::floor((t_s - trajectory.grid().t0_s()) / accel_bias_segment_s);
-    return static_cast<int>(std::clamp(i, 0.0, static_cast<double>(last)));
-  }
-  double* AccelBiasBlock(double t_s) {
-    return accel_bias_segments[AccelBiasSegment(t_s)].data();
-  }
-  Eigen::Vector3d AccelBiasAt(double t_s) const {
-    const std::array<double, 3>& b = accel_bias_segments[AccelBiasSegment(t_s)];
-    return Eigen::Vector3d(b[0], b[1], b[2]);
+  // Splits b_g and b_a into segments of gyro_segment_s and accel_segment_s
+  // over the spline (0 = one segment), each at its current mean. Call before
+  // a Problem refers to the state.
+  void SetBiasSegments(double gyro_segment_s, double accel_segment_s) {
+    const double t0 = trajectory.grid().t0_s();
+    const double duration = trajectory.grid().end_s() - t0;
+    gyro_bias.Split(t0, duration, gyro_segment_s);
+    accel_bias.Split(t0, duration, accel_segment_s);
   }
 
   // Convenience accessors (copies).
@@ -118,17 +100,9 @@ struct CalibrationState {
            Eigen::Vector3d(gravity_direction[0], gravity_direction[1], gravity_direction[2])
                .normalized();
   }
-  Eigen::Vector3d GyroBias() const {
-    return Eigen::Vector3d(gyro_bias_radps[0], gyro_bias_radps[1], gyro_bias_radps[2]);
-  }
-  // Mean of b_a over the segments.
-  Eigen::Vector3d AccelBias() const {
-    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    for (const std::array<double, 3>& b : accel_bias_segments) {
-      sum += Eigen::Vector3d(b[0], b[1], b[2]);
-    }
-    return sum / static_cast<double>(accel_bias_segments.size());
-  }
+  // Means of b_g and b_a over their segments.
+  Eigen::Vector3d GyroBias() const { return gyro_bias.Mean(); }
+  Eigen::Vector3d AccelBias() const { return accel_bias.Mean(); }
 
   void SetImuFromLidarRotation(const Eigen::Quaterniond& q) {
     const Eigen::Quaterniond n = q.normalized();
@@ -145,15 +119,9 @@ struct CalibrationState {
     const Eigen::Vector3d n = gravity_in_world.normalized();
     for (int i = 0; i < 3; ++i) gravity_direction[i] = n[i];
   }
-  void SetGyroBias(const Eigen::Vector3d& b) {
-    for (int i = 0; i < 3; ++i) gyro_bias_radps[i] = b[i];
-  }
-  // Sets every b_a segment to b.
-  void SetAccelBias(const Eigen::Vector3d& b) {
-    for (std::array<double, 3>& segment : accel_bias_segments) {
-      for (int i = 0; i < 3; ++i) segment[i] = b[i];
-    }
-  }
+  // Set every segment of b_g or b_a to b.
+  void SetGyroBias(const Eigen::Vector3d& b) { gyro_bias.SetAll(b); }
+  void SetAccelBias(const Eigen::Vector3d& b) { accel_bias.SetAll(b); }
 
   // The frozen knot window of a residual at LiDAR time t_lidar_s, chosen with
   // the current tau: Locate(t_lidar_s + tau). Returns false when that time is

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <utility>
 
 #include "common/spline/so3_spline.h"
 #include "stages/calibrate/accel_cost_function.h"
@@ -67,8 +68,9 @@ CalibrationProblem::CalibrationProblem(CalibrationState* state, const ProblemOpt
   p.AddParameterBlock(state_->imu_from_lidar_translation, 3);
   p.AddParameterBlock(state_->time_offset_s, 1);
   p.AddParameterBlock(state_->gravity_direction, 3, &sphere_manifold_);
-  p.AddParameterBlock(state_->gyro_bias_radps, 3);
-  for (std::array<double, 3>& b : state_->accel_bias_segments) p.AddParameterBlock(b.data(), 3);
+  for (BiasSegments* bias : {&state_->gyro_bias, &state_->accel_bias}) {
+    for (std::array<double, 3>& b : bias->values) p.AddParameterBlock(b.data(), 3);
+  }
 
   // tau bounds around the binning value; tau clamped into them.
   const double bound = std::abs(options_.time_offset_bound_s);
@@ -87,19 +89,19 @@ CalibrationProblem::CalibrationProblem(CalibrationState* state, const ProblemOpt
     p.SetParameterBlockConstant(state_->imu_from_lidar_translation);
   }
   if (!options_.estimate_gravity) p.SetParameterBlockConstant(state_->gravity_direction);
-  if (!options_.estimate_biases) {
-    p.SetParameterBlockConstant(state_->gyro_bias_radps);
-    for (std::array<double, 3>& b : state_->accel_bias_segments) {
-      p.SetParameterBlockConstant(b.data());
-    }
-  } else if (options_.accel_bias_random_walk > 0.0) {
-    // Consecutive b_a segments tied by the random walk over one segment.
-    for (size_t i = 0; i + 1 < state_->accel_bias_segments.size(); ++i) {
-      p.AddResidualBlock(new BiasRandomWalkCostFunction(options_.accel_bias_random_walk,
-                                                        state_->accel_bias_segment_s),
-                         nullptr, state_->accel_bias_segments[i].data(),
-                         state_->accel_bias_segments[i + 1].data());
-      ++counts_.prior_residuals;
+  const std::pair<BiasSegments*, double> biases[] = {
+      {&state_->gyro_bias, options_.gyro_bias_random_walk},
+      {&state_->accel_bias, options_.accel_bias_random_walk}};
+  for (const auto& [bias, random_walk] : biases) {
+    if (!options_.estimate_biases) {
+      for (std::array<double, 3>& b : bias->values) p.SetParameterBlockConstant(b.data());
+    } else if (random_walk > 0.0) {
+      // Consecutive segments tied by the random walk over one segment.
+      for (int i = 0; i + 1 < bias->size(); ++i) {
+        p.AddResidualBlock(new BiasRandomWalkCostFunction(random_walk, bias->segment_s), nullptr,
+                           bias->values[i].data(), bias->values[i + 1].data());
+        ++counts_.prior_residuals;
+      }
     }
   }
   if (options_.translation_prior_sigma_m > 0.0 && options_.estimate_extrinsic) {
@@ -134,7 +136,7 @@ void CalibrationProblem::AddImuResiduals(const std::vector<imu::ImuReading>& sam
           new GyroCostFunction(w, grid.inv_dt(), s.angular_velocity_radps,
                                options_.gyro_sigma_radps),
           nullptr, traj.rotation_knot(k), traj.rotation_knot(k + 1), traj.rotation_knot(k + 2),
-          traj.rotation_knot(k + 3), state_->gyro_bias_radps);
+          traj.rotation_knot(k + 3), state_->gyro_bias.Block(s.time_s));
       ++counts_.gyro_residuals;
       MarkKnots(k, false);
     }
@@ -146,7 +148,7 @@ void CalibrationProblem::AddImuResiduals(const std::vector<imu::ImuReading>& sam
           {traj.rotation_knot(k), traj.rotation_knot(k + 1), traj.rotation_knot(k + 2),
            traj.rotation_knot(k + 3), traj.position_knot(k), traj.position_knot(k + 1),
            traj.position_knot(k + 2), traj.position_knot(k + 3), state_->gravity_direction,
-           state_->AccelBiasBlock(s.time_s)});
+           state_->accel_bias.Block(s.time_s)});
       ++counts_.accel_residuals;
       MarkKnots(k, true);
     }
@@ -209,8 +211,10 @@ void CalibrationProblem::RemoveUnusedKnots() {
   std::vector<ceres::ResidualBlockId> users;
   std::vector<double*> blocks = {state_->imu_from_lidar_rotation,
                                  state_->imu_from_lidar_translation, state_->time_offset_s,
-                                 state_->gravity_direction, state_->gyro_bias_radps};
-  for (std::array<double, 3>& b : state_->accel_bias_segments) blocks.push_back(b.data());
+                                 state_->gravity_direction};
+  for (BiasSegments* bias : {&state_->gyro_bias, &state_->accel_bias}) {
+    for (std::array<double, 3>& b : bias->values) blocks.push_back(b.data());
+  }
   for (double* block : blocks) {
     users.clear();
     problem_->GetResidualBlocksForParameterBlock(block, &users);

@@ -21,8 +21,9 @@
 // afterwards so that C_ab(t0) = 1 and r_a^{ba}(t0) = 0 exactly
 // (ReexpressInFirstImuFrame).
 //
-// Accelerometer bias: one block per segment of the state; with more than one,
-// a random-walk prior between consecutive segments (accel_bias_random_walk).
+// Gyro and accelerometer biases: one block per segment of the state; with
+// more than one, a random-walk prior between consecutive segments
+// (gyro_bias_random_walk, accel_bias_random_walk).
 //
 // Optional prior on r_b^{lb} (translation_prior_sigma_m > 0): one residual
 // (r_b^{lb} - r_prior) / sigma (3), or, with a unit translation_prior_axis_b,
@@ -80,10 +81,11 @@ struct ProblemOptions {
   bool estimate_time_offset = true;
   bool estimate_gravity = true;
   bool estimate_biases = true;
-  // Random walk of the accelerometer bias, m/s^3/sqrt(Hz): ties consecutive
-  // b_a segments (CalibrationState::accel_bias_segments) by
-  // BiasRandomWalkCostFunction; 0 = segments independent. Counted in
-  // ProblemCounts::prior_residuals.
+  // Random walks of the biases, rad/s^2/sqrt(Hz) (gyro) and m/s^3/sqrt(Hz)
+  // (accelerometer): tie consecutive segments of b_g and b_a
+  // (CalibrationState::gyro_bias, accel_bias) by BiasRandomWalkCostFunction;
+  // 0 = segments independent. Counted in ProblemCounts::prior_residuals.
+  double gyro_bias_random_walk = 0.0;
   double accel_bias_random_walk = 0.0;
   // Gauge by holding rotation knot 0 and position knot 0 (see above). Off
   // when fixed map planes already pin the world frame.

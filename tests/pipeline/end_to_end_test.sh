@@ -16,6 +16,7 @@ fail() { echo "FAIL: $*" >&2; exit 1; }
 for i in 1 2; do
   sed -E -e "s/^seed: .*/seed: $((40 + i))/" -e "s/^duration_s: .*/duration_s: 20/" \
     -e "s/^([[:space:]]*heading_deg:).*/\1 $((30 * i))/" \
+    -e "s/^(  length_m:).*/\1 10/" -e "s/^(  width_m:).*/\1 5/" -e "s/^(  speed_mps:).*/\1 1.2/" \
     "$SRC/stages/simulate/scenarios/flat_vlp16.txtpb" > "$WORK/seq_$i.txtpb"
   rig=""
   [ "$i" = 1 ] && rig="--out_rig=$DATA/rig.txtpb"
@@ -37,13 +38,16 @@ cat "$table"
 grep -q "seq_1" "$table" && grep -q "seq_2" "$table" || fail "the report misses a sequence"
 
 # Errors against the truth, from the CSV: rotation deg, x/y/z cm, tau ms, with
-# the defaults (flat + distance residuals on this level ground): issue 6's
-# bounds, 0.1 deg, 1 cm on every axis, 0.5 ms. Measured: rotation 0.04-0.06
-# deg, x/y at most 0.43 cm, z 0.02 cm, tau 0.08-0.12 ms.
+# the defaults (flat + distance residuals on this level ground). The 20 s
+# sequences (a 10 x 5 m figure-eight at 1.2 m/s, about two thirds of a loop)
+# hold less information on the angle of C_bl about the vertical than the
+# 40-60 s ones issue 6 bounds at 0.1 deg (its sigma here: 0.11-0.27 deg), so
+# rotation is held to 0.25 deg; every axis to 1 cm, tau to 0.5 ms. Measured:
+# rotation 0.089 / 0.012 deg, x/y at most 0.82 cm, z 0.01 cm, tau 0.09-0.32 ms.
 awk -F, 'function abs(v) { return v < 0 ? -v : v }
 NR > 1 && $1 ~ /^seq_/ {
   if ($9 == "") { print "FAIL: no error columns for " $1; bad = 1 }
-  else if ($9 > 0.1 || abs($10) > 1 || abs($11) > 1 || abs($12) > 1 || abs($13) > 0.5) {
+  else if ($9 > 0.25 || abs($10) > 1 || abs($11) > 1 || abs($12) > 1 || abs($13) > 0.5) {
     print "FAIL: " $1 " errors rot " $9 " deg, x " $10 " cm, y " $11 " cm, z " $12 " cm, tau " $13 " ms"
     bad = 1
   }

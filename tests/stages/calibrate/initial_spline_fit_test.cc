@@ -6,7 +6,11 @@
 //    accelerometer recovers the accelerometer bias and a lever arm given
 //    half a metre off, and keeps the positions, where a bias held at zero
 //    would bend them; with a drifting bias, its piecewise-constant segments
-//    (tied by the random-walk prior) follow the drift.
+//    (tied by the random-walk prior) follow the drift;
+//  - the problem builder's gyro bias segments: with 10 Hz orientation samples
+//    (as the LiDAR gives) they follow a drifting gyro bias, which a constant
+//    b_g can only average;
+//  - the state's bias segments: count, lookup, clamping, mean.
 //
 // Truth (closed form, C_ab(0) = 1 as the gyro integration starts): planar
 // driving with a wobble,
@@ -18,12 +22,16 @@
 #include <random>
 #include <vector>
 
+#include <ceres/problem.h>
+#include <ceres/solver.h>
 #include <gtest/gtest.h>
 
 #include "common/geometry/so3.h"
 #include "common/spline/knot_grid.h"
 #include "stages/calibrate/calibration_state.h"
 #include "stages/calibrate/initialisation.h"
+#include "stages/calibrate/orientation_sample_cost_function.h"
+#include "stages/calibrate/problem_builder.h"
 
 namespace tiltcal::calibrate {
 namespace {
@@ -46,10 +54,12 @@ Eigen::Vector3d Acceleration(double t) {
   return {-0.32 * std::sin(0.4 * t), -0.135 * std::cos(0.3 * t), 0.0};
 }
 
-// Accelerometer bias b_a(t) = accel_bias + accel_bias_drift * t.
+// Biases b_g(t) = gyro_bias + gyro_bias_drift * t,
+// b_a(t) = accel_bias + accel_bias_drift * t.
 std::vector<imu::ImuReading> Imu(const Eigen::Vector3d& gyro_bias,
                                  const Eigen::Vector3d& accel_bias, std::mt19937* rng,
-                                 const Eigen::Vector3d& accel_bias_drift = Eigen::Vector3d::Zero()) {
+                                 const Eigen::Vector3d& accel_bias_drift = Eigen::Vector3d::Zero(),
+                                 const Eigen::Vector3d& gyro_bias_drift = Eigen::Vector3d::Zero()) {
   std::normal_distribution<double> n(0.0, 1.0);
   std::vector<imu::ImuReading> out;
   for (int i = 0; i <= static_cast<int>(kDuration * kImuRate); ++i) {
@@ -57,7 +67,7 @@ std::vector<imu::ImuReading> Imu(const Eigen::Vector3d& gyro_bias,
     imu::ImuReading r;
     r.time_s = t;
     r.angular_velocity_radps = geometry::RightJacobian(Phi(t)) * PhiDot(t) + gyro_bias +
-                               0.002 * Eigen::Vector3d(n(*rng), n(*rng), n(*rng));
+                               gyro_bias_drift * t + 0.002 * Eigen::Vector3d(n(*rng), n(*rng), n(*rng));
     r.linear_acceleration_mps2 = Rotation(t).transpose() * (Acceleration(t) - kGravity) +
                                  accel_bias + accel_bias_drift * t +
                                  0.014 * Eigen::Vector3d(n(*rng), n(*rng), n(*rng));
@@ -177,7 +187,7 @@ double WorstAccelBiasSegmentError(double segment_s, const Eigen::Vector3d& accel
   const std::vector<imu::ImuReading> imu = Imu(gyro_bias, accel_bias, &rng, drift);
   const spline::UniformKnotGrid grid = spline::UniformKnotGrid::ForDuration(0.0, kDuration, 0.05);
   CalibrationState state(grid);
-  state.SetAccelBiasSegments(segment_s);
+  state.SetBiasSegments(0.0, segment_s);
   state.SetGyroBias(gyro_bias);
   state.SetGravityDirection(kGravity);
   state.SetImuFromLidarTranslation(r_bl);
@@ -190,7 +200,7 @@ double WorstAccelBiasSegmentError(double segment_s, const Eigen::Vector3d& accel
   FitPositionSpline(times, positions, imu, options, &state);
   double worst = 0.0;
   for (double t = 2.5; t < kDuration; t += 5.0) {
-    worst = std::max(worst, (state.AccelBiasAt(t) - (accel_bias + drift * t)).norm());
+    worst = std::max(worst, (state.accel_bias.At(t) - (accel_bias + drift * t)).norm());
   }
   return worst;
 }
@@ -208,26 +218,102 @@ TEST(InitialSplineFitTest, AccelerometerBiasSegmentsFollowADriftingBias) {
   EXPECT_GT(constant, 0.025);
 }
 
-TEST(CalibrationStateTest, AccelBiasSegmentsCoverTheSplineAndClampOutside) {
+// Fits the rotation spline to the gyro and to 10 Hz orientation samples
+// (1 mrad noise, as from the LiDAR) with b_g free in segments of segment_s
+// (0: one constant bias), tied by a random walk of 1e-4 rad/s^2/sqrt(Hz);
+// returns the largest error of b_g against the truth at 2.5, 7.5, ..., 37.5 s.
+double WorstGyroBiasSegmentError(double segment_s, const Eigen::Vector3d& gyro_bias,
+                                 const Eigen::Vector3d& drift) {
+  std::mt19937 rng(17);
+  const std::vector<imu::ImuReading> imu =
+      Imu(gyro_bias, Eigen::Vector3d::Zero(), &rng, Eigen::Vector3d::Zero(), drift);
+  const spline::UniformKnotGrid grid = spline::UniformKnotGrid::ForDuration(0.0, kDuration, 0.05);
+  CalibrationState state(grid);
+  state.SetBiasSegments(segment_s, 0.0);
+  state.SetGyroBias(gyro_bias);
+  FitRotationSplineToGyro(imu, Options(), &state);
+
+  ProblemOptions options;
+  options.gyro_sigma_radps = 0.003;
+  options.gyro_bias_random_walk = 1e-4;
+  options.estimate_extrinsic = false;
+  options.estimate_time_offset = false;
+  options.estimate_gravity = false;
+  CalibrationProblem problem(&state, options);
+  problem.AddImuResiduals(imu, /*gyro=*/true, /*accel=*/false);
+  std::normal_distribution<double> n(0.0, 1.0);
+  const Status status =
+      problem.AddExtraResiduals([&](CalibrationState* s, ceres::Problem* p, int* added) {
+        for (double t = 0.1; t < kDuration - 0.1; t += 0.1) {
+          spline::KnotWindow w;
+          if (!grid.Locate(t, &w)) continue;
+          const Eigen::Vector3d noise = 0.001 * Eigen::Vector3d(n(rng), n(rng), n(rng));
+          const int f = w.first_knot;
+          p->AddResidualBlock(
+              new OrientationSampleCostFunction(w, grid.inv_dt(),
+                                                Eigen::Quaterniond(Rotation(t) *
+                                                                   geometry::ExpMatrix(noise)),
+                                                0.001),
+              nullptr, s->trajectory.rotation_knot(f), s->trajectory.rotation_knot(f + 1),
+              s->trajectory.rotation_knot(f + 2), s->trajectory.rotation_knot(f + 3));
+          ++*added;
+        }
+        return Status::Ok();
+      });
+  EXPECT_TRUE(status.ok());
+  problem.RemoveUnusedKnots();
+  ceres::Solver::Summary summary;
+  ceres::Solve(MakeSolverOptions(30, 2, 1e-10), problem.problem(), &summary);
+  double worst = 0.0;
+  for (double t = 2.5; t < kDuration; t += 5.0) {
+    worst = std::max(worst, (state.gyro_bias.At(t) - (gyro_bias + drift * t)).norm());
+  }
+  return worst;
+}
+
+TEST(InitialSplineFitTest, GyroBiasSegmentsFollowADriftingBias) {
+  const Eigen::Vector3d gyro_bias(0.002, -0.003, 0.0015);
+  // 3.3e-3 rad/s of drift over the 40 s (a warming MEMS gyro).
+  const Eigen::Vector3d drift(6e-5, -4e-5, 4e-5);
+  const double segmented = WorstGyroBiasSegmentError(5.0, gyro_bias, drift);
+  const double constant = WorstGyroBiasSegmentError(0.0, gyro_bias, drift);
+  // Each 5 s segment holds its centre's bias to ~1e-4 rad/s per axis (the
+  // 1 mrad samples over 5 s); the constant bias is off by 1.4e-3 rad/s at
+  // 2.5 s and 37.5 s.
+  EXPECT_LT(segmented, 4e-4) << "constant: " << constant;
+  EXPECT_GT(constant, 1e-3) << "segmented: " << segmented;
+}
+
+TEST(CalibrationStateTest, BiasSegmentsCoverTheSplineAndClampOutside) {
   const spline::UniformKnotGrid grid = spline::UniformKnotGrid::ForDuration(2.0, 12.0, 0.05);
   CalibrationState state(grid);
-  ASSERT_EQ(state.accel_bias_segments.size(), 1u);
+  ASSERT_EQ(state.accel_bias.size(), 1);
+  ASSERT_EQ(state.gyro_bias.size(), 1);
   state.SetAccelBias(Eigen::Vector3d(0.1, 0.2, 0.3));
-  state.SetAccelBiasSegments(5.0);
-  ASSERT_EQ(state.accel_bias_segments.size(), 3u);  // ceil(12 / 5)
-  EXPECT_EQ(state.AccelBiasSegment(1.0), 0);        // before t0: clamped
-  EXPECT_EQ(state.AccelBiasSegment(2.0), 0);
-  EXPECT_EQ(state.AccelBiasSegment(7.01), 1);
-  EXPECT_EQ(state.AccelBiasSegment(13.9), 2);
-  EXPECT_EQ(state.AccelBiasSegment(100.0), 2);      // after the end: clamped
-  state.accel_bias_segments[2] = {0.4, 0.5, 0.6};
-  EXPECT_TRUE(state.AccelBiasAt(13.0).isApprox(Eigen::Vector3d(0.4, 0.5, 0.6)));
+  state.SetGyroBias(Eigen::Vector3d(-1.0, -2.0, -3.0));
+  state.SetBiasSegments(4.0, 5.0);
+  ASSERT_EQ(state.gyro_bias.size(), 3);   // ceil(12 / 4)
+  ASSERT_EQ(state.accel_bias.size(), 3);  // ceil(12 / 5)
+  EXPECT_TRUE(state.gyro_bias.At(13.9).isApprox(Eigen::Vector3d(-1.0, -2.0, -3.0)));
+  EXPECT_EQ(state.gyro_bias.Index(5.99), 0);
+  EXPECT_EQ(state.gyro_bias.Index(6.01), 1);
+  EXPECT_EQ(state.accel_bias.Index(1.0), 0);  // before t0: clamped
+  EXPECT_EQ(state.accel_bias.Index(2.0), 0);
+  EXPECT_EQ(state.accel_bias.Index(7.01), 1);
+  EXPECT_EQ(state.accel_bias.Index(13.9), 2);
+  EXPECT_EQ(state.accel_bias.Index(100.0), 2);  // after the end: clamped
+  state.accel_bias.values[2] = {0.4, 0.5, 0.6};
+  EXPECT_TRUE(state.accel_bias.At(13.0).isApprox(Eigen::Vector3d(0.4, 0.5, 0.6)));
   EXPECT_TRUE(state.AccelBias().isApprox(Eigen::Vector3d(0.2, 0.3, 0.4)));  // the mean
-  EXPECT_EQ(state.AccelBiasBlock(3.0), state.accel_bias_segments[0].data());
+  EXPECT_EQ(state.accel_bias.Block(3.0), state.accel_bias.values[0].data());
   // Back to one segment: the mean.
-  state.SetAccelBiasSegments(0.0);
-  ASSERT_EQ(state.accel_bias_segments.size(), 1u);
-  EXPECT_TRUE(state.AccelBiasAt(13.0).isApprox(Eigen::Vector3d(0.2, 0.3, 0.4)));
+  state.SetBiasSegments(0.0, 0.0);
+  ASSERT_EQ(state.accel_bias.size(), 1);
+  EXPECT_TRUE(state.accel_bias.At(13.0).isApprox(Eigen::Vector3d(0.2, 0.3, 0.4)));
+  // A segment longer than the spline: one segment.
+  state.SetBiasSegments(20.0, 20.0);
+  EXPECT_EQ(state.gyro_bias.size(), 1);
+  EXPECT_EQ(state.gyro_bias.segment_s, 0.0);
 }
 
 }  // namespace

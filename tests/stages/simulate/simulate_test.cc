@@ -503,8 +503,8 @@ TEST(SimulateTest, BadParamsAreAClearErrorAndLeaveNoOutput) {
 // The scenarios of the repository (demo and tests) pass the schema and the
 // simulator's own checks.
 TEST(SimulateTest, RepositoryScenariosAreValid) {
-  for (const char* name : {"flat_vlp16", "tilted_husky_vlp16", "flat_m2dgr_vlp32c",
-                           "offroad_os1_32", "short_test_vlp16"}) {
+  for (const char* name : {"flat_vlp16", "flat_vlp16_40s", "tilted_husky_vlp16",
+                           "flat_m2dgr_vlp32c", "offroad_os1_32", "short_test_vlp16"}) {
     SCOPED_TRACE(name);
     proto::SimulateParams params;
     const Status loaded = LoadParams(tiltcal::testing::SourceDir() + "/stages/simulate/scenarios/" +
