@@ -27,10 +27,11 @@
 //   accel_bias.values[i]         3 doubles, b_a over segment i, m/s^2.
 //                                Both biases are piecewise constant in time
 //                                (bias_segments.h): a real IMU's biases
-//                                wander, and a constant b_a would bend the
+//                                wander: a constant b_a would bend the
 //                                trajectory and the yaw of C_bl, a constant
-//                                b_g its tilt; one segment for the whole
-//                                sequence when the segment length is 0.
+//                                b_g the rotation spline away from the
+//                                LiDAR's; one segment for the whole sequence
+//                                when the segment length is 0.
 // Gauge (DESIGN §5: C_ab(t0) = 1, r_a^{ba}(t0) = 0): the builder holds the
 // first knots constant (see problem_builder.h).
 //
@@ -45,10 +46,6 @@
 // blocks itself, change their manifolds or bounds, or hold the pointers
 // beyond the life of the Problem.
 
-#include <algorithm>
-#include <array>
-#include <cmath>
-#include <vector>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -60,8 +57,7 @@
 namespace tiltcal::calibrate {
 
 struct CalibrationState {
-  explicit CalibrationState(const spline::UniformKnotGrid& grid)
-      : trajectory(grid) {}
+  explicit CalibrationState(const spline::UniformKnotGrid& grid) : trajectory(grid) {}
   CalibrationState(const CalibrationState&) = default;
   CalibrationState& operator=(const CalibrationState&) = default;
 
