@@ -46,7 +46,6 @@
 // blocks itself, change their manifolds or bounds, or hold the pointers
 // beyond the life of the Problem.
 
-
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
