@@ -176,6 +176,17 @@ TEST(InitialSplineFitTest, PositionFitEstimatesTheAccelerometerBiasAndTheLeverAr
       << "bias " << state.AccelBias().transpose() << " g " << state.GravityInWorld().transpose();
 }
 
+// Largest error of the estimated segments against a bias + drift * t,
+// at 2.5, 7.5, ..., 37.5 s (the centres of 5 s segments).
+double WorstBiasError(const BiasSegments& estimated, const Eigen::Vector3d& bias,
+                      const Eigen::Vector3d& drift) {
+  double worst = 0.0;
+  for (double t = 2.5; t < kDuration; t += 5.0) {
+    worst = std::max(worst, (estimated.At(t) - (bias + drift * t)).norm());
+  }
+  return worst;
+}
+
 // Fits the position spline to 10 Hz LiDAR positions (r_b^{lb} known, 1 cm
 // noise) with b_a in segments of segment_s (0: one constant bias); returns
 // the largest error of b_a against the truth at 2.5, 7.5, ..., 37.5 s.
@@ -198,11 +209,7 @@ double WorstAccelBiasSegmentError(double segment_s, const Eigen::Vector3d& accel
   std::vector<Eigen::Vector3d> positions;
   LidarPositions(r_bl, &rng, &times, &positions);
   FitPositionSpline(times, positions, imu, options, &state);
-  double worst = 0.0;
-  for (double t = 2.5; t < kDuration; t += 5.0) {
-    worst = std::max(worst, (state.accel_bias.At(t) - (accel_bias + drift * t)).norm());
-  }
-  return worst;
+  return WorstBiasError(state.accel_bias, accel_bias, drift);
 }
 
 TEST(InitialSplineFitTest, AccelerometerBiasSegmentsFollowADriftingBias) {
@@ -264,11 +271,7 @@ double WorstGyroBiasSegmentError(double segment_s, const Eigen::Vector3d& gyro_b
   problem.RemoveUnusedKnots();
   ceres::Solver::Summary summary;
   ceres::Solve(MakeSolverOptions(30, 2, 1e-10), problem.problem(), &summary);
-  double worst = 0.0;
-  for (double t = 2.5; t < kDuration; t += 5.0) {
-    worst = std::max(worst, (state.gyro_bias.At(t) - (gyro_bias + drift * t)).norm());
-  }
-  return worst;
+  return WorstBiasError(state.gyro_bias, gyro_bias, drift);
 }
 
 TEST(InitialSplineFitTest, GyroBiasSegmentsFollowADriftingBias) {
