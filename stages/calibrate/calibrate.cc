@@ -1,7 +1,6 @@
 #include "stages/calibrate/calibrate.h"
 
 #include <algorithm>
-#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>

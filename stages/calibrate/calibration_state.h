@@ -46,6 +46,9 @@
 // blocks itself, change their manifolds or bounds, or hold the pointers
 // beyond the life of the Problem.
 
+#include <array>
+#include <vector>
+
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
@@ -77,6 +80,14 @@ struct CalibrationState {
     const double duration = trajectory.grid().end_s() - t0;
     gyro_bias.Split(t0, duration, gyro_segment_s);
     accel_bias.Split(t0, duration, accel_segment_s);
+  }
+  // Every parameter block of b_g and b_a (3 doubles each).
+  std::vector<double*> BiasBlocks() {
+    std::vector<double*> blocks;
+    for (BiasSegments* bias : {&gyro_bias, &accel_bias}) {
+      for (std::array<double, 3>& b : bias->values) blocks.push_back(b.data());
+    }
+    return blocks;
   }
 
   // Convenience accessors (copies).

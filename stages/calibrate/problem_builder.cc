@@ -68,9 +68,7 @@ CalibrationProblem::CalibrationProblem(CalibrationState* state, const ProblemOpt
   p.AddParameterBlock(state_->imu_from_lidar_translation, 3);
   p.AddParameterBlock(state_->time_offset_s, 1);
   p.AddParameterBlock(state_->gravity_direction, 3, &sphere_manifold_);
-  for (BiasSegments* bias : {&state_->gyro_bias, &state_->accel_bias}) {
-    for (std::array<double, 3>& b : bias->values) p.AddParameterBlock(b.data(), 3);
-  }
+  for (double* b : state_->BiasBlocks()) p.AddParameterBlock(b, 3);
 
   // tau bounds around the binning value; tau clamped into them.
   const double bound = std::abs(options_.time_offset_bound_s);
@@ -209,11 +207,10 @@ void CalibrationProblem::RemoveUnusedKnots() {
   // each; there are a handful), so extra residual sets are accounted for
   // exactly.
   std::vector<ceres::ResidualBlockId> users;
-  std::vector<double*> blocks = {state_->imu_from_lidar_rotation,
-                                 state_->imu_from_lidar_translation, state_->time_offset_s,
-                                 state_->gravity_direction};
-  for (BiasSegments* bias : {&state_->gyro_bias, &state_->accel_bias}) {
-    for (std::array<double, 3>& b : bias->values) blocks.push_back(b.data());
+  std::vector<double*> blocks = state_->BiasBlocks();
+  for (double* b : {state_->imu_from_lidar_rotation, state_->imu_from_lidar_translation,
+                    state_->time_offset_s, state_->gravity_direction}) {
+    blocks.push_back(b);
   }
   for (double* block : blocks) {
     users.clear();

@@ -3,7 +3,7 @@
 // (numeric differences through the manifolds), at several knot spacings and
 // normalised times including segment ends, and the time-offset window
 // behaviour of the point-to-plane residual at a segment boundary; the
-// random-walk prior between accelerometer bias segments.
+// random-walk prior between consecutive bias segments.
 
 #include <memory>
 #include <random>
