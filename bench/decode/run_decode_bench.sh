@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Decode benchmark (DESIGN §6; see README.md beside this file).
+# Decode benchmark (docs/design.md §13; see README.md beside this file).
 #
 # Builds tiltcal_decode (Release) and, when Debian's C++ rosbag library
 # installs, the anchor reader tiltcal_bench_rosbag_cpp_reader; generates

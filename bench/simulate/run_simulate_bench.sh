@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# tiltcal_simulate benchmark (DESIGN §6): time to generate the 60 s VLP-16
+# tiltcal_simulate benchmark (docs/design.md §13): time to generate the 60 s VLP-16
 # tilted Husky sequence (stages/simulate/scenarios/tilted_husky_vlp16.txtpb,
 # ~12 M points, 600 scans, 12,000 IMU samples) per chunk compression and
 # thread count, with two anchors measured in the same run:

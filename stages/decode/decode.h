@@ -6,8 +6,7 @@
 // provenance, both strictly increasing in stamp_ns.
 
 #include <cstdint>
-#include <cstdio>
-#include <map>
+#include <ostream>
 #include <string>
 
 #include "common/status.h"
@@ -15,15 +14,14 @@
 
 namespace tiltcal {
 
-struct DecodeInputs {
-  std::string bag_path;
-  std::string rig_path;  // optional: topics from rig.txtpb
-  std::string out_imu_path;
-  std::string out_scans_path;
+// Every path of one decode run.
+struct DecodePaths {
+  std::string bag;
+  std::string rig;  // optional: imu_topic / lidar_topic from rig.txtpb
+  std::string out_imu;
+  std::string out_scans;
+  std::string params;        // the params file ("" = the stage defaults), for the provenance
   std::string command_line;  // recorded in the provenance
-  // Where the progress (only when it is a terminal) and the final summary
-  // go; nullptr = silent.
-  std::FILE* log = stderr;
 };
 
 // What a run did, for the summary and for tests.
@@ -52,10 +50,15 @@ struct DecodeSummary {
   double wall_s = 0.0;
 };
 
-// Runs the stage. Errors are one line naming the file and the record.
-// Outputs appear only when the whole run succeeded.
-Status Run(const DecodeInputs& inputs, const proto::DecodeParams& params,
-           DecodeSummary* summary = nullptr);
+// Decodes the bag into the two streams and fills *summary. `log` receives
+// the progress (only when it is a terminal) and the final summary; nullptr
+// = silent. Errors are one line naming the file and the record. Outputs
+// appear only when the whole run succeeded.
+Status Decode(const DecodePaths& paths, const proto::DecodeParams& params, std::ostream* log,
+              DecodeSummary* summary);
+
+// The stage: Decode without the summary.
+Status Run(const DecodePaths& paths, const proto::DecodeParams& params, std::ostream* log);
 
 }  // namespace tiltcal
 

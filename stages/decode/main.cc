@@ -2,6 +2,7 @@
 //                --out_imu=imu.binpb --out_scans=scans.binpb.lz4
 // Decodes the IMU and LiDAR topics of a ROS1 bag into record streams.
 #include <cstdio>
+#include <iostream>
 
 #include <gflags/gflags.h>
 
@@ -31,13 +32,14 @@ int main(int argc, char** argv) {
     status = tiltcal::LoadParams(FLAGS_params, &params);
   }
   if (status.ok()) {
-    tiltcal::DecodeInputs inputs;
-    inputs.bag_path = FLAGS_bag;
-    inputs.rig_path = FLAGS_rig;
-    inputs.out_imu_path = FLAGS_out_imu;
-    inputs.out_scans_path = FLAGS_out_scans;
-    inputs.command_line = command_line;
-    status = tiltcal::Run(inputs, params);
+    tiltcal::DecodePaths paths;
+    paths.bag = FLAGS_bag;
+    paths.rig = FLAGS_rig;
+    paths.out_imu = FLAGS_out_imu;
+    paths.out_scans = FLAGS_out_scans;
+    paths.params = FLAGS_params;
+    paths.command_line = command_line;
+    status = tiltcal::Run(paths, params, &std::cerr);
   }
   if (!status.ok()) {
     std::fprintf(stderr, "tiltcal_decode: %s\n", status.message().c_str());

@@ -89,6 +89,30 @@ Status RequireType(const Accessor& a, bool ok, const char* expected) {
                        ros1::PointFieldTypeName(a.type) + ", expected " + expected);
 }
 
+// Outcome of the validity rule for one point.
+enum class PointCheck { kValid, kInvalid, kTooClose };
+
+// The validity rule of every point, shared by the fast and the generic loop:
+// a NaN or Inf coordinate is invalid; a point at zero range, or with
+// x² + y² + z² (in double) below min_range_m², is too close.
+inline PointCheck CheckPoint(float x, float y, float z, double min_range2) {
+  if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) return PointCheck::kInvalid;
+  const double range2 =
+      static_cast<double>(x) * x + static_cast<double>(y) * y + static_cast<double>(z) * z;
+  if (range2 == 0.0 || range2 < min_range2) return PointCheck::kTooClose;
+  return PointCheck::kValid;
+}
+
+// A per-point time in seconds relative to the stamp (Velodyne `time`) is
+// valid when finite and within 1000 s of the stamp.
+inline bool IsValidRelativeSeconds(double v) { return std::isfinite(v) && std::fabs(v) < 1e3; }
+
+// A per-point time offset must fit the int32 ns column (+-2.147 s).
+inline bool FitsInt32(int64_t offset_ns) {
+  return offset_ns >= std::numeric_limits<int32_t>::min() &&
+         offset_ns <= std::numeric_limits<int32_t>::max();
+}
+
 // ---------------------------------------------------------------- fast path --
 // One loop per common layout, types fixed at compile time: no per-point type
 // switch and no libm call. Every value is computed exactly as in the generic
@@ -157,20 +181,15 @@ bool ConvertFast(const PointCloud2View& cloud, const uint32_t offsets[6], double
       const float x = Load<float>(p + ox);
       const float y = Load<float>(p + oy);
       const float z = Load<float>(p + oz);
-      if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) {
-        ++dropped_invalid;
-        continue;
-      }
-      const double range2 = static_cast<double>(x) * x + static_cast<double>(y) * y +
-                            static_cast<double>(z) * z;
-      if (range2 == 0.0 || range2 < min_range2) {
-        ++dropped_range;
+      const PointCheck check = CheckPoint(x, y, z, min_range2);
+      if (check != PointCheck::kValid) {
+        ++(check == PointCheck::kInvalid ? dropped_invalid : dropped_range);
         continue;
       }
       int64_t offset_ns = 0;
       if constexpr (kTime == FastTime::kVelodyneFloat32) {
         const double v = Load<float>(p + ot);  // s relative to the stamp
-        if (!(std::isfinite(v) && std::fabs(v) < 1e3)) {
+        if (!IsValidRelativeSeconds(v)) {
           ++dropped_invalid;
           continue;
         }
@@ -178,10 +197,7 @@ bool ConvertFast(const PointCloud2View& cloud, const uint32_t offsets[6], double
       } else if constexpr (kTime == FastTime::kOusterUint32) {
         offset_ns = Load<uint32_t>(p + ot);  // ns relative to the stamp, exact
       }
-      if (offset_ns < std::numeric_limits<int32_t>::min() ||
-          offset_ns > std::numeric_limits<int32_t>::max()) {
-        return false;
-      }
+      if (!FitsInt32(offset_ns)) return false;
       xs[k] = x;
       ys[k] = y;
       zs[k] = z;
@@ -227,111 +243,96 @@ FastConverter PickRing(const Accessor& ring, FastTime time) {
   }
 }
 
+// The fields of a cloud that the conversion reads, and its time convention.
+struct CloudLayout {
+  Accessor x, y, z, intensity, ring;
+  Accessor time;                 // the one time field, except for SEC_NSEC
+  Accessor time_sec, time_nsec;  // POINT_TIME_SEC_NSEC
+  proto::PointTimeSource source = proto::POINT_TIME_NONE;
+};
+
 // The specialised loop for this layout, or null when the generic loop must run.
-FastConverter PickFastConverter(bool swap, const Accessor& ax, const Accessor& ay,
-                                const Accessor& az, const Accessor& intensity,
-                                const Accessor& ring, proto::PointTimeSource source,
-                                const Accessor& time) {
-  if (swap || ax.type != ros1::kFloat32 || ay.type != ros1::kFloat32 ||
-      az.type != ros1::kFloat32) {
+FastConverter PickFastConverter(bool swap, const CloudLayout& layout) {
+  if (swap || layout.x.type != ros1::kFloat32 || layout.y.type != ros1::kFloat32 ||
+      layout.z.type != ros1::kFloat32) {
     return nullptr;
   }
   FastTime fast_time;
-  if (source == proto::POINT_TIME_NONE) {
+  if (layout.source == proto::POINT_TIME_NONE) {
     fast_time = FastTime::kNone;
-  } else if (source == proto::POINT_TIME_VELODYNE_TIME && time.type == ros1::kFloat32) {
+  } else if (layout.source == proto::POINT_TIME_VELODYNE_TIME &&
+             layout.time.type == ros1::kFloat32) {
     fast_time = FastTime::kVelodyneFloat32;
-  } else if (source == proto::POINT_TIME_OUSTER_T && time.type == ros1::kUint32) {
+  } else if (layout.source == proto::POINT_TIME_OUSTER_T && layout.time.type == ros1::kUint32) {
     fast_time = FastTime::kOusterUint32;
   } else {
     return nullptr;
   }
-  if (!intensity.present) return PickRing<NoField>(ring, fast_time);
-  switch (intensity.type) {
-    case ros1::kFloat32: return PickRing<float>(ring, fast_time);
-    case ros1::kUint8: return PickRing<uint8_t>(ring, fast_time);
-    case ros1::kUint16: return PickRing<uint16_t>(ring, fast_time);
+  if (!layout.intensity.present) return PickRing<NoField>(layout.ring, fast_time);
+  switch (layout.intensity.type) {
+    case ros1::kFloat32: return PickRing<float>(layout.ring, fast_time);
+    case ros1::kUint8: return PickRing<uint8_t>(layout.ring, fast_time);
+    case ros1::kUint16: return PickRing<uint16_t>(layout.ring, fast_time);
     default: return nullptr;
   }
 }
 
-}  // namespace
-
-std::string DescribeFields(const PointCloud2View& cloud) {
-  std::string out;
-  for (const PointField& f : cloud.fields) {
-    if (!out.empty()) out += ' ';
-    out += f.name + ":" + ros1::PointFieldTypeName(f.datatype) + "@" + std::to_string(f.offset);
+// The per-point time: `time_sec` + `time_nsec`, else the first present of
+// `timestamp`, `t`, `time`, `offset_time`, each with its datatype checked.
+Status FindTimeFields(const PointCloud2View& cloud, CloudLayout* layout) {
+  TILTCAL_RETURN_IF_ERROR(FindField(cloud, {"time_sec"}, &layout->time_sec));
+  TILTCAL_RETURN_IF_ERROR(FindField(cloud, {"time_nsec"}, &layout->time_nsec));
+  const Accessor& sec = layout->time_sec;
+  const Accessor& nsec = layout->time_nsec;
+  if (sec.present && nsec.present) {
+    TILTCAL_RETURN_IF_ERROR(RequireType(sec, IsInteger(sec.type), "an integer type"));
+    TILTCAL_RETURN_IF_ERROR(RequireType(nsec, IsInteger(nsec.type), "an integer type"));
+    layout->source = proto::POINT_TIME_SEC_NSEC;
+    return Status::Ok();
   }
-  return out.empty() ? "(none)" : out;
+  // The first of these names present decides the convention.
+  Accessor& time = layout->time;
+  TILTCAL_RETURN_IF_ERROR(FindField(cloud, {"timestamp", "t", "time", "offset_time"}, &time));
+  if (!time.present) return Status::Ok();
+  const std::string name = time.name;
+  if (name == "timestamp") {
+    TILTCAL_RETURN_IF_ERROR(RequireType(time, time.type == ros1::kFloat64, "FLOAT64"));
+    layout->source = proto::POINT_TIME_ABSOLUTE_SECONDS;  // or ns, decided on the values
+  } else if (name == "t") {
+    TILTCAL_RETURN_IF_ERROR(RequireType(time, IsInteger(time.type), "an integer type (ns)"));
+    layout->source = proto::POINT_TIME_OUSTER_T;
+  } else if (name == "time") {
+    TILTCAL_RETURN_IF_ERROR(RequireType(time, IsFloat(time.type), "FLOAT32 or FLOAT64 (s)"));
+    layout->source = proto::POINT_TIME_VELODYNE_TIME;
+  } else {
+    TILTCAL_RETURN_IF_ERROR(RequireType(time, IsInteger(time.type), "an integer type (ns)"));
+    layout->source = proto::POINT_TIME_OFFSET_TIME_NS;
+  }
+  return Status::Ok();
 }
 
-Status ConvertPointCloud2ToScan(const PointCloud2View& cloud,
-                                const PointConversionOptions& options, proto::Scan* scan) {
-  scan->clear_x();
-  scan->clear_y();
-  scan->clear_z();
-  scan->clear_intensity();
-  scan->clear_ring();
-  scan->clear_time_offset_ns();
-  const int64_t stamp_ns = ros1::RosTimeToNs(cloud.header.stamp);
-  scan->set_stamp_ns(stamp_ns);
-  scan->set_frame_id(cloud.header.frame_id);
-  scan->set_num_dropped_invalid(0);
-  scan->set_num_dropped_zero_range(0);
-  scan->set_time_source(proto::POINT_TIME_NONE);
-
-  // Layout.
-  Accessor ax, ay, az, intensity, ring, time, time_sec, time_nsec;
-  TILTCAL_RETURN_IF_ERROR(FindField(cloud, {"x"}, &ax));
-  TILTCAL_RETURN_IF_ERROR(FindField(cloud, {"y"}, &ay));
-  TILTCAL_RETURN_IF_ERROR(FindField(cloud, {"z"}, &az));
-  if (!ax.present || !ay.present || !az.present) {
+Status FindLayout(const PointCloud2View& cloud, CloudLayout* layout) {
+  TILTCAL_RETURN_IF_ERROR(FindField(cloud, {"x"}, &layout->x));
+  TILTCAL_RETURN_IF_ERROR(FindField(cloud, {"y"}, &layout->y));
+  TILTCAL_RETURN_IF_ERROR(FindField(cloud, {"z"}, &layout->z));
+  if (!layout->x.present || !layout->y.present || !layout->z.present) {
     return Status::Error("PointCloud2 lacks an x, y or z field (fields: " +
                          DescribeFields(cloud) + ")");
   }
-  for (const Accessor* a : {&ax, &ay, &az}) {
+  for (const Accessor* a : {&layout->x, &layout->y, &layout->z}) {
     TILTCAL_RETURN_IF_ERROR(RequireType(*a, IsFloat(a->type), "FLOAT32 or FLOAT64"));
   }
-  TILTCAL_RETURN_IF_ERROR(FindField(cloud, {"intensity", "i", "reflectivity"}, &intensity));
-  TILTCAL_RETURN_IF_ERROR(FindField(cloud, {"ring", "line", "laser_id"}, &ring));
+  TILTCAL_RETURN_IF_ERROR(
+      FindField(cloud, {"intensity", "i", "reflectivity"}, &layout->intensity));
+  TILTCAL_RETURN_IF_ERROR(FindField(cloud, {"ring", "line", "laser_id"}, &layout->ring));
+  return FindTimeFields(cloud, layout);
+}
 
-  proto::PointTimeSource source = proto::POINT_TIME_NONE;
-  TILTCAL_RETURN_IF_ERROR(FindField(cloud, {"time_sec"}, &time_sec));
-  TILTCAL_RETURN_IF_ERROR(FindField(cloud, {"time_nsec"}, &time_nsec));
-  if (time_sec.present && time_nsec.present) {
-    TILTCAL_RETURN_IF_ERROR(RequireType(time_sec, IsInteger(time_sec.type), "an integer type"));
-    TILTCAL_RETURN_IF_ERROR(RequireType(time_nsec, IsInteger(time_nsec.type), "an integer type"));
-    source = proto::POINT_TIME_SEC_NSEC;
-  } else {
-    // The first of these names present decides the convention.
-    TILTCAL_RETURN_IF_ERROR(FindField(cloud, {"timestamp", "t", "time", "offset_time"}, &time));
-    if (time.present) {
-      const std::string name = time.name;
-      if (name == "timestamp") {
-        TILTCAL_RETURN_IF_ERROR(RequireType(time, time.type == ros1::kFloat64, "FLOAT64"));
-        source = proto::POINT_TIME_ABSOLUTE_SECONDS;  // or ns, decided on the values below
-      } else if (name == "t") {
-        TILTCAL_RETURN_IF_ERROR(RequireType(time, IsInteger(time.type), "an integer type (ns)"));
-        source = proto::POINT_TIME_OUSTER_T;
-      } else if (name == "time") {
-        TILTCAL_RETURN_IF_ERROR(RequireType(time, IsFloat(time.type), "FLOAT32 or FLOAT64 (s)"));
-        source = proto::POINT_TIME_VELODYNE_TIME;
-      } else {
-        TILTCAL_RETURN_IF_ERROR(RequireType(time, IsInteger(time.type), "an integer type (ns)"));
-        source = proto::POINT_TIME_OFFSET_TIME_NS;
-      }
-    }
-  }
-
-  // Geometry of the data block.
+// Checks that the data block holds height rows of width points (rows
+// row_step apart, points point_step apart), for a cloud with points.
+Status CheckDataSize(const PointCloud2View& cloud) {
   const uint64_t width = cloud.width;
   const uint64_t height = cloud.height;
-  const uint64_t num_points = width * height;
-  if (num_points == 0) {
-    scan->set_time_source(source);
-    return Status::Ok();
-  }
   if (cloud.point_step == 0) return Status::Error("PointCloud2 has point_step 0");
   if (uint64_t{cloud.row_step} < width * cloud.point_step && height > 1) {
     return Status::Error("PointCloud2 row_step " + std::to_string(cloud.row_step) +
@@ -351,150 +352,228 @@ Status ConvertPointCloud2ToScan(const PointCloud2View& cloud,
                          (needed > UINT64_MAX ? std::string("more than 2^64")
                                               : std::to_string(static_cast<uint64_t>(needed))));
   }
-  if (num_points > static_cast<uint64_t>(std::numeric_limits<int>::max())) {
-    return Status::Error("PointCloud2 has too many points: " + std::to_string(num_points));
+  if (width * height > static_cast<uint64_t>(std::numeric_limits<int>::max())) {
+    return Status::Error("PointCloud2 has too many points: " + std::to_string(width * height));
+  }
+  return Status::Ok();
+}
+
+// Reads the per-point time offset from the stamp, ns, of each point. For
+// `timestamp` fields the first valid value decides between absolute seconds
+// and absolute ns as a double (values above 1e12: seconds since 1970 stay
+// below that until the year 33658), which updates source().
+class PointTimeReader {
+ public:
+  PointTimeReader(const CloudLayout& layout, ros1::RosTime stamp, bool swap)
+      : layout_(layout),
+        source_(layout.source),
+        swap_(swap),
+        stamp_ns_(ros1::RosTimeToNs(stamp)),
+        stamp_sec_(static_cast<double>(stamp.sec)),
+        stamp_nsec_(static_cast<double>(stamp.nsec)) {}
+
+  // False when the point's time is not a valid value (the point is invalid).
+  bool OffsetNs(const uint8_t* p, int64_t* offset_ns) {
+    *offset_ns = 0;
+    switch (source_) {
+      case proto::POINT_TIME_VELODYNE_TIME: {
+        const double v = layout_.time.Get(p, swap_);  // s relative to the stamp
+        if (!IsValidRelativeSeconds(v)) return false;
+        *offset_ns = std::llround(v * 1e9);
+        return true;
+      }
+      case proto::POINT_TIME_OUSTER_T:
+      case proto::POINT_TIME_OFFSET_TIME_NS:
+        *offset_ns = static_cast<int64_t>(layout_.time.Get(p, swap_));  // ns relative, exact
+        return true;
+      case proto::POINT_TIME_ABSOLUTE_SECONDS:
+      case proto::POINT_TIME_ABSOLUTE_NS_DOUBLE:
+        return AbsoluteOffsetNs(layout_.time.Get(p, swap_), offset_ns);
+      case proto::POINT_TIME_SEC_NSEC: {
+        const int64_t sec = static_cast<int64_t>(layout_.time_sec.Get(p, swap_));
+        const int64_t nsec = static_cast<int64_t>(layout_.time_nsec.Get(p, swap_));
+        *offset_ns = sec * 1000000000 + nsec - stamp_ns_;
+        return true;
+      }
+      default:  // POINT_TIME_NONE, POINT_TIME_SIMULATED: all offsets 0
+        return true;
+    }
   }
 
-  // Columns, written in place (no per-point allocation), truncated at the end.
-  const int n = static_cast<int>(num_points);
-  auto reserve = [n](auto* column) {
-    column->Reserve(n);
-    return column->AddNAlreadyReserved(n);
-  };
-  float* xs = reserve(scan->mutable_x());
-  float* ys = reserve(scan->mutable_y());
-  float* zs = reserve(scan->mutable_z());
-  float* is = reserve(scan->mutable_intensity());
-  uint32_t* rs = ring.present ? reserve(scan->mutable_ring()) : nullptr;
-  int32_t* ts = reserve(scan->mutable_time_offset_ns());
+  proto::PointTimeSource source() const { return source_; }
+  // The field named in errors about the time.
+  std::string field_name() const {
+    return source_ == proto::POINT_TIME_SEC_NSEC ? "time_sec" : layout_.time.name;
+  }
 
+ private:
+  bool AbsoluteOffsetNs(double v, int64_t* offset_ns) {
+    if (!(std::isfinite(v) && v >= 0.0 && v < 9e18)) return false;
+    if (!decided_ns_double_) {
+      if (v > 1e12) source_ = proto::POINT_TIME_ABSOLUTE_NS_DOUBLE;
+      decided_ns_double_ = true;
+    }
+    if (source_ == proto::POINT_TIME_ABSOLUTE_NS_DOUBLE) {
+      *offset_ns = std::llround(v) - stamp_ns_;
+      return true;
+    }
+    // v - sec is exact (both within a factor of 2 for times near the stamp),
+    // so only the final scaling rounds.
+    const double rel = (v - stamp_sec_) * 1e9 - stamp_nsec_;
+    if (!(std::fabs(rel) < 9e18)) return false;
+    *offset_ns = std::llround(rel);
+    return true;
+  }
+
+  const CloudLayout& layout_;
+  proto::PointTimeSource source_;
+  const bool swap_;
+  const int64_t stamp_ns_;
+  const double stamp_sec_;
+  const double stamp_nsec_;
+  bool decided_ns_double_ = false;
+};
+
+// The loop for any layout: every value through its type's accessor. Fills
+// the columns with the valid points; *source is the time convention found.
+Status ConvertGeneric(const PointCloud2View& cloud, const CloudLayout& layout,
+                      double min_range2, const FastColumns& out, FastResult* result,
+                      proto::PointTimeSource* source) {
   const bool swap = cloud.is_bigendian;
-  const bool fast_xyz = !swap && ax.type == ros1::kFloat32 && ay.type == ros1::kFloat32 &&
-                        az.type == ros1::kFloat32;
-  const double min_range2 = options.min_range_m * options.min_range_m;
-  const double stamp_sec = static_cast<double>(cloud.header.stamp.sec);
-  const double stamp_nsec = static_cast<double>(cloud.header.stamp.nsec);
-  bool decided_ns_double = false;
-  uint32_t dropped_invalid = 0;
-  uint32_t dropped_range = 0;
+  const bool fast_xyz = !swap && layout.x.type == ros1::kFloat32 &&
+                        layout.y.type == ros1::kFloat32 && layout.z.type == ros1::kFloat32;
+  PointTimeReader time(layout, cloud.header.stamp, swap);
+  const uint64_t width = cloud.width;
   int k = 0;
-  const FastConverter fast =
-      options.allow_fast_path
-          ? PickFastConverter(swap, ax, ay, az, intensity, ring, source, time)
-          : nullptr;
-  FastResult fast_result;
-  const uint32_t offsets[6] = {ax.offset,   ay.offset,   az.offset,
-                               intensity.offset, ring.offset, time.offset};
-  const bool fast_done =
-      fast != nullptr && fast(cloud, offsets, min_range2, FastColumns{xs, ys, zs, is, rs, ts},
-                              &fast_result);
-  if (fast_done) {
-    k = fast_result.count;
-    dropped_invalid = fast_result.dropped_invalid;
-    dropped_range = fast_result.dropped_range;
-  }
-  for (uint64_t r = 0; r < (fast_done ? 0 : height); ++r) {
+  for (uint64_t r = 0; r < cloud.height; ++r) {
     const uint8_t* row = cloud.data + r * cloud.row_step;
     for (uint64_t c = 0; c < width; ++c) {
       const uint8_t* p = row + c * cloud.point_step;
       float x, y, z;
       if (fast_xyz) {
-        std::memcpy(&x, p + ax.offset, 4);
-        std::memcpy(&y, p + ay.offset, 4);
-        std::memcpy(&z, p + az.offset, 4);
+        std::memcpy(&x, p + layout.x.offset, 4);
+        std::memcpy(&y, p + layout.y.offset, 4);
+        std::memcpy(&z, p + layout.z.offset, 4);
       } else {
-        x = static_cast<float>(ax.Get(p, swap));
-        y = static_cast<float>(ay.Get(p, swap));
-        z = static_cast<float>(az.Get(p, swap));
+        x = static_cast<float>(layout.x.Get(p, swap));
+        y = static_cast<float>(layout.y.Get(p, swap));
+        z = static_cast<float>(layout.z.Get(p, swap));
       }
-      if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) {
-        ++dropped_invalid;
+      const PointCheck check = CheckPoint(x, y, z, min_range2);
+      if (check != PointCheck::kValid) {
+        ++(check == PointCheck::kInvalid ? result->dropped_invalid : result->dropped_range);
         continue;
       }
-      const double range2 = static_cast<double>(x) * x + static_cast<double>(y) * y +
-                            static_cast<double>(z) * z;
-      if (range2 == 0.0 || range2 < min_range2) {
-        ++dropped_range;
-        continue;
-      }
-      // Per-point time offset from the stamp, ns.
       int64_t offset_ns = 0;
-      bool time_ok = true;
-      switch (source) {
-        case proto::POINT_TIME_NONE:
-        case proto::POINT_TIME_SIMULATED:
-          break;
-        case proto::POINT_TIME_VELODYNE_TIME: {
-          const double v = time.Get(p, swap);  // s relative to the stamp
-          time_ok = std::isfinite(v) && std::fabs(v) < 1e3;
-          if (time_ok) offset_ns = std::llround(v * 1e9);
-          break;
-        }
-        case proto::POINT_TIME_OUSTER_T:
-        case proto::POINT_TIME_OFFSET_TIME_NS:
-          offset_ns = static_cast<int64_t>(time.Get(p, swap));  // ns relative, exact
-          break;
-        case proto::POINT_TIME_ABSOLUTE_SECONDS:
-        case proto::POINT_TIME_ABSOLUTE_NS_DOUBLE: {
-          const double v = time.Get(p, swap);
-          time_ok = std::isfinite(v) && v >= 0.0 && v < 9e18;
-          if (!time_ok) break;
-          if (!decided_ns_double) {
-            // Absolute seconds since 1970 stay below 1e12 until year 33658.
-            if (v > 1e12) source = proto::POINT_TIME_ABSOLUTE_NS_DOUBLE;
-            decided_ns_double = true;
-          }
-          if (source == proto::POINT_TIME_ABSOLUTE_NS_DOUBLE) {
-            offset_ns = std::llround(v) - stamp_ns;
-          } else {
-            // v - sec is exact (both within a factor of 2 for times near the
-            // stamp), so only the final scaling rounds.
-            const double rel = (v - stamp_sec) * 1e9 - stamp_nsec;
-            time_ok = std::fabs(rel) < 9e18;
-            if (time_ok) offset_ns = std::llround(rel);
-          }
-          break;
-        }
-        case proto::POINT_TIME_SEC_NSEC: {
-          const int64_t sec = static_cast<int64_t>(time_sec.Get(p, swap));
-          const int64_t nsec = static_cast<int64_t>(time_nsec.Get(p, swap));
-          offset_ns = sec * 1000000000 + nsec - stamp_ns;
-          break;
-        }
-        default:
-          break;
-      }
-      if (!time_ok) {
-        ++dropped_invalid;
+      if (!time.OffsetNs(p, &offset_ns)) {
+        ++result->dropped_invalid;
         continue;
       }
-      if (offset_ns < std::numeric_limits<int32_t>::min() ||
-          offset_ns > std::numeric_limits<int32_t>::max()) {
+      if (!FitsInt32(offset_ns)) {
         return Status::Error("point " + std::to_string(r * width + c) + ": its time (field '" +
-                             (source == proto::POINT_TIME_SEC_NSEC ? std::string("time_sec") :
-                                                                     std::string(time.name)) +
-                             "') is " + std::to_string(static_cast<double>(offset_ns) * 1e-9) +
+                             time.field_name() + "') is " +
+                             std::to_string(static_cast<double>(offset_ns) * 1e-9) +
                              " s from header.stamp; offsets must stay within +-2.147 s "
                              "(point times in another clock than the stamp?)");
       }
-      xs[k] = x;
-      ys[k] = y;
-      zs[k] = z;
-      is[k] = intensity.present ? static_cast<float>(intensity.Get(p, swap)) : 0.0f;
-      if (rs != nullptr) rs[k] = static_cast<uint32_t>(ring.Get(p, swap));
-      ts[k] = static_cast<int32_t>(offset_ns);
+      out.x[k] = x;
+      out.y[k] = y;
+      out.z[k] = z;
+      out.intensity[k] =
+          layout.intensity.present ? static_cast<float>(layout.intensity.Get(p, swap)) : 0.0f;
+      if (out.ring != nullptr) out.ring[k] = static_cast<uint32_t>(layout.ring.Get(p, swap));
+      out.time_offset_ns[k] = static_cast<int32_t>(offset_ns);
       ++k;
     }
   }
+  result->count = k;
+  *source = time.source();
+  return Status::Ok();
+}
+
+// Clears `scan` and sets the fields known before the points are read.
+void ResetScan(const PointCloud2View& cloud, proto::Scan* scan) {
+  scan->clear_x();
+  scan->clear_y();
+  scan->clear_z();
+  scan->clear_intensity();
+  scan->clear_ring();
+  scan->clear_time_offset_ns();
+  scan->set_stamp_ns(ros1::RosTimeToNs(cloud.header.stamp));
+  scan->set_frame_id(cloud.header.frame_id);
+  scan->set_num_dropped_invalid(0);
+  scan->set_num_dropped_zero_range(0);
+  scan->set_time_source(proto::POINT_TIME_NONE);
+}
+
+// Columns of n values written in place (no per-point allocation), truncated
+// to the points kept by FinishColumns.
+FastColumns ReserveColumns(int n, bool with_ring, proto::Scan* scan) {
+  auto reserve = [n](auto* column) {
+    column->Reserve(n);
+    return column->AddNAlreadyReserved(n);
+  };
+  FastColumns columns;
+  columns.x = reserve(scan->mutable_x());
+  columns.y = reserve(scan->mutable_y());
+  columns.z = reserve(scan->mutable_z());
+  columns.intensity = reserve(scan->mutable_intensity());
+  columns.ring = with_ring ? reserve(scan->mutable_ring()) : nullptr;
+  columns.time_offset_ns = reserve(scan->mutable_time_offset_ns());
+  return columns;
+}
+
+void FinishColumns(const FastResult& result, bool with_ring, proto::Scan* scan) {
+  const int k = result.count;
   scan->mutable_x()->Truncate(k);
   scan->mutable_y()->Truncate(k);
   scan->mutable_z()->Truncate(k);
   scan->mutable_intensity()->Truncate(k);
-  if (rs != nullptr) scan->mutable_ring()->Truncate(k);
+  if (with_ring) scan->mutable_ring()->Truncate(k);
   scan->mutable_time_offset_ns()->Truncate(k);
+  scan->set_num_dropped_invalid(result.dropped_invalid);
+  scan->set_num_dropped_zero_range(result.dropped_range);
+}
+
+}  // namespace
+
+std::string DescribeFields(const PointCloud2View& cloud) {
+  std::string out;
+  for (const PointField& f : cloud.fields) {
+    if (!out.empty()) out += ' ';
+    out += f.name + ":" + ros1::PointFieldTypeName(f.datatype) + "@" + std::to_string(f.offset);
+  }
+  return out.empty() ? "(none)" : out;
+}
+
+Status ConvertPointCloud2ToScan(const PointCloud2View& cloud,
+                                const PointConversionOptions& options, proto::Scan* scan) {
+  ResetScan(cloud, scan);
+  CloudLayout layout;
+  TILTCAL_RETURN_IF_ERROR(FindLayout(cloud, &layout));
+  const uint64_t num_points = uint64_t{cloud.width} * cloud.height;
+  if (num_points == 0) {
+    scan->set_time_source(layout.source);
+    return Status::Ok();
+  }
+  TILTCAL_RETURN_IF_ERROR(CheckDataSize(cloud));
+
+  const bool with_ring = layout.ring.present;
+  const FastColumns columns = ReserveColumns(static_cast<int>(num_points), with_ring, scan);
+  const double min_range2 = options.min_range_m * options.min_range_m;
+  const FastConverter fast =
+      options.allow_fast_path ? PickFastConverter(cloud.is_bigendian, layout) : nullptr;
+  const uint32_t offsets[6] = {layout.x.offset,         layout.y.offset,    layout.z.offset,
+                               layout.intensity.offset, layout.ring.offset, layout.time.offset};
+  FastResult result;
+  proto::PointTimeSource source = layout.source;
+  if (fast == nullptr || !fast(cloud, offsets, min_range2, columns, &result)) {
+    result = FastResult();
+    TILTCAL_RETURN_IF_ERROR(
+        ConvertGeneric(cloud, layout, min_range2, columns, &result, &source));
+  }
+  FinishColumns(result, with_ring, scan);
   scan->set_time_source(source);
-  scan->set_num_dropped_invalid(dropped_invalid);
-  scan->set_num_dropped_zero_range(dropped_range);
   return Status::Ok();
 }
 

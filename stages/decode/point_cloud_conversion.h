@@ -23,8 +23,8 @@
 
 #include <string>
 
+#include "bag/ros1/messages.h"
 #include "common/status.h"
-#include "stages/decode/ros1_messages.h"
 #include "tiltcal/proto/scan.pb.h"
 
 namespace tiltcal {

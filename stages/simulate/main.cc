@@ -33,32 +33,18 @@ int main(int argc, char** argv) {
   }
   tiltcal::proto::SimulateParams params;
   tiltcal::Status status = tiltcal::LoadParams(FLAGS_params, &params);
-  tiltcal::simulate::SimulateSummary summary;
   if (status.ok()) {
-    tiltcal::simulate::SimulateOutputs outputs;
-    outputs.bag_path = FLAGS_out_bag;
-    outputs.truth_path = FLAGS_out_truth;
-    outputs.rig_path = FLAGS_out_rig;
-    outputs.command_line = command_line;
-    if (isatty(STDERR_FILENO) && !FLAGS_quiet) {
-      outputs.progress = [](int done, int total) {
-        std::fprintf(stderr, "\rtiltcal_simulate: scan %d / %d", done, total);
-        if (done == total) std::fprintf(stderr, "\n");
-      };
-    }
-    status = tiltcal::simulate::Run(params, outputs, &summary);
+    tiltcal::simulate::SimulatePaths paths;
+    paths.params = FLAGS_params;
+    paths.out_bag = FLAGS_out_bag;
+    paths.out_truth = FLAGS_out_truth;
+    paths.out_rig = FLAGS_out_rig;
+    paths.command_line = command_line;
+    status = tiltcal::simulate::Run(paths, params, FLAGS_quiet ? nullptr : &std::cerr);
   }
   if (!status.ok()) {
     std::cerr << "tiltcal_simulate: " << status.message() << "\n";
     return 1;
-  }
-  if (!FLAGS_quiet) {
-    std::fprintf(stderr,
-                 "tiltcal_simulate: %d IMU samples, %d scans, %llu points, %.1f MB bag; "
-                 "ray casting %.2f s, total %.2f s\n",
-                 summary.num_imu_samples, summary.num_scans,
-                 static_cast<unsigned long long>(summary.num_points), summary.bag_bytes / 1e6,
-                 summary.raycast_seconds, summary.total_seconds);
   }
   return 0;
 }

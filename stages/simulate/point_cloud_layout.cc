@@ -3,11 +3,16 @@
 #include <cstring>
 #include <vector>
 
-#include "stages/simulate/ros1_messages.h"
+#include "bag/ros1/message_encoding.h"
 
 namespace tiltcal::simulate {
 
 namespace {
+
+using ros1::kFloat32;
+using ros1::kUint16;
+using ros1::kUint32;
+using ros1::kUint8;
 
 template <typename T>
 inline void Put(char* base, uint32_t offset, T value) {
@@ -18,7 +23,7 @@ inline void Put(char* base, uint32_t offset, T value) {
 
 bool SerializeScan(const SimulatedScan& scan, bool ouster, bool append_label, uint32_t seq,
                    int64_t stamp_ns, const std::string& frame_id, std::string* message) {
-  std::vector<PointField> fields;
+  std::vector<ros1::PointField> fields;
   uint32_t step = 0;
   if (!ouster) {
     fields = {{"x", 0, kFloat32, 1},        {"y", 4, kFloat32, 1},
@@ -65,7 +70,7 @@ bool SerializeScan(const SimulatedScan& scan, bool ouster, bool append_label, ui
   const uint32_t height = ouster ? static_cast<uint32_t>(scan.rows) : 1u;
   const uint32_t width = ouster ? static_cast<uint32_t>(scan.columns) : static_cast<uint32_t>(n);
   const bool dense = !ouster || scan.num_valid == n;
-  return SerializePointCloud2(seq, stamp_ns, frame_id, height, width, fields, step, data, dense,
+  return ros1::SerializePointCloud2(seq, stamp_ns, frame_id, height, width, fields, step, data, dense,
                               message);
 }
 

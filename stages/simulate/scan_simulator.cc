@@ -47,48 +47,53 @@ double SweepSpanS(const ScanConfig& config) {
          *std::max_element(m.firing_offset_s.begin(), m.firing_offset_s.end());
 }
 
-SimulatedScan SimulateSweep(const ScanConfig& config, const PlanarTrajectory& trajectory,
-                            const World& world, uint64_t seed, int k) {
-  const LidarModel& m = config.model;
-  Rng rng(seed, kSweepStreamBase + static_cast<uint64_t>(k));
-  SimulatedScan scan;
-  const int64_t start_ns = SweepStartNs(config, k);
-  const double start_s = start_ns * 1e-9;
-  const int lasers = m.num_lasers();
+namespace {
 
-  // Unit direction of laser i at horizontal angle alpha, frame l.
-  std::vector<double> cos_el(lasers), sin_el(lasers);
-  for (int i = 0; i < lasers; ++i) {
-    cos_el[i] = std::cos(m.elevation_rad[i]);
-    sin_el[i] = std::sin(m.elevation_rad[i]);
+// Casts the lasers of one sweep into the world, with the range noise of the
+// sweep's own random stream.
+class LaserCaster {
+ public:
+  LaserCaster(const ScanConfig& config, const PlanarTrajectory& trajectory, const World& world,
+              uint64_t seed, int k)
+      : config_(config),
+        trajectory_(trajectory),
+        world_(world),
+        rng_(seed, kSweepStreamBase + static_cast<uint64_t>(k)),
+        cos_el_(config.model.num_lasers()),
+        sin_el_(config.model.num_lasers()) {
+    for (int i = 0; i < config.model.num_lasers(); ++i) {
+      cos_el_[i] = std::cos(config.model.elevation_rad[i]);
+      sin_el_[i] = std::sin(config.model.elevation_rad[i]);
+    }
   }
 
-  const Eigen::Matrix3d& c_bl = config.imu_from_lidar_rotation;
-  const Eigen::Vector3d& r_b = config.imu_from_lidar_translation;
-  // Pose of the LiDAR at true time t (s since the first IMU sample).
-  auto lidar_pose = [&](double t, Eigen::Matrix3d* c_wl, Eigen::Vector3d* r_wl) {
+  // Pose C_wl, r_wl of the LiDAR at true time t (s since the first IMU sample).
+  void LidarPose(double t, Eigen::Matrix3d* c_wl, Eigen::Vector3d* r_wl) const {
     Eigen::Matrix3d c_wb;
     Eigen::Vector3d r_wb;
-    trajectory.Pose(t, &c_wb, &r_wb);
-    *c_wl = c_wb * c_bl;
-    *r_wl = r_wb + c_wb * r_b;
-  };
-  // Casts laser i at horizontal angle alpha from the pose; fills *p.
-  auto cast = [&](const Eigen::Matrix3d& c_wl, const Eigen::Vector3d& r_wl, int i, double alpha,
-                  ScanPoint* p) {
-    const Eigen::Vector3d d_l(cos_el[i] * std::cos(alpha), cos_el[i] * std::sin(alpha),
-                              sin_el[i]);
+    trajectory_.Pose(t, &c_wb, &r_wb);
+    *c_wl = c_wb * config_.imu_from_lidar_rotation;
+    *r_wl = r_wb + c_wb * config_.imu_from_lidar_translation;
+  }
+
+  // Casts laser i at horizontal angle alpha from the pose; fills *p (valid
+  // when a surface is hit within the range limits after the noise).
+  void Cast(const Eigen::Matrix3d& c_wl, const Eigen::Vector3d& r_wl, int i, double alpha,
+            ScanPoint* p) {
+    // Unit direction of laser i at horizontal angle alpha, frame l.
+    const Eigen::Vector3d d_l(cos_el_[i] * std::cos(alpha), cos_el_[i] * std::sin(alpha),
+                              sin_el_[i]);
     const Eigen::Vector3d d_w = c_wl * d_l;
     RayHit hit;
-    p->ring = static_cast<uint16_t>(m.ring[i]);
+    p->ring = static_cast<uint16_t>(config_.model.ring[i]);
     // Cast a little beyond the limits: noise may bring the range back inside.
-    const double margin = 6.0 * config.range_noise_m;
-    if (!world.Cast(r_wl, d_w, std::max(0.0, config.min_range_m - margin),
-                    config.max_range_m + margin, &hit)) {
+    const double margin = 6.0 * config_.range_noise_m;
+    if (!world_.Cast(r_wl, d_w, std::max(0.0, config_.min_range_m - margin),
+                     config_.max_range_m + margin, &hit)) {
       return;
     }
-    const double range = hit.range + config.range_noise_m * rng.Gaussian();
-    if (range < config.min_range_m || range > config.max_range_m) return;
+    const double range = hit.range + config_.range_noise_m * rng_.Gaussian();
+    if (range < config_.min_range_m || range > config_.max_range_m) return;
     const Eigen::Vector3d q = range * d_l;
     p->x = static_cast<float>(q.x());
     p->y = static_cast<float>(q.y());
@@ -97,63 +102,96 @@ SimulatedScan SimulateSweep(const ScanConfig& config, const PlanarTrajectory& tr
     p->range_mm = static_cast<uint32_t>(std::llround(range * 1000.0));
     p->label = static_cast<uint8_t>(hit.surface);
     p->valid = true;
-  };
+  }
 
-  if (m.kind == LidarModel::Kind::kVelodyne) {
-    const int sequences = VelodyneSequences(config);
-    const double span = SweepSpanS(config);
-    const int64_t stamp_ns =
-        config.velodyne_stamp_at_start ? start_ns : start_ns + std::llround(span * 1e9);
-    scan.stamp_true_ns = stamp_ns;
-    const double start_minus_stamp_s = (start_ns - stamp_ns) * 1e-9;
-    scan.points.reserve(static_cast<size_t>(sequences) * lasers);
-    Eigen::Matrix3d c_wl;
-    Eigen::Vector3d r_wl;
-    double pose_offset = std::numeric_limits<double>::quiet_NaN();
-    for (int j = 0; j < sequences; ++j) {
-      for (int i = 0; i < lasers; ++i) {
-        const double offset = j * m.sequence_period_s + m.firing_offset_s[i];
-        if (offset != pose_offset) {  // lasers sharing a slot share the pose
-          lidar_pose(start_s + offset, &c_wl, &r_wl);
-          pose_offset = offset;
-        }
-        const double alpha = -kTwoPi * config.scan_rate_hz * offset;
-        ScanPoint p;
-        cast(c_wl, r_wl, i, alpha, &p);
-        if (!p.valid) continue;
-        p.time_s = static_cast<float>(start_minus_stamp_s + offset);
-        ++scan.num_valid;
-        if (p.label == static_cast<uint8_t>(Surface::kGround)) ++scan.num_ground;
-        scan.points.push_back(p);
+ private:
+  const ScanConfig& config_;
+  const PlanarTrajectory& trajectory_;
+  const World& world_;
+  Rng rng_;
+  std::vector<double> cos_el_, sin_el_;
+};
+
+// Velodyne: firing sequences, the valid returns in firing order; lasers
+// sharing a firing slot share the pose.
+void SimulateVelodyneSweep(const ScanConfig& config, int64_t start_ns, LaserCaster* caster,
+                           SimulatedScan* scan) {
+  const LidarModel& m = config.model;
+  const int lasers = m.num_lasers();
+  const int sequences = VelodyneSequences(config);
+  const double span = SweepSpanS(config);
+  const double start_s = start_ns * 1e-9;
+  const int64_t stamp_ns =
+      config.velodyne_stamp_at_start ? start_ns : start_ns + std::llround(span * 1e9);
+  scan->stamp_true_ns = stamp_ns;
+  const double start_minus_stamp_s = (start_ns - stamp_ns) * 1e-9;
+  scan->points.reserve(static_cast<size_t>(sequences) * lasers);
+  Eigen::Matrix3d c_wl;
+  Eigen::Vector3d r_wl;
+  double pose_offset = std::numeric_limits<double>::quiet_NaN();
+  for (int j = 0; j < sequences; ++j) {
+    for (int i = 0; i < lasers; ++i) {
+      const double offset = j * m.sequence_period_s + m.firing_offset_s[i];
+      if (offset != pose_offset) {
+        caster->LidarPose(start_s + offset, &c_wl, &r_wl);
+        pose_offset = offset;
       }
+      const double alpha = -kTwoPi * config.scan_rate_hz * offset;
+      ScanPoint p;
+      caster->Cast(c_wl, r_wl, i, alpha, &p);
+      if (!p.valid) continue;
+      p.time_s = static_cast<float>(start_minus_stamp_s + offset);
+      ++scan->num_valid;
+      if (p.label == static_cast<uint8_t>(Surface::kGround)) ++scan->num_ground;
+      scan->points.push_back(p);
     }
-    scan.rows = 1;
-    scan.columns = static_cast<int>(scan.points.size());
+  }
+  scan->rows = 1;
+  scan->columns = static_cast<int>(scan->points.size());
+}
+
+// Ouster: rows = beams x columns, all lasers of a column at once, invalid
+// pixels kept with NaN coordinates.
+void SimulateOusterSweep(const ScanConfig& config, int64_t start_ns, LaserCaster* caster,
+                         SimulatedScan* scan) {
+  const int lasers = config.model.num_lasers();
+  const int columns = config.model.columns;
+  scan->stamp_true_ns = start_ns;
+  scan->rows = lasers;
+  scan->columns = columns;
+  scan->points.resize(static_cast<size_t>(lasers) * columns);
+  const double column_period_ns = 1e9 / (config.scan_rate_hz * columns);
+  Eigen::Matrix3d c_wl;
+  Eigen::Vector3d r_wl;
+  for (int c = 0; c < columns; ++c) {
+    const int64_t t_ns = std::llround(c * column_period_ns);
+    caster->LidarPose((start_ns + t_ns) * 1e-9, &c_wl, &r_wl);
+    const double alpha = -kTwoPi * c / columns;
+    for (int i = 0; i < lasers; ++i) {
+      ScanPoint& p = scan->points[static_cast<size_t>(i) * columns + c];
+      caster->Cast(c_wl, r_wl, i, alpha, &p);
+      p.time_ns = static_cast<uint32_t>(t_ns);
+      if (!p.valid) {
+        p.x = p.y = p.z = std::numeric_limits<float>::quiet_NaN();
+        continue;
+      }
+      ++scan->num_valid;
+      if (p.label == static_cast<uint8_t>(Surface::kGround)) ++scan->num_ground;
+    }
+  }
+}
+
+}  // namespace
+
+SimulatedScan SimulateSweep(const ScanConfig& config, const PlanarTrajectory& trajectory,
+                            const World& world, uint64_t seed, int k) {
+  LaserCaster caster(config, trajectory, world, seed, k);
+  SimulatedScan scan;
+  const int64_t start_ns = SweepStartNs(config, k);
+  if (config.model.kind == LidarModel::Kind::kVelodyne) {
+    SimulateVelodyneSweep(config, start_ns, &caster, &scan);
   } else {
-    const int columns = m.columns;
-    scan.stamp_true_ns = start_ns;
-    scan.rows = lasers;
-    scan.columns = columns;
-    scan.points.resize(static_cast<size_t>(lasers) * columns);
-    const double column_period_ns = 1e9 / (config.scan_rate_hz * columns);
-    Eigen::Matrix3d c_wl;
-    Eigen::Vector3d r_wl;
-    for (int c = 0; c < columns; ++c) {
-      const int64_t t_ns = std::llround(c * column_period_ns);
-      lidar_pose((start_ns + t_ns) * 1e-9, &c_wl, &r_wl);
-      const double alpha = -kTwoPi * c / columns;
-      for (int i = 0; i < lasers; ++i) {
-        ScanPoint& p = scan.points[static_cast<size_t>(i) * columns + c];
-        cast(c_wl, r_wl, i, alpha, &p);
-        p.time_ns = static_cast<uint32_t>(t_ns);
-        if (!p.valid) {
-          p.x = p.y = p.z = std::numeric_limits<float>::quiet_NaN();
-          continue;
-        }
-        ++scan.num_valid;
-        if (p.label == static_cast<uint8_t>(Surface::kGround)) ++scan.num_ground;
-      }
-    }
+    SimulateOusterSweep(config, start_ns, &caster, &scan);
   }
   return scan;
 }

@@ -1,20 +1,25 @@
 #include "stages/simulate/simulate.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <iostream>
 #include <thread>
 #include <vector>
 
 #include <Eigen/Geometry>
 
+#include "bag/ros1/bag_writer.h"
+#include "bag/ros1/message_encoding.h"
+#include "common/geometry/euler_angles.h"
+#include "common/io/eigen_proto.h"
 #include "common/io/provenance.h"
 #include "common/io/text_proto.h"
-#include "common/geometry/euler_angles.h"
 #include "stages/simulate/point_cloud_layout.h"
 #include "stages/simulate/random.h"
-#include "stages/simulate/ros1_bag_writer.h"
-#include "stages/simulate/ros1_messages.h"
 #include "tiltcal/proto/rig.pb.h"
 
 namespace tiltcal::simulate {
@@ -29,24 +34,12 @@ constexpr uint64_t kWorldStream = 1;
 // Largest stamp a ROS time can hold.
 constexpr int64_t kMaxRosTimeNs = 4294967295LL * 1000000000LL;
 
-Eigen::Vector3d ToEigen(const proto::Vector3& v) { return Eigen::Vector3d(v.x(), v.y(), v.z()); }
-
-void SetVector(const Eigen::Vector3d& v, proto::Vector3* out) {
-  out->set_x(v.x());
-  out->set_y(v.y());
-  out->set_z(v.z());
-}
-
-void SetRigid(const Eigen::Matrix3d& rotation, const Eigen::Vector3d& translation,
-              proto::Rigid3* out) {
+// The unit quaternion of `rotation` with w >= 0, the form written to disk.
+proto::Rigid3 RigidToProto(const Eigen::Matrix3d& rotation, const Eigen::Vector3d& translation) {
   Eigen::Quaterniond q(rotation);
   q.normalize();
   if (q.w() < 0) q.coeffs() = -q.coeffs();
-  out->mutable_rotation()->set_w(q.w());
-  out->mutable_rotation()->set_x(q.x());
-  out->mutable_rotation()->set_y(q.y());
-  out->mutable_rotation()->set_z(q.z());
-  SetVector(translation, out->mutable_translation());
+  return ToProto(Rigid3d{q, translation});
 }
 
 double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
@@ -96,22 +89,20 @@ void AddRandomObstacles(const proto::SimWorldParams& p, const PlanarTrajectory& 
   }
 }
 
-Ros1BagWriter::Compression ToCompression(proto::SimBagParams::Compression c) {
+ros1::ChunkCompression ToCompression(proto::SimBagParams::Compression c) {
   switch (c) {
-    case proto::SimBagParams::BZ2: return Ros1BagWriter::Compression::kBz2;
-    case proto::SimBagParams::LZ4: return Ros1BagWriter::Compression::kLz4;
-    default: return Ros1BagWriter::Compression::kNone;
+    case proto::SimBagParams::BZ2: return ros1::ChunkCompression::kBz2;
+    case proto::SimBagParams::LZ4: return ros1::ChunkCompression::kLz4;
+    default: return ros1::ChunkCompression::kNone;
   }
 }
 
 }  // namespace
 
-Status BuildScenario(const proto::SimulateParams& params, Scenario* scenario) {
-  const auto& tp = params.trajectory();
-  const auto& rig = params.rig();
-  const auto& lp = params.lidar();
-  const auto& wp = params.world();
+namespace {
 
+TrajectoryConfig MakeTrajectoryConfig(const proto::SimulateParams& params) {
+  const auto& tp = params.trajectory();
   TrajectoryConfig tc;
   tc.shape = tp.shape() == proto::SimTrajectoryParams::CIRCLE
                  ? TrajectoryConfig::Shape::kCircle
@@ -128,37 +119,25 @@ Status BuildScenario(const proto::SimulateParams& params, Scenario* scenario) {
   tc.max_yaw_rate_radps = tp.max_yaw_rate_radps();
   tc.ground_roll_rad = params.ground_roll_deg() * kDegToRad;
   tc.ground_pitch_rad = params.ground_pitch_deg() * kDegToRad;
-  tc.imu_height_m = rig.imu_height_m();
-  tc.vehicle_from_imu = geometry::RotationFromEuler123Deg(ToEigen(rig.imu_rotation_in_vehicle_deg()));
-  if ((tc.vibration_roll_rad > 0 || tc.vibration_pitch_rad > 0) &&
-      tc.vibration_frequency_hz <= 0) {
-    return Status::Error("field trajectory.vibration_frequency_hz must be > 0 with a vibration");
-  }
-  scenario->trajectory = std::make_unique<PlanarTrajectory>(tc);
-  const PlanarTrajectory& trajectory = *scenario->trajectory;
+  tc.imu_height_m = params.rig().imu_height_m();
+  tc.vehicle_from_imu =
+      geometry::RotationFromEuler123Deg(ToEigen(params.rig().imu_rotation_in_vehicle_deg()));
+  return tc;
+}
 
-  // The track must fit in the room.
-  const double half = wp.room_half_size_m();
-  const Eigen::Vector2d pmin = trajectory.PathMin(), pmax = trajectory.PathMax();
-  const double extent = std::max(pmin.cwiseAbs().maxCoeff(), pmax.cwiseAbs().maxCoeff());
-  if (wp.wall_height_m() > 0 && extent + 2.0 > half) {
-    return Status::Error("field world.room_half_size_m = " + std::to_string(half) +
-                         " leaves no room for the track (extent " + std::to_string(extent) +
-                         " m + 2 m)");
-  }
-
-  // LiDAR model and timing.
-  ScanConfig& sc = scenario->scan;
+// The LiDAR model, range limits, timing and mounting of the params.
+Status MakeScanConfig(const proto::SimulateParams& params, ScanConfig* sc) {
+  const auto& lp = params.lidar();
   switch (lp.model()) {
-    case proto::SimLidarParams::VLP_16: sc.model = Vlp16Model(); break;
-    case proto::SimLidarParams::VLP_32C: sc.model = Vlp32cModel(); break;
+    case proto::SimLidarParams::VLP_16: sc->model = Vlp16Model(); break;
+    case proto::SimLidarParams::VLP_32C: sc->model = Vlp32cModel(); break;
     case proto::SimLidarParams::OS1_32: {
       const uint32_t columns = lp.ouster_columns() == 0 ? 1024 : lp.ouster_columns();
       if (columns != 512 && columns != 1024 && columns != 2048) {
         return Status::Error("field lidar.ouster_columns = " + std::to_string(columns) +
                              " must be 512, 1024 or 2048");
       }
-      sc.model = Os132Model(static_cast<int>(columns));
+      sc->model = Os132Model(static_cast<int>(columns));
       break;
     }
     default: return Status::Error("field lidar.model must be VLP_16, VLP_32C or OS1_32");
@@ -166,43 +145,71 @@ Status BuildScenario(const proto::SimulateParams& params, Scenario* scenario) {
   if (lp.max_range_m() <= lp.min_range_m()) {
     return Status::Error("field lidar.max_range_m must exceed lidar.min_range_m");
   }
-  sc.scan_rate_hz = lp.scan_rate_hz();
-  sc.min_range_m = lp.min_range_m();
-  sc.max_range_m = lp.max_range_m();
-  sc.range_noise_m = lp.range_noise_m();
-  sc.velodyne_stamp_at_start = lp.velodyne_stamp_at_start();
-  sc.first_scan_time_s = lp.first_scan_time_s();
-  sc.imu_from_lidar_rotation = geometry::RotationFromEuler123Deg(ToEigen(rig.lidar_rotation_in_imu_deg()));
-  sc.imu_from_lidar_translation = ToEigen(rig.lidar_translation_in_imu_m());
+  sc->scan_rate_hz = lp.scan_rate_hz();
+  sc->min_range_m = lp.min_range_m();
+  sc->max_range_m = lp.max_range_m();
+  sc->range_noise_m = lp.range_noise_m();
+  sc->velodyne_stamp_at_start = lp.velodyne_stamp_at_start();
+  sc->first_scan_time_s = lp.first_scan_time_s();
+  sc->imu_from_lidar_rotation =
+      geometry::RotationFromEuler123Deg(ToEigen(params.rig().lidar_rotation_in_imu_deg()));
+  sc->imu_from_lidar_translation = ToEigen(params.rig().lidar_translation_in_imu_m());
+  return Status::Ok();
+}
 
-  // The LiDAR must be above the ground (checked at the start pose).
-  {
-    Eigen::Matrix3d c_wb;
-    Eigen::Vector3d r_wb;
-    trajectory.Pose(0.0, &c_wb, &r_wb);
-    const double lidar_height =
-        trajectory.NormalInWorld().dot(r_wb + c_wb * sc.imu_from_lidar_translation);
-    if (lidar_height < 0.05) {
-      return Status::Error("the LiDAR is " + std::to_string(lidar_height) +
-                           " m above the ground: check rig.imu_height_m, "
-                           "rig.lidar_translation_in_imu_m and rig.imu_rotation_in_vehicle_deg");
-    }
-  }
-
-  scenario->world = std::make_unique<World>(trajectory.NormalInWorld(), half, wp.wall_height_m());
+// The room with its walls, the boxes and pillars of the params and the
+// random obstacles.
+std::unique_ptr<World> MakeWorld(const proto::SimulateParams& params,
+                                 const PlanarTrajectory& trajectory) {
+  const auto& wp = params.world();
+  auto world =
+      std::make_unique<World>(trajectory.NormalInWorld(), wp.room_half_size_m(), wp.wall_height_m());
   for (const auto& b : wp.boxes()) {
-    const double z = scenario->world->GroundZ(b.center_x_m(), b.center_y_m());
-    scenario->world->AddBox({b.center_x_m() - 0.5 * b.size_x_m(), b.center_x_m() + 0.5 * b.size_x_m(),
-                             b.center_y_m() - 0.5 * b.size_y_m(), b.center_y_m() + 0.5 * b.size_y_m(),
-                             z + b.height_m()});
+    const double z = world->GroundZ(b.center_x_m(), b.center_y_m());
+    world->AddBox({b.center_x_m() - 0.5 * b.size_x_m(), b.center_x_m() + 0.5 * b.size_x_m(),
+                   b.center_y_m() - 0.5 * b.size_y_m(), b.center_y_m() + 0.5 * b.size_y_m(),
+                   z + b.height_m()});
   }
   for (const auto& p : wp.pillars()) {
-    const double z = scenario->world->GroundZ(p.center_x_m(), p.center_y_m());
-    scenario->world->AddPillar({p.center_x_m(), p.center_y_m(), p.radius_m(), z + p.height_m()});
+    const double z = world->GroundZ(p.center_x_m(), p.center_y_m());
+    world->AddPillar({p.center_x_m(), p.center_y_m(), p.radius_m(), z + p.height_m()});
   }
-  AddRandomObstacles(wp, trajectory, params.seed(), scenario->world.get());
+  AddRandomObstacles(wp, trajectory, params.seed(), world.get());
+  return world;
+}
 
-  scenario->gravity_w = Eigen::Vector3d(0.0, 0.0, -params.gravity_norm_mps2());
+Status CheckTrackFitsRoom(const proto::SimulateParams& params,
+                          const PlanarTrajectory& trajectory) {
+  const double half = params.world().room_half_size_m();
+  const Eigen::Vector2d pmin = trajectory.PathMin(), pmax = trajectory.PathMax();
+  const double extent = std::max(pmin.cwiseAbs().maxCoeff(), pmax.cwiseAbs().maxCoeff());
+  if (params.world().wall_height_m() > 0 && extent + 2.0 > half) {
+    return Status::Error("field world.room_half_size_m = " + std::to_string(half) +
+                         " leaves no room for the track (extent " + std::to_string(extent) +
+                         " m + 2 m)");
+  }
+  return Status::Ok();
+}
+
+// The LiDAR must be above the ground (checked at the start pose).
+Status CheckLidarAboveGround(const PlanarTrajectory& trajectory, const ScanConfig& sc) {
+  Eigen::Matrix3d c_wb;
+  Eigen::Vector3d r_wb;
+  trajectory.Pose(0.0, &c_wb, &r_wb);
+  const double lidar_height =
+      trajectory.NormalInWorld().dot(r_wb + c_wb * sc.imu_from_lidar_translation);
+  if (lidar_height < 0.05) {
+    return Status::Error("the LiDAR is " + std::to_string(lidar_height) +
+                         " m above the ground: check rig.imu_height_m, "
+                         "rig.lidar_translation_in_imu_m and rig.imu_rotation_in_vehicle_deg");
+  }
+  return Status::Ok();
+}
+
+// Sample and sweep counts of the duration; every stamp must be a valid ROS
+// time (LiDAR stamps are true − τ).
+Status SetTiming(const proto::SimulateParams& params, Scenario* scenario) {
+  const ScanConfig& sc = scenario->scan;
   const int64_t duration_ns = std::llround(params.duration_s() * 1e9);
   scenario->num_imu_samples =
       static_cast<int>(std::floor(params.duration_s() * params.imu().rate_hz() + 1e-9)) + 1;
@@ -214,9 +221,7 @@ Status BuildScenario(const proto::SimulateParams& params, Scenario* scenario) {
                          " is too short for one LiDAR sweep after lidar.first_scan_time_s");
   }
   scenario->num_scans = scans;
-  scenario->time_offset_ns = std::llround(rig.time_offset_s() * 1e9);
-
-  // Every stamp must be a valid ROS time (LiDAR stamps are true − τ).
+  scenario->time_offset_ns = std::llround(params.rig().time_offset_s() * 1e9);
   const int64_t start = params.start_stamp_ns();
   if (start + SweepStartNs(sc, 0) - scenario->time_offset_ns < 0 ||
       start + duration_ns + std::abs(scenario->time_offset_ns) > kMaxRosTimeNs) {
@@ -227,202 +232,350 @@ Status BuildScenario(const proto::SimulateParams& params, Scenario* scenario) {
   return Status::Ok();
 }
 
-Status Run(const proto::SimulateParams& params, const SimulateOutputs& outputs,
-           SimulateSummary* summary) {
-  const auto wall_start = std::chrono::steady_clock::now();
-  Scenario scenario;
-  TILTCAL_RETURN_IF_ERROR(BuildScenario(params, &scenario));
-  const PlanarTrajectory& trajectory = *scenario.trajectory;
-  const ScanConfig& sc = scenario.scan;
-  const auto& ip = params.imu();
-  const auto& lp = params.lidar();
-  const int64_t start_ns = params.start_stamp_ns();
-  const bool ouster = sc.model.kind == LidarModel::Kind::kOuster;
+}  // namespace
 
-  unsigned threads = params.num_threads();
-  if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
-  Ros1BagWriter writer;
-  TILTCAL_RETURN_IF_ERROR(writer.Open(outputs.bag_path, ToCompression(params.bag().compression()),
-                                      params.bag().chunk_threshold_bytes(), threads));
-  const RosMessageType& imu_type = ImuMessageType();
-  const RosMessageType& cloud_type = PointCloud2MessageType();
-  const uint32_t imu_conn =
-      writer.AddConnection(ip.topic(), imu_type.type, imu_type.md5sum, imu_type.definition);
-  const uint32_t lidar_conn =
-      writer.AddConnection(lp.topic(), cloud_type.type, cloud_type.md5sum, cloud_type.definition);
+Status BuildScenario(const proto::SimulateParams& params, Scenario* scenario) {
+  const TrajectoryConfig tc = MakeTrajectoryConfig(params);
+  if ((tc.vibration_roll_rad > 0 || tc.vibration_pitch_rad > 0) &&
+      tc.vibration_frequency_hz <= 0) {
+    return Status::Error("field trajectory.vibration_frequency_hz must be > 0 with a vibration");
+  }
+  scenario->trajectory = std::make_unique<PlanarTrajectory>(tc);
+  const PlanarTrajectory& trajectory = *scenario->trajectory;
+  TILTCAL_RETURN_IF_ERROR(CheckTrackFitsRoom(params, trajectory));
+  TILTCAL_RETURN_IF_ERROR(MakeScanConfig(params, &scenario->scan));
+  TILTCAL_RETURN_IF_ERROR(CheckLidarAboveGround(trajectory, scenario->scan));
+  scenario->world = MakeWorld(params, trajectory);
+  scenario->gravity_w = Eigen::Vector3d(0.0, 0.0, -params.gravity_norm_mps2());
+  return SetTiming(params, scenario);
+}
 
-  // IMU model: ω_m = ω_b + b_g + n_g, f_m = C_wb^T (r̈_w − g_w) + b_a + n_a,
-  // white noise σ = density · sqrt(rate), bias random walk σ = density / sqrt(rate).
-  Rng imu_rng(params.seed(), kImuStream);
-  const double rate = ip.rate_hz();
-  const double gyro_sigma = ip.gyro_noise_density_radps_sqrthz() * std::sqrt(rate);
-  const double accel_sigma = ip.accel_noise_density_mps2_sqrthz() * std::sqrt(rate);
-  const double gyro_walk = ip.gyro_bias_random_walk_radps2_sqrthz() / std::sqrt(rate);
-  const double accel_walk = ip.accel_bias_random_walk_mps3_sqrthz() / std::sqrt(rate);
-  Eigen::Vector3d gyro_bias = ToEigen(ip.gyro_bias_radps());
-  Eigen::Vector3d accel_bias = ToEigen(ip.accel_bias_mps2());
-  Eigen::Vector3d last_gyro_bias = gyro_bias, last_accel_bias = accel_bias;
-  auto gaussian3 = [&]() {
-    const double x = imu_rng.Gaussian(), y = imu_rng.Gaussian(), z = imu_rng.Gaussian();
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// What a run did, for its summary line.
+struct SimulateSummary {
+  int num_imu_samples = 0;
+  int num_scans = 0;
+  uint64_t num_points = 0;
+  uint64_t bag_bytes = 0;
+  double raycast_seconds = 0.0;  // wall time in ray casting + serialization
+  double total_seconds = 0.0;
+};
+
+// True when `log` is the standard error stream and that is a terminal.
+bool IsTerminal(const std::ostream* log) {
+  return (log == &std::cerr || log == &std::clog) && ::isatty(STDERR_FILENO);
+}
+
+// The IMU: samples at rate_hz from the start stamp, with
+//   ω_m = ω_b + b_g + n_g,   f_m = C_wb^T (r̈_w − g_w) + b_a + n_a,
+// white noise σ = density · sqrt(rate), bias random walk σ = density / sqrt(rate),
+// from its own random stream.
+class ImuSimulator {
+ public:
+  ImuSimulator(const proto::SimulateParams& params, const Scenario& scenario)
+      : params_(params.imu()),
+        scenario_(scenario),
+        start_ns_(params.start_stamp_ns()),
+        rng_(params.seed(), kImuStream),
+        rate_(params_.rate_hz()),
+        gyro_sigma_(params_.gyro_noise_density_radps_sqrthz() * std::sqrt(rate_)),
+        accel_sigma_(params_.accel_noise_density_mps2_sqrthz() * std::sqrt(rate_)),
+        gyro_walk_(params_.gyro_bias_random_walk_radps2_sqrthz() / std::sqrt(rate_)),
+        accel_walk_(params_.accel_bias_random_walk_mps3_sqrthz() / std::sqrt(rate_)),
+        gyro_bias_(ToEigen(params_.gyro_bias_radps())),
+        accel_bias_(ToEigen(params_.accel_bias_mps2())),
+        last_gyro_bias_(gyro_bias_),
+        last_accel_bias_(accel_bias_) {}
+
+  int64_t StampNs(int i) const {
+    return start_ns_ + std::llround(static_cast<double>(i) * 1e9 / rate_);
+  }
+
+  // Writes the samples up to `stamp_ns` (all of them for INT64_MAX) not yet written.
+  Status WriteUpTo(int64_t stamp_ns, uint32_t connection, ros1::BagWriter* writer) {
+    while (next_ < scenario_.num_imu_samples && StampNs(next_) <= stamp_ns) {
+      TILTCAL_RETURN_IF_ERROR(WriteSample(next_++, connection, writer));
+    }
+    return Status::Ok();
+  }
+
+  double max_yaw_rate() const { return max_yaw_rate_; }
+  // The biases of the last sample.
+  const Eigen::Vector3d& last_gyro_bias() const { return last_gyro_bias_; }
+  const Eigen::Vector3d& last_accel_bias() const { return last_accel_bias_; }
+
+ private:
+  Eigen::Vector3d Gaussian3() {
+    const double x = rng_.Gaussian(), y = rng_.Gaussian(), z = rng_.Gaussian();
     return Eigen::Vector3d(x, y, z);
-  };
-  int next_imu = 0;
-  std::string message;
-  double max_yaw_rate = 0.0;
-  auto imu_stamp_ns = [&](int i) {
-    return start_ns + std::llround(static_cast<double>(i) * 1e9 / rate);
-  };
-  auto write_imu = [&](int i) -> Status {
-    const int64_t rel_ns = imu_stamp_ns(i) - start_ns;
-    const ImuState s = trajectory.Evaluate(rel_ns * 1e-9);
-    max_yaw_rate = std::max(max_yaw_rate, std::abs(s.yaw_rate_radps));
-    const Eigen::Vector3d omega = s.angular_velocity_b + gyro_bias + gyro_sigma * gaussian3();
+  }
+
+  Status WriteSample(int i, uint32_t connection, ros1::BagWriter* writer) {
+    const int64_t rel_ns = StampNs(i) - start_ns_;
+    const ImuState s = scenario_.trajectory->Evaluate(rel_ns * 1e-9);
+    max_yaw_rate_ = std::max(max_yaw_rate_, std::abs(s.yaw_rate_radps));
+    const Eigen::Vector3d omega = s.angular_velocity_b + gyro_bias_ + gyro_sigma_ * Gaussian3();
     const Eigen::Vector3d force = s.world_from_imu.transpose() *
-                                      (s.acceleration_w - scenario.gravity_w) +
-                                  accel_bias + accel_sigma * gaussian3();
-    last_gyro_bias = gyro_bias;
-    last_accel_bias = accel_bias;
-    gyro_bias += gyro_walk * gaussian3();
-    accel_bias += accel_walk * gaussian3();
-    if (!SerializeImu(static_cast<uint32_t>(i), imu_stamp_ns(i), ip.frame_id(), omega, force,
-                      gyro_sigma * gyro_sigma, accel_sigma * accel_sigma, &message)) {
+                                      (s.acceleration_w - scenario_.gravity_w) +
+                                  accel_bias_ + accel_sigma_ * Gaussian3();
+    last_gyro_bias_ = gyro_bias_;
+    last_accel_bias_ = accel_bias_;
+    gyro_bias_ += gyro_walk_ * Gaussian3();
+    accel_bias_ += accel_walk_ * Gaussian3();
+    if (!ros1::SerializeImu(static_cast<uint32_t>(i), StampNs(i), params_.frame_id(), omega,
+                            force, gyro_sigma_ * gyro_sigma_, accel_sigma_ * accel_sigma_,
+                            &message_)) {
       return Status::Error("IMU stamp of sample " + std::to_string(i) + " is not a ROS time");
     }
-    return writer.Write(imu_conn, imu_stamp_ns(i), message);
-  };
-  // Truth.
-  proto::SimulationTruth truth;
+    return writer->Write(connection, StampNs(i), message_);
+  }
+
+  const proto::SimImuParams& params_;
+  const Scenario& scenario_;
+  const int64_t start_ns_;
+  Rng rng_;
+  const double rate_;
+  const double gyro_sigma_, accel_sigma_, gyro_walk_, accel_walk_;
+  Eigen::Vector3d gyro_bias_, accel_bias_;
+  Eigen::Vector3d last_gyro_bias_, last_accel_bias_;
+  int next_ = 0;
+  double max_yaw_rate_ = 0.0;
+  std::string message_;
+};
+
+// Frames of the truth: world a = the IMU frame at the first sample, the
+// simulator's world w, the plane normal and the flat-ground gravity.
+struct TruthFrames {
+  TruthFrames(const proto::SimulateParams& params, const Scenario& scenario) {
+    scenario.trajectory->Pose(0.0, &c_wb0, &r_wb0);
+    c_aw = c_wb0.transpose();
+    n_w = scenario.trajectory->NormalInWorld();
+    const Eigen::Matrix3d c_vb =
+        geometry::RotationFromEuler123Deg(ToEigen(params.rig().imu_rotation_in_vehicle_deg()));
+    g_f = c_vb.transpose() * scenario.gravity_w;
+    up_f = -g_f.normalized();
+  }
   Eigen::Matrix3d c_wb0;
   Eigen::Vector3d r_wb0;
-  trajectory.Pose(0.0, &c_wb0, &r_wb0);
-  const Eigen::Matrix3d c_aw = c_wb0.transpose();
-  const Eigen::Vector3d n_w = trajectory.NormalInWorld();
-  const Eigen::Vector3d up_w = Eigen::Vector3d::UnitZ();
-  const Eigen::Matrix3d c_vb = geometry::RotationFromEuler123Deg(ToEigen(params.rig().imu_rotation_in_vehicle_deg()));
-  const Eigen::Vector3d g_f = c_vb.transpose() * scenario.gravity_w;
-  const Eigen::Vector3d up_f = -g_f.normalized();
-  const Eigen::Matrix3d& c_bl = sc.imu_from_lidar_rotation;
-  const Eigen::Vector3d& r_bl = sc.imu_from_lidar_translation;
+  Eigen::Matrix3d c_aw;                                    // C_aw = C_wb(0)^T
+  Eigen::Vector3d n_w;                                     // ground normal in w
+  const Eigen::Vector3d up_w = Eigen::Vector3d::UnitZ();  // level up in w
+  Eigen::Vector3d g_f;                                     // gravity in b on flat ground
+  Eigen::Vector3d up_f;
+};
 
-  // Scans in batches: ray casting and serialization in worker threads (one
-  // random stream per sweep, so the result does not depend on the threads),
-  // writing in order on this thread.
-  const int batch = static_cast<int>(threads) * 2;
-  const int num_scans = scenario.num_scans;
-  const uint64_t seed = params.seed();
-  std::vector<std::string> messages(batch);
-  std::vector<SimulatedScan> scans(batch);
-  std::vector<char> ok(batch);
-  double raycast_seconds = 0.0;
-  uint64_t num_points = 0;
-  const int64_t tau_ns = scenario.time_offset_ns;
+// The truth of one written scan with bag stamp `stamp_ns`.
+void FillTruthScan(const Scenario& scenario, const TruthFrames& f, const SimulatedScan& scan,
+                   int64_t start_ns, int64_t stamp_ns, proto::TruthScan* ts) {
+  const Eigen::Matrix3d& c_bl = scenario.scan.imu_from_lidar_rotation;
+  const Eigen::Vector3d& r_bl = scenario.scan.imu_from_lidar_translation;
+  const int64_t true_rel_ns = scan.stamp_true_ns;
+  const ImuState s = scenario.trajectory->Evaluate(true_rel_ns * 1e-9);
+  const Eigen::Matrix3d c_wl = s.world_from_imu * c_bl;
+  const Eigen::Vector3d r_wl = s.position_w + s.world_from_imu * r_bl;
+  ts->set_stamp_ns(stamp_ns);
+  ts->set_true_stamp_ns(start_ns + true_rel_ns);
+  *ts->mutable_ground_normal_in_lidar() = ToProto(Eigen::Vector3d(c_wl.transpose() * f.n_w));
+  ts->set_ground_height_m(f.n_w.dot(r_wl));  // the plane passes through the origin
+  ts->set_inclination_deg(AngleDeg(f.n_w, f.up_w));
+  *ts->mutable_world_from_imu() =
+      RigidToProto(f.c_aw * s.world_from_imu, f.c_aw * (s.position_w - f.r_wb0));
+  ts->set_vehicle_inclination_deg(AngleDeg(s.world_from_imu.transpose() * f.up_w, f.up_f));
+  ts->set_num_points(scan.num_valid);
+  ts->set_num_ground_points(scan.num_ground);
+}
 
-  for (int first = 0; first < num_scans; first += batch) {
-    const int count = std::min(batch, num_scans - first);
-    const auto t0 = std::chrono::steady_clock::now();
-    auto work = [&](unsigned tid) {
-      for (int j = static_cast<int>(tid); j < count; j += static_cast<int>(threads)) {
+// The sequence-level truth, after every scan is in.
+void FillSequenceTruth(const proto::SimulateParams& params, const Scenario& scenario,
+                       const TruthFrames& f, const ImuSimulator& imu,
+                       proto::SimulationTruth* truth) {
+  const auto& ip = params.imu();
+  const ScanConfig& sc = scenario.scan;
+  *truth->mutable_imu_from_lidar() =
+      RigidToProto(sc.imu_from_lidar_rotation, sc.imu_from_lidar_translation);
+  truth->set_time_offset_s(scenario.time_offset_ns * 1e-9);
+  *truth->mutable_gravity_in_world() = ToProto(Eigen::Vector3d(f.c_aw * scenario.gravity_w));
+  *truth->mutable_gravity_flat_in_imu() = ToProto(f.g_f);
+  truth->set_imu_height_m(params.rig().imu_height_m());
+  *truth->mutable_gyro_bias_radps() = ip.gyro_bias_radps();
+  *truth->mutable_accel_bias_mps2() = ip.accel_bias_mps2();
+  *truth->mutable_gyro_bias_last_radps() = ToProto(imu.last_gyro_bias());
+  *truth->mutable_accel_bias_last_mps2() = ToProto(imu.last_accel_bias());
+  *truth->mutable_ground_normal_in_world() = ToProto(f.n_w);
+  truth->set_ground_roll_deg(params.ground_roll_deg());
+  truth->set_ground_pitch_deg(params.ground_pitch_deg());
+  truth->set_start_stamp_ns(params.start_stamp_ns());
+  *truth->mutable_ground_normal_in_world_a() = ToProto(Eigen::Vector3d(f.c_aw * f.n_w));
+  truth->set_ground_offset_in_world_m(params.rig().imu_height_m());
+  truth->set_lidar_model(sc.model.name);
+  truth->set_num_imu_samples(static_cast<uint32_t>(scenario.num_imu_samples));
+  truth->set_max_yaw_rate_radps(imu.max_yaw_rate());
+  truth->set_mean_speed_mps(params.trajectory().speed_mps());
+  truth->set_range_noise_m(params.lidar().range_noise_m());
+  truth->set_gyro_noise_density_radps_sqrthz(ip.gyro_noise_density_radps_sqrthz());
+  truth->set_accel_noise_density_mps2_sqrthz(ip.accel_noise_density_mps2_sqrthz());
+  *truth->mutable_world_from_sim_world() = RigidToProto(f.c_aw, -f.c_aw * f.r_wb0);
+  truth->set_inclination_deg(AngleDeg(f.n_w, f.up_w));
+}
+
+// The rig a user would have measured: the true extrinsic with the errors of
+// params.rig_file.
+proto::Rig MakeRig(const proto::SimulateParams& params, const Scenario& scenario,
+                   const TruthFrames& f) {
+  const auto& rf = params.rig_file();
+  const ScanConfig& sc = scenario.scan;
+  proto::Rig rig;
+  *rig.mutable_imu_from_lidar() = RigidToProto(
+      sc.imu_from_lidar_rotation *
+          geometry::RotationFromEuler123Deg(ToEigen(rf.rotation_error_deg())),
+      sc.imu_from_lidar_translation + ToEigen(rf.translation_error_m()));
+  rig.set_imu_height_m(params.rig().imu_height_m());
+  rig.set_imu_topic(params.imu().topic());
+  rig.set_lidar_topic(params.lidar().topic());
+  rig.set_lidar_model(sc.model.name);
+  if (rf.write_gravity_flat()) *rig.mutable_gravity_flat_in_imu() = ToProto(f.g_f);
+  rig.set_gravity_reference(rf.gravity_reference());
+  return rig;
+}
+
+// The sweeps, in batches: ray casting and serialization in worker threads
+// (one random stream per sweep, so the bytes do not depend on the threads),
+// writing in order on this thread, each after the IMU samples up to its
+// record time (IMU first on ties).
+class ScanWriter {
+ public:
+  ScanWriter(const proto::SimulateParams& params, const Scenario& scenario, unsigned threads)
+      : params_(params),
+        scenario_(scenario),
+        threads_(threads),
+        batch_(static_cast<int>(threads) * 2),
+        messages_(batch_),
+        scans_(batch_),
+        ok_(batch_) {}
+
+  Status WriteAll(ros1::BagWriter* writer, uint32_t lidar_conn, uint32_t imu_conn,
+                  ImuSimulator* imu, const TruthFrames& frames, proto::SimulationTruth* truth,
+                  std::ostream* progress, SimulateSummary* summary) {
+    const int num_scans = scenario_.num_scans;
+    for (int first = 0; first < num_scans; first += batch_) {
+      const int count = std::min(batch_, num_scans - first);
+      const auto t0 = Clock::now();
+      SimulateBatch(first, count);
+      summary->raycast_seconds += std::chrono::duration<double>(Clock::now() - t0).count();
+      for (int j = 0; j < count; ++j) {
         const int k = first + j;
-        scans[j] = SimulateSweep(sc, trajectory, *scenario.world, seed, k);
-        const int64_t stamp = start_ns + scans[j].stamp_true_ns - tau_ns;
-        ok[j] = SerializeScan(scans[j], ouster, lp.append_surface_label(), static_cast<uint32_t>(k),
-                              stamp, lp.frame_id(), &messages[j]);
+        const int64_t stamp = StampNs(scans_[j]);
+        if (!ok_[j]) return Status::Error("scan " + std::to_string(k) + ": stamp is not a ROS time");
+        TILTCAL_RETURN_IF_ERROR(imu->WriteUpTo(stamp, imu_conn, writer));
+        TILTCAL_RETURN_IF_ERROR(writer->Write(lidar_conn, stamp, messages_[j]));
+        summary->num_points += scans_[j].num_valid;
+        FillTruthScan(scenario_, frames, scans_[j], params_.start_stamp_ns(), stamp,
+                      truth->add_scans());
+        if (progress != nullptr) {
+          *progress << "\rtiltcal_simulate: scan " << k + 1 << " / " << num_scans
+                    << (k + 1 == num_scans ? "\n" : "") << std::flush;
+        }
+      }
+    }
+    return Status::Ok();
+  }
+
+ private:
+  // The bag stamp of a sweep (LiDAR clock: true − τ).
+  int64_t StampNs(const SimulatedScan& scan) const {
+    return params_.start_stamp_ns() + scan.stamp_true_ns - scenario_.time_offset_ns;
+  }
+
+  // Simulates and serializes sweeps first .. first + count - 1.
+  void SimulateBatch(int first, int count) {
+    const auto& lp = params_.lidar();
+    const bool ouster = scenario_.scan.model.kind == LidarModel::Kind::kOuster;
+    auto work = [&](unsigned tid) {
+      for (int j = static_cast<int>(tid); j < count; j += static_cast<int>(threads_)) {
+        const int k = first + j;
+        scans_[j] =
+            SimulateSweep(scenario_.scan, *scenario_.trajectory, *scenario_.world, params_.seed(), k);
+        ok_[j] = SerializeScan(scans_[j], ouster, lp.append_surface_label(),
+                               static_cast<uint32_t>(k), StampNs(scans_[j]), lp.frame_id(),
+                               &messages_[j]);
         // Keep the counts; drop the points.
-        scans[j].points.clear();
-        scans[j].points.shrink_to_fit();
+        scans_[j].points.clear();
+        scans_[j].points.shrink_to_fit();
       }
     };
     std::vector<std::thread> pool;
-    for (unsigned tid = 1; tid < threads; ++tid) pool.emplace_back(work, tid);
+    for (unsigned tid = 1; tid < threads_; ++tid) pool.emplace_back(work, tid);
     work(0);
     for (auto& th : pool) th.join();
-    raycast_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-
-    for (int j = 0; j < count; ++j) {
-      const int k = first + j;
-      const SimulatedScan& scan = scans[j];
-      const int64_t stamp = start_ns + scan.stamp_true_ns - tau_ns;
-      if (!ok[j]) return Status::Error("scan " + std::to_string(k) + ": stamp is not a ROS time");
-      // IMU samples up to this record time go first (IMU first on ties).
-      while (next_imu < scenario.num_imu_samples && imu_stamp_ns(next_imu) <= stamp) {
-        TILTCAL_RETURN_IF_ERROR(write_imu(next_imu++));
-      }
-      TILTCAL_RETURN_IF_ERROR(writer.Write(lidar_conn, stamp, messages[j]));
-      num_points += scan.num_valid;
-
-      proto::TruthScan* ts = truth.add_scans();
-      const int64_t true_rel_ns = scan.stamp_true_ns;
-      const ImuState s = trajectory.Evaluate(true_rel_ns * 1e-9);
-      const Eigen::Matrix3d c_wl = s.world_from_imu * c_bl;
-      const Eigen::Vector3d r_wl = s.position_w + s.world_from_imu * r_bl;
-      ts->set_stamp_ns(stamp);
-      ts->set_true_stamp_ns(start_ns + true_rel_ns);
-      SetVector(c_wl.transpose() * n_w, ts->mutable_ground_normal_in_lidar());
-      ts->set_ground_height_m(n_w.dot(r_wl));  // the plane passes through the origin
-      ts->set_inclination_deg(AngleDeg(n_w, up_w));
-      SetRigid(c_aw * s.world_from_imu, c_aw * (s.position_w - r_wb0),
-               ts->mutable_world_from_imu());
-      ts->set_vehicle_inclination_deg(AngleDeg(s.world_from_imu.transpose() * up_w, up_f));
-      ts->set_num_points(scan.num_valid);
-      ts->set_num_ground_points(scan.num_ground);
-      if (outputs.progress) outputs.progress(k + 1, num_scans);
-    }
   }
-  while (next_imu < scenario.num_imu_samples) TILTCAL_RETURN_IF_ERROR(write_imu(next_imu++));
+
+  const proto::SimulateParams& params_;
+  const Scenario& scenario_;
+  const unsigned threads_;
+  const int batch_;
+  std::vector<std::string> messages_;
+  std::vector<SimulatedScan> scans_;
+  std::vector<char> ok_;
+};
+
+void PrintSummary(std::ostream* log, const SimulateSummary& s) {
+  if (log == nullptr) return;
+  char line[256];
+  std::snprintf(line, sizeof(line),
+                "tiltcal_simulate: %d IMU samples, %d scans, %llu points, %.1f MB bag; "
+                "ray casting %.2f s, total %.2f s\n",
+                s.num_imu_samples, s.num_scans, static_cast<unsigned long long>(s.num_points),
+                s.bag_bytes / 1e6, s.raycast_seconds, s.total_seconds);
+  *log << line;
+}
+
+}  // namespace
+
+Status Run(const SimulatePaths& paths, const proto::SimulateParams& params, std::ostream* log) {
+  const auto wall_start = Clock::now();
+  if (paths.out_bag.empty() || paths.out_truth.empty()) {
+    return Status::Error("--out_bag and --out_truth are required");
+  }
+  Scenario scenario;
+  TILTCAL_RETURN_IF_ERROR(BuildScenario(params, &scenario));
+  unsigned threads = params.num_threads();
+  if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
+  ros1::BagWriter writer;
+  TILTCAL_RETURN_IF_ERROR(writer.Open(paths.out_bag, ToCompression(params.bag().compression()),
+                                      params.bag().chunk_threshold_bytes(), threads));
+  const ros1::MessageType& imu_type = ros1::ImuMessageType();
+  const ros1::MessageType& cloud_type = ros1::PointCloud2MessageType();
+  const uint32_t imu_conn = writer.AddConnection(params.imu().topic(), imu_type.type,
+                                                 imu_type.md5sum, imu_type.definition);
+  const uint32_t lidar_conn = writer.AddConnection(params.lidar().topic(), cloud_type.type,
+                                                   cloud_type.md5sum, cloud_type.definition);
+
+  SimulateSummary summary;
+  ImuSimulator imu(params, scenario);
+  const TruthFrames frames(params, scenario);
+  proto::SimulationTruth truth;
+  ScanWriter scans(params, scenario, threads);
+  TILTCAL_RETURN_IF_ERROR(scans.WriteAll(&writer, lidar_conn, imu_conn, &imu, frames, &truth,
+                                         IsTerminal(log) ? log : nullptr, &summary));
+  TILTCAL_RETURN_IF_ERROR(imu.WriteUpTo(INT64_MAX, imu_conn, &writer));
   TILTCAL_RETURN_IF_ERROR(writer.Close());
 
-  // Truth, sequence level.
-  *truth.mutable_provenance() = MakeProvenance("tiltcal_simulate", params, {},
-                                               outputs.command_line);
-  SetRigid(c_bl, r_bl, truth.mutable_imu_from_lidar());
-  truth.set_time_offset_s(tau_ns * 1e-9);
-  SetVector(c_aw * scenario.gravity_w, truth.mutable_gravity_in_world());
-  SetVector(g_f, truth.mutable_gravity_flat_in_imu());
-  truth.set_imu_height_m(params.rig().imu_height_m());
-  *truth.mutable_gyro_bias_radps() = ip.gyro_bias_radps();
-  *truth.mutable_accel_bias_mps2() = ip.accel_bias_mps2();
-  SetVector(last_gyro_bias, truth.mutable_gyro_bias_last_radps());
-  SetVector(last_accel_bias, truth.mutable_accel_bias_last_mps2());
-  SetVector(n_w, truth.mutable_ground_normal_in_world());
-  truth.set_ground_roll_deg(params.ground_roll_deg());
-  truth.set_ground_pitch_deg(params.ground_pitch_deg());
-  truth.set_start_stamp_ns(start_ns);
-  SetVector(c_aw * n_w, truth.mutable_ground_normal_in_world_a());
-  truth.set_ground_offset_in_world_m(params.rig().imu_height_m());
-  truth.set_lidar_model(sc.model.name);
-  truth.set_num_imu_samples(static_cast<uint32_t>(scenario.num_imu_samples));
-  truth.set_max_yaw_rate_radps(max_yaw_rate);
-  truth.set_mean_speed_mps(params.trajectory().speed_mps());
-  truth.set_range_noise_m(lp.range_noise_m());
-  truth.set_gyro_noise_density_radps_sqrthz(ip.gyro_noise_density_radps_sqrthz());
-  truth.set_accel_noise_density_mps2_sqrthz(ip.accel_noise_density_mps2_sqrthz());
-  SetRigid(c_aw, -c_aw * r_wb0, truth.mutable_world_from_sim_world());
-  truth.set_inclination_deg(AngleDeg(n_w, up_w));
-  TILTCAL_RETURN_IF_ERROR(WriteTextProto(outputs.truth_path, truth));
-
-  if (!outputs.rig_path.empty()) {
-    const auto& rf = params.rig_file();
-    proto::Rig rig;
-    SetRigid(c_bl * geometry::RotationFromEuler123Deg(ToEigen(rf.rotation_error_deg())),
-             r_bl + ToEigen(rf.translation_error_m()), rig.mutable_imu_from_lidar());
-    rig.set_imu_height_m(params.rig().imu_height_m());
-    rig.set_imu_topic(ip.topic());
-    rig.set_lidar_topic(lp.topic());
-    rig.set_lidar_model(sc.model.name);
-    if (rf.write_gravity_flat()) SetVector(g_f, rig.mutable_gravity_flat_in_imu());
-    rig.set_gravity_reference(rf.gravity_reference());
-    TILTCAL_RETURN_IF_ERROR(WriteTextProto(outputs.rig_path, rig));
+  *truth.mutable_provenance() =
+      MakeProvenance("tiltcal_simulate", params, {}, paths.command_line);
+  FillSequenceTruth(params, scenario, frames, imu, &truth);
+  TILTCAL_RETURN_IF_ERROR(WriteTextProto(paths.out_truth, truth));
+  if (!paths.out_rig.empty()) {
+    TILTCAL_RETURN_IF_ERROR(WriteTextProto(paths.out_rig, MakeRig(params, scenario, frames)));
   }
 
-  if (summary != nullptr) {
-    summary->num_imu_samples = scenario.num_imu_samples;
-    summary->num_scans = num_scans;
-    summary->num_points = num_points;
-    summary->bag_bytes = writer.bytes_written();
-    summary->raycast_seconds = raycast_seconds;
-    summary->total_seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-  }
+  summary.num_imu_samples = scenario.num_imu_samples;
+  summary.num_scans = scenario.num_scans;
+  summary.bag_bytes = writer.bytes_written();
+  summary.total_seconds = std::chrono::duration<double>(Clock::now() - wall_start).count();
+  PrintSummary(log, summary);
   return Status::Ok();
 }
 

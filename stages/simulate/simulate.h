@@ -2,8 +2,8 @@
 #define TILTCAL_STAGES_SIMULATE_SIMULATE_H_
 
 #include <cstdint>
-#include <functional>
 #include <memory>
+#include <ostream>
 #include <string>
 
 #include <Eigen/Core>
@@ -17,29 +17,21 @@
 
 namespace tiltcal::simulate {
 
-struct SimulateOutputs {
-  std::string bag_path;    // required
-  std::string truth_path;  // required
-  std::string rig_path;    // optional ("" = none)
+// Every path of one simulate run.
+struct SimulatePaths {
+  std::string params;     // the scenario file, for the provenance
+  std::string out_bag;    // required
+  std::string out_truth;  // required
+  std::string out_rig;    // optional ("" = none)
   std::string command_line;
-  // Called after each written scan (done, total) when set.
-  std::function<void(int, int)> progress;
-};
-
-struct SimulateSummary {
-  int num_imu_samples = 0;
-  int num_scans = 0;
-  uint64_t num_points = 0;
-  uint64_t bag_bytes = 0;
-  double raycast_seconds = 0.0;  // wall time in ray casting + serialization
-  double total_seconds = 0.0;
 };
 
 // Simulates the scenario and writes the bag (IMU + LiDAR), the truth file and
 // optionally a rig file. The bag bytes depend only on `params` (same seed,
 // same bytes, for any num_threads). `params` must have passed LoadParams.
-Status Run(const proto::SimulateParams& params, const SimulateOutputs& outputs,
-           SimulateSummary* summary);
+// `log` receives the progress (only when it is a terminal) and a one-line
+// summary; nullptr = silent.
+Status Run(const SimulatePaths& paths, const proto::SimulateParams& params, std::ostream* log);
 
 // The scene, motion and sensors a params file describes (I/O-free; tests
 // use it to evaluate the true trajectory).

@@ -43,6 +43,36 @@ inline double CircleEntry(double ox, double oy, double dx, double dy, double cx,
   return (-b - sq) / a;
 }
 
+// Slab test of the ray (o, d) against the box (from 1e6 m below the ground
+// up to its top): the entry parameter and *entry_axis, the axis whose face
+// it enters through; *entry_axis stays -1 when the ray misses the box or
+// starts inside it.
+double BoxEntry(const Box& box, const Eigen::Vector3d& o, const Eigen::Vector3d& d,
+                int* entry_axis) {
+  double t0 = -std::numeric_limits<double>::infinity();
+  double t1 = std::numeric_limits<double>::infinity();
+  int axis_of_t0 = -1;
+  const double lo[3] = {box.min_x, box.min_y, -1e6};
+  const double hi[3] = {box.max_x, box.max_y, box.top_z};
+  for (int axis = 0; axis < 3; ++axis) {
+    if (std::abs(d[axis]) < 1e-15) {
+      if (o[axis] < lo[axis] || o[axis] > hi[axis]) return t0;
+      continue;
+    }
+    double ta = (lo[axis] - o[axis]) / d[axis];
+    double tb = (hi[axis] - o[axis]) / d[axis];
+    if (ta > tb) std::swap(ta, tb);
+    if (ta > t0) {
+      t0 = ta;
+      axis_of_t0 = axis;
+    }
+    t1 = std::min(t1, tb);
+    if (t0 > t1) return t0;
+  }
+  *entry_axis = axis_of_t0;
+  return t0;
+}
+
 }  // namespace
 
 bool World::Cast(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double min_range,
@@ -89,35 +119,9 @@ bool World::Cast(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double min_
     const double entry = CircleEntry(o.x(), o.y(), d.x(), d.y(), bound.cx, bound.cy,
                                      bound.radius, &exit);
     if (!(entry < best) || exit < min_range) continue;
-    const Box& box = boxes_[i];
-    double t0 = -std::numeric_limits<double>::infinity();
-    double t1 = std::numeric_limits<double>::infinity();
     int entry_axis = -1;
-    bool miss = false;
-    const double lo[3] = {box.min_x, box.min_y, -1e6};
-    const double hi[3] = {box.max_x, box.max_y, box.top_z};
-    for (int axis = 0; axis < 3; ++axis) {
-      if (std::abs(d[axis]) < 1e-15) {
-        if (o[axis] < lo[axis] || o[axis] > hi[axis]) {
-          miss = true;
-          break;
-        }
-        continue;
-      }
-      double ta = (lo[axis] - o[axis]) / d[axis];
-      double tb = (hi[axis] - o[axis]) / d[axis];
-      if (ta > tb) std::swap(ta, tb);
-      if (ta > t0) {
-        t0 = ta;
-        entry_axis = axis;
-      }
-      t1 = std::min(t1, tb);
-      if (t0 > t1) {
-        miss = true;
-        break;
-      }
-    }
-    if (miss || entry_axis < 0 || t0 < min_range || t0 > best) continue;
+    const double t0 = BoxEntry(boxes_[i], o, d, &entry_axis);
+    if (entry_axis < 0 || t0 < min_range || t0 > best) continue;
     best = t0;
     surface = Surface::kBox;
     normal = Eigen::Vector3d::Zero();

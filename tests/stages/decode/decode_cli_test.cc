@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "tests/stages/decode/decode_test_util.h"
+#include "tests/bag/ros1/bag_test_util.h"
 #include "tests/testing/test_env.h"
 
 namespace tiltcal {

@@ -5,8 +5,12 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
+
+#include "bag/ros1/message_encoding.h"
 
 namespace tiltcal {
 namespace {
@@ -288,6 +292,44 @@ TEST(PointCloudConversion, LayoutErrors) {
     Status s = Convert(b, &scan);
     ASSERT_FALSE(s.ok());
     EXPECT_NE(s.message().find("offsets must stay within"), std::string::npos) << s.message();
+  }
+}
+
+// Byte flips of a serialized cloud: whatever still decodes converts without
+// a crash and never yields more points than the cloud has.
+TEST(PointCloudConversion, CorruptedCloudsNeverCrash) {
+  const std::vector<PointField> fields = {{"x", 0, ros1::kFloat32, 1},
+                                          {"y", 4, ros1::kFloat32, 1},
+                                          {"z", 8, ros1::kFloat32, 1},
+                                          {"time", 12, ros1::kFloat32, 1}};
+  std::string data;
+  for (int i = 0; i < 24; ++i) ros1::AppendLe<float>(&data, 0.05f * i - 0.3f);
+  std::string good;
+  ASSERT_TRUE(ros1::SerializePointCloud2(7, 1700000000000000000, "l", 2, 3, fields, 16, data,
+                                         /*is_dense=*/true, &good));
+  {
+    PointCloud2View cloud;
+    ASSERT_TRUE(ros1::DecodePointCloud2(reinterpret_cast<const uint8_t*>(good.data()), good.size(),
+                                        &cloud)
+                    .ok());
+    proto::Scan scan;
+    Status status = ConvertPointCloud2ToScan(cloud, PointConversionOptions{}, &scan);
+    ASSERT_TRUE(status.ok()) << status.message();
+    EXPECT_EQ(scan.x_size() + scan.num_dropped_zero_range() + scan.num_dropped_invalid(), 6u);
+  }
+  for (size_t i = 0; i < good.size(); ++i) {
+    for (uint8_t flip : {0x01, 0x80, 0xFF}) {
+      std::string b = good;
+      b[i] = static_cast<char>(b[i] ^ flip);
+      PointCloud2View cloud;
+      if (!ros1::DecodePointCloud2(reinterpret_cast<const uint8_t*>(b.data()), b.size(), &cloud)
+               .ok()) {
+        continue;
+      }
+      proto::Scan scan;
+      (void)ConvertPointCloud2ToScan(cloud, PointConversionOptions{}, &scan);
+      EXPECT_LE(scan.x_size(), 6);
+    }
   }
 }
 

@@ -11,9 +11,9 @@
 
 #include <gtest/gtest.h>
 
+#include "bag/ros1/bag_reader.h"
+#include "bag/ros1/messages.h"
 #include "stages/decode/point_cloud_conversion.h"
-#include "stages/decode/ros1_bag_reader.h"
-#include "stages/decode/ros1_messages.h"
 #include "tests/testing/test_env.h"
 
 namespace tiltcal {
@@ -217,7 +217,7 @@ TEST(PointCloudFastPath, SameBytesOnFixtureBagClouds) {
                            "rosbagjs_example-lz4.bag", "rosbagjs_example-bz2.bag"}) {
     const std::string path = dir + "/bags/ros1/" + name;
     if (!testing::FileExists(path)) continue;
-    ros1::Ros1BagReader reader;
+    ros1::BagReader reader;
     ASSERT_TRUE(reader.Open(path).ok()) << path;
     ros1::ReadOptions options;
     options.topics = reader.TopicsOfType("sensor_msgs/PointCloud2");

@@ -9,10 +9,10 @@
 
 #include <gtest/gtest.h>
 
+#include "bag/ros1/bag_reader.h"
+#include "bag/ros1/messages.h"
 #include "stages/decode/point_cloud_conversion.h"
-#include "stages/decode/ros1_bag_reader.h"
-#include "stages/decode/ros1_messages.h"
-#include "tests/stages/decode/decode_test_util.h"
+#include "tests/bag/ros1/bag_test_util.h"
 #include "tests/testing/test_env.h"
 
 namespace tiltcal {
@@ -49,7 +49,7 @@ struct RawMessage {
 };
 
 std::vector<RawMessage> ReadAll(const std::string& path, const std::string& topic = "") {
-  ros1::Ros1BagReader reader;
+  ros1::BagReader reader;
   Status status = reader.Open(path);
   EXPECT_TRUE(status.ok()) << status.message();
   std::vector<RawMessage> out;
@@ -115,7 +115,7 @@ TEST(Ros1FixtureBags, UnsortedChunksComeOutInTimeOrder) {
 
 TEST(Ros1FixtureBags, NoMessagesBagOpensEmpty) {
   REQUIRE_FIXTURE(path, "rosbagjs_no-messages.bag");
-  ros1::Ros1BagReader reader;
+  ros1::BagReader reader;
   Status status = reader.Open(path);
   ASSERT_TRUE(status.ok()) << status.message();
   EXPECT_TRUE(reader.indexed());
@@ -136,7 +136,7 @@ TEST(Ros1FixtureBags, NoMessagesBagOpensEmpty) {
 void CompareImuWithOracle(const std::string& path, const std::string& topic,
                           size_t expected_count, int64_t expected_first_stamp_ns,
                           const std::string& expected_frame) {
-  ros1::Ros1BagReader reader;
+  ros1::BagReader reader;
   Status status = reader.Open(path);
   ASSERT_TRUE(status.ok()) << status.message();
   EXPECT_EQ(reader.TopicsOfType(ros1::kImuType), std::vector<std::string>{topic});
@@ -192,7 +192,7 @@ TEST(Ros1FixtureBags, CartographerImuMatchesRosbag) {
 void CompareCloudsWithOracle(const std::string& path, const std::string& topic,
                              size_t expected_clouds, uint32_t expected_point_step,
                              proto::PointTimeSource expected_source) {
-  ros1::Ros1BagReader reader;
+  ros1::BagReader reader;
   Status status = reader.Open(path);
   ASSERT_TRUE(status.ok()) << status.message();
   std::vector<proto::Scan> scans;
@@ -309,7 +309,7 @@ TEST(Ros1FixtureBags, RosNumpyPointCloud2MatchesRosbag) {
 
 TEST(Ros1FixtureBags, EmbagCloudsHaveTheDocumentedSize) {
   REQUIRE_FIXTURE(path, "embag_test_lz4_pointcloud2.bag");
-  ros1::Ros1BagReader reader;
+  ros1::BagReader reader;
   ASSERT_TRUE(reader.Open(path).ok());
   EXPECT_EQ(reader.MessageCount("/luminar_pointcloud"), 5);
   Status status = reader.ReadMessages({{"/luminar_pointcloud"}}, [&](const ros1::MessageView& m) {

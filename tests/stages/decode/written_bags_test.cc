@@ -14,7 +14,7 @@
 #include "common/io/record_stream.h"
 #include "common/io/text_proto.h"
 #include "stages/decode/decode.h"
-#include "tests/stages/decode/decode_test_util.h"
+#include "tests/bag/ros1/bag_test_util.h"
 #include "tests/testing/test_env.h"
 #include "tiltcal/proto/imu.pb.h"
 #include "tiltcal/proto/rig.pb.h"
@@ -128,13 +128,12 @@ class WrittenBags : public ::testing::Test {
 
   Status Decode(const std::string& bag, const proto::DecodeParams& params,
                 DecodeSummary* summary, const std::string& rig = "") {
-    DecodeInputs in;
-    in.bag_path = dir_ + "/" + bag;
-    in.rig_path = rig;
-    in.out_imu_path = tmp_.File("imu.binpb");
-    in.out_scans_path = tmp_.File("scans.binpb.lz4");
-    in.log = nullptr;
-    return ::tiltcal::Run(in, params, summary);
+    DecodePaths paths;
+    paths.bag = dir_ + "/" + bag;
+    paths.rig = rig;
+    paths.out_imu = tmp_.File("imu.binpb");
+    paths.out_scans = tmp_.File("scans.binpb.lz4");
+    return ::tiltcal::Decode(paths, params, /*log=*/nullptr, summary);
   }
 
   // Decodes `bag` and checks every output value against the expected file.

@@ -12,13 +12,13 @@
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
+#include "bag/ros1/message_encoding.h"
 #include "common/io/atomic_file.h"
 #include "common/io/params.h"
 #include "common/io/record_stream.h"
 #include "common/io/text_proto.h"
 #include "stages/simulate/point_cloud_layout.h"
-#include "stages/simulate/ros1_messages.h"
-#include "tests/stages/simulate/sim_bag_dump.h"
+#include "tests/bag/ros1/rosbag_oracle.h"
 #include "tests/testing/test_env.h"
 #include "tiltcal/proto/imu.pb.h"
 #include "tiltcal/proto/rig.pb.h"
@@ -27,10 +27,10 @@
 namespace tiltcal::simulate {
 namespace {
 
-using testing::BagDump;
-using testing::Crc32;
-using testing::DumpBagWithRosbag;
-using testing::DumpedMessage;
+using ros1::testing::BagDump;
+using ros1::testing::Crc32;
+using ros1::testing::DumpBagWithRosbag;
+using ros1::testing::DumpedMessage;
 using tiltcal::testing::TempDir;
 
 proto::SimulateParams ShortScenario() {
@@ -44,15 +44,14 @@ proto::SimulateParams ShortScenario() {
 // Runs the simulator; returns the truth.
 proto::SimulationTruth Simulate(const proto::SimulateParams& params, const TempDir& dir,
                                 const std::string& name) {
-  SimulateOutputs outputs;
-  outputs.bag_path = dir.File(name + ".bag");
-  outputs.truth_path = dir.File(name + "_truth.txtpb");
-  outputs.rig_path = dir.File(name + "_rig.txtpb");
-  SimulateSummary summary;
-  const Status status = Run(params, outputs, &summary);
+  SimulatePaths paths;
+  paths.out_bag = dir.File(name + ".bag");
+  paths.out_truth = dir.File(name + "_truth.txtpb");
+  paths.out_rig = dir.File(name + "_rig.txtpb");
+  const Status status = Run(paths, params, /*log=*/nullptr);
   EXPECT_TRUE(status.ok()) << status.message();
   proto::SimulationTruth truth;
-  EXPECT_TRUE(ReadTextProto(outputs.truth_path, &truth).ok());
+  EXPECT_TRUE(ReadTextProto(paths.out_truth, &truth).ok());
   return truth;
 }
 
@@ -122,7 +121,7 @@ TEST_P(SimulateRosbagTest, RealRosLibraryReadsEveryMessage) {
     ASSERT_EQ(m.imu[8], -1.0);  // no orientation
     // The bytes are our serialization of the values ROS decoded.
     std::string bytes;
-    ASSERT_TRUE(SerializeImu(m.seq, m.stamp_ns, m.frame_id,
+    ASSERT_TRUE(ros1::SerializeImu(m.seq, m.stamp_ns, m.frame_id,
                              Eigen::Vector3d(m.imu[0], m.imu[1], m.imu[2]),
                              Eigen::Vector3d(m.imu[3], m.imu[4], m.imu[5]), m.imu[6], m.imu[7],
                              &bytes));
@@ -468,35 +467,35 @@ TEST(SimulateTest, BadParamsAreAClearErrorAndLeaveNoOutput) {
   TempDir dir;
   proto::SimulateParams params = ShortScenario();
   params.mutable_lidar()->set_max_range_m(0.4);
-  SimulateOutputs outputs;
-  outputs.bag_path = dir.File("x.bag");
-  outputs.truth_path = dir.File("x.txtpb");
-  Status status = simulate::Run(params, outputs, nullptr);
+  SimulatePaths paths;
+  paths.out_bag = dir.File("x.bag");
+  paths.out_truth = dir.File("x.txtpb");
+  Status status = simulate::Run(paths, params, nullptr);
   EXPECT_FALSE(status.ok());
   EXPECT_NE(status.message().find("max_range_m"), std::string::npos) << status.message();
   params = ShortScenario();
   params.mutable_world()->set_room_half_size_m(5);
-  status = simulate::Run(params, outputs, nullptr);
+  status = simulate::Run(paths, params, nullptr);
   EXPECT_NE(status.message().find("room_half_size_m"), std::string::npos) << status.message();
   params = ShortScenario();
   params.mutable_rig()->set_imu_height_m(0.1);  // the LiDAR would be under the ground
   params.mutable_rig()->mutable_lidar_translation_in_imu_m()->set_z(0.4);
-  status = simulate::Run(params, outputs, nullptr);
+  status = simulate::Run(paths, params, nullptr);
   EXPECT_NE(status.message().find("above the ground"), std::string::npos) << status.message();
-  EXPECT_FALSE(tiltcal::testing::FileExists(outputs.bag_path));
-  EXPECT_FALSE(tiltcal::testing::FileExists(outputs.truth_path));
+  EXPECT_FALSE(tiltcal::testing::FileExists(paths.out_bag));
+  EXPECT_FALSE(tiltcal::testing::FileExists(paths.out_truth));
   // The command line reports the schema error with the field name, exit 1.
   const std::string tool = tiltcal::testing::ToolPath("tiltcal_simulate");
   if (tiltcal::testing::FileExists(tool)) {
     ASSERT_TRUE(WriteFileAtomically(dir.File("bad.txtpb"), "seed: 1\nduration_s: -3\n").ok());
     std::string output;
     EXPECT_EQ(tiltcal::testing::RunCommand(tool + " --params=" + dir.File("bad.txtpb") +
-                                               " --out_bag=" + outputs.bag_path +
-                                               " --out_truth=" + outputs.truth_path,
+                                               " --out_bag=" + paths.out_bag +
+                                               " --out_truth=" + paths.out_truth,
                                            &output),
               1);
     EXPECT_NE(output.find("duration_s"), std::string::npos) << output;
-    EXPECT_FALSE(tiltcal::testing::FileExists(outputs.bag_path));
+    EXPECT_FALSE(tiltcal::testing::FileExists(paths.out_bag));
   }
 }
 

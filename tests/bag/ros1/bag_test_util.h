@@ -1,5 +1,5 @@
-#ifndef TILTCAL_TESTS_STAGES_DECODE_DECODE_TEST_UTIL_H_
-#define TILTCAL_TESTS_STAGES_DECODE_DECODE_TEST_UTIL_H_
+#ifndef TILTCAL_TESTS_BAG_ROS1_BAG_TEST_UTIL_H_
+#define TILTCAL_TESTS_BAG_ROS1_BAG_TEST_UTIL_H_
 
 // Helpers of the decode tests: oracle output from Debian's python rosbag,
 // cached in the build tree (keyed by the script's contents) so that each test
@@ -103,4 +103,4 @@ inline std::vector<std::string> OracleDump(const std::string& bag, const std::st
 
 }  // namespace tiltcal::testing
 
-#endif  // TILTCAL_TESTS_STAGES_DECODE_DECODE_TEST_UTIL_H_
+#endif  // TILTCAL_TESTS_BAG_ROS1_BAG_TEST_UTIL_H_

@@ -1,10 +1,10 @@
-#include "stages/simulate/ros1_messages.h"
+#include "bag/ros1/message_encoding.h"
 
 #include <cstring>
 
-#include "stages/decode/ros1_format.h"
+#include "bag/ros1/format.h"
 
-namespace tiltcal::simulate {
+namespace tiltcal::ros1 {
 
 // Full message definitions as recorded by rosbag (the top-level .msg, then
 // each dependency after a line of 80 '=' and "MSG: pkg/Type"), from
@@ -135,29 +135,28 @@ uint8  datatype  # Datatype enumeration, see above
 uint32 count     # How many elements in the field
 )msgdef";
 
-const RosMessageType& ImuMessageType() {
-  static const RosMessageType kType{"sensor_msgs/Imu", "6a62c6daae103f4ff57a132d6f95cec2",
-                                    kImuDefinition};
+const MessageType& ImuMessageType() {
+  static const MessageType kType{kImuType, "6a62c6daae103f4ff57a132d6f95cec2", kImuDefinition};
   return kType;
 }
 
-const RosMessageType& PointCloud2MessageType() {
-  static const RosMessageType kType{"sensor_msgs/PointCloud2",
-                                    "1158d486dd51d683ce2f1be655c3c181", kPointCloud2Definition};
+const MessageType& PointCloud2MessageType() {
+  static const MessageType kType{kPointCloud2Type, "1158d486dd51d683ce2f1be655c3c181",
+                                 kPointCloud2Definition};
   return kType;
 }
 
 namespace {
 
 void AppendString(std::string* out, const std::string& s) {
-  ros1::AppendU32Le(out, static_cast<uint32_t>(s.size()));
+  AppendU32Le(out, static_cast<uint32_t>(s.size()));
   out->append(s);
 }
 
 void AppendVector3(std::string* out, const Eigen::Vector3d& v) {
-  ros1::AppendLe(out, v.x());
-  ros1::AppendLe(out, v.y());
-  ros1::AppendLe(out, v.z());
+  AppendLe(out, v.x());
+  AppendLe(out, v.y());
+  AppendLe(out, v.z());
 }
 
 // float64[9], diagonal.
@@ -165,17 +164,17 @@ void AppendCovariance(std::string* out, double diagonal, double first) {
   for (int i = 0; i < 9; ++i) {
     double value = (i % 4 == 0) ? diagonal : 0.0;
     if (i == 0) value = first;
-    ros1::AppendLe(out, value);
+    AppendLe(out, value);
   }
 }
 
 }  // namespace
 
 bool AppendHeader(std::string* out, uint32_t seq, int64_t stamp_ns, const std::string& frame_id) {
-  ros1::RosTime t;
-  if (!ros1::NsToRosTime(stamp_ns, &t)) return false;
-  ros1::AppendU32Le(out, seq);
-  ros1::AppendRosTime(out, t);
+  RosTime t;
+  if (!NsToRosTime(stamp_ns, &t)) return false;
+  AppendU32Le(out, seq);
+  AppendRosTime(out, t);
   AppendString(out, frame_id);
   return true;
 }
@@ -188,10 +187,10 @@ bool SerializeImu(uint32_t seq, int64_t stamp_ns, const std::string& frame_id,
   out->reserve(320 + frame_id.size());
   if (!AppendHeader(out, seq, stamp_ns, frame_id)) return false;
   // orientation (x, y, z, w): not provided.
-  ros1::AppendLe(out, 0.0);
-  ros1::AppendLe(out, 0.0);
-  ros1::AppendLe(out, 0.0);
-  ros1::AppendLe(out, 1.0);
+  AppendLe(out, 0.0);
+  AppendLe(out, 0.0);
+  AppendLe(out, 0.0);
+  AppendLe(out, 1.0);
   AppendCovariance(out, 0.0, -1.0);
   AppendVector3(out, angular_velocity_radps);
   AppendCovariance(out, gyro_variance, gyro_variance);
@@ -207,22 +206,22 @@ bool SerializePointCloud2(uint32_t seq, int64_t stamp_ns, const std::string& fra
   out->clear();
   out->reserve(data.size() + 64 + 32 * fields.size() + frame_id.size());
   if (!AppendHeader(out, seq, stamp_ns, frame_id)) return false;
-  ros1::AppendU32Le(out, height);
-  ros1::AppendU32Le(out, width);
-  ros1::AppendU32Le(out, static_cast<uint32_t>(fields.size()));
+  AppendU32Le(out, height);
+  AppendU32Le(out, width);
+  AppendU32Le(out, static_cast<uint32_t>(fields.size()));
   for (const PointField& f : fields) {
     AppendString(out, f.name);
-    ros1::AppendU32Le(out, f.offset);
+    AppendU32Le(out, f.offset);
     out->push_back(static_cast<char>(f.datatype));
-    ros1::AppendU32Le(out, f.count);
+    AppendU32Le(out, f.count);
   }
   out->push_back(0);  // is_bigendian
-  ros1::AppendU32Le(out, point_step);
-  ros1::AppendU32Le(out, width * point_step);  // row_step
-  ros1::AppendU32Le(out, static_cast<uint32_t>(data.size()));
+  AppendU32Le(out, point_step);
+  AppendU32Le(out, width * point_step);  // row_step
+  AppendU32Le(out, static_cast<uint32_t>(data.size()));
   out->append(data);
   out->push_back(is_dense ? 1 : 0);
   return true;
 }
 
-}  // namespace tiltcal::simulate
+}  // namespace tiltcal::ros1

@@ -1,4 +1,4 @@
-#include "tests/stages/simulate/sim_bag_dump.h"
+#include "tests/bag/ros1/rosbag_oracle.h"
 
 #include <cstdlib>
 #include <fstream>
@@ -6,7 +6,7 @@
 
 #include "tests/testing/test_env.h"
 
-namespace tiltcal::simulate::testing {
+namespace tiltcal::ros1::testing {
 
 std::vector<const DumpedMessage*> BagDump::Topic(const std::string& topic) const {
   std::vector<const DumpedMessage*> out;
@@ -93,4 +93,4 @@ bool DumpBagWithRosbag(const std::string& bag, const std::string& dump_path,
   return true;
 }
 
-}  // namespace tiltcal::simulate::testing
+}  // namespace tiltcal::ros1::testing

@@ -1,11 +1,11 @@
-#ifndef TILTCAL_TESTS_STAGES_SIMULATE_SIM_BAG_DUMP_H_
-#define TILTCAL_TESTS_STAGES_SIMULATE_SIM_BAG_DUMP_H_
+#ifndef TILTCAL_TESTS_BAG_ROS1_ROSBAG_ORACLE_H_
+#define TILTCAL_TESTS_BAG_ROS1_ROSBAG_ORACLE_H_
 
 #include <cstdint>
 #include <string>
 #include <vector>
 
-namespace tiltcal::simulate::testing {
+namespace tiltcal::ros1::testing {
 
 // What the real ROS library (tests/oracle/read_sim_bag.py, run with Debian's
 // /usr/bin/python3) found in a bag.
@@ -41,6 +41,6 @@ bool DumpBagWithRosbag(const std::string& bag, const std::string& dump_path,
 // CRC-32 (IEEE 802.3, as zlib.crc32) of bytes.
 uint32_t Crc32(const void* data, size_t size);
 
-}  // namespace tiltcal::simulate::testing
+}  // namespace tiltcal::ros1::testing
 
-#endif  // TILTCAL_TESTS_STAGES_SIMULATE_SIM_BAG_DUMP_H_
+#endif  // TILTCAL_TESTS_BAG_ROS1_ROSBAG_ORACLE_H_

@@ -1,7 +1,7 @@
-#ifndef TILTCAL_STAGES_DECODE_ROS1_BAG_READER_H_
-#define TILTCAL_STAGES_DECODE_ROS1_BAG_READER_H_
+#ifndef TILTCAL_BAG_ROS1_BAG_READER_H_
+#define TILTCAL_BAG_ROS1_BAG_READER_H_
 
-// Reader for ROS1 bags, format 2.0 (see ros1_format.h for the layout and
+// Reader for ROS1 bags, format 2.0 (see format.h for the layout and
 // ../shared/reference/bag-formats.md for the pitfalls), without ROS.
 //
 // Open() reads the bag header, the connection records and the chunk infos of
@@ -20,9 +20,9 @@
 #include <string>
 #include <vector>
 
+#include "bag/ros1/chunk_codec.h"
+#include "bag/ros1/format.h"
 #include "common/status.h"
-#include "stages/decode/chunk_decompressor.h"
-#include "stages/decode/ros1_format.h"
 
 namespace tiltcal::ros1 {
 
@@ -65,12 +65,12 @@ struct ReaderStats {
   uint64_t uncompressed_bytes = 0;      // bytes produced by decompression
 };
 
-class Ros1BagReader {
+class BagReader {
  public:
-  Ros1BagReader();
-  ~Ros1BagReader();
-  Ros1BagReader(const Ros1BagReader&) = delete;
-  Ros1BagReader& operator=(const Ros1BagReader&) = delete;
+  BagReader();
+  ~BagReader();
+  BagReader(const BagReader&) = delete;
+  BagReader& operator=(const BagReader&) = delete;
 
   // Opens `path` and reads its index (or scans it). Every error names the
   // file and, where it applies, the byte offset of the record at fault.
@@ -110,6 +110,13 @@ class Ros1BagReader {
   struct Chunk;
   struct Entry;
   class ChunkCache;
+  // One message to yield: its index entry and connection slot.
+  struct Item {
+    int64_t time_ns;
+    uint32_t chunk;
+    uint32_t offset;
+    uint32_t slot;
+  };
 
   Status Error(uint64_t pos, const std::string& what) const;
   Status ReadAt(uint64_t pos, size_t size, void* dst) const;
@@ -118,8 +125,34 @@ class Ros1BagReader {
   Status ReadRecordHeaderAt(uint64_t pos, std::string* buffer, RecordHeader* header,
                             uint64_t* data_pos, uint32_t* data_len) const;
   Status ReadIndexed(uint64_t index_pos, uint32_t conn_count, uint32_t chunk_count);
+  // The index section of an indexed bag: connection records from *pos (left
+  // just past them), then the chunk info records, then each chunk's header.
+  Status ReadConnectionRecords(uint32_t conn_count, uint64_t* pos);
+  Status ReadChunkInfos(uint32_t chunk_count, uint64_t pos);
+  Status ReadChunkHeaders();
   Status ReadChunkIndex(size_t chunk_index, const std::vector<size_t>& connection_slots);
+  // Reads the index entries of the connection slots not read yet.
+  Status LoadEntries(const std::vector<size_t>& slots);
+  // The entries of `slots` inside the time window of `options`, ordered by
+  // (time, chunk_pos, offset).
+  std::vector<Item> MergedItems(const std::vector<size_t>& slots,
+                                const ReadOptions& options) const;
   Status ScanUnindexed(uint64_t first_record_pos);
+  // The compression and size fields of a chunk record header.
+  static Status ParseChunkHeader(const RecordHeader& header, Chunk* chunk);
+  // Scan of an unindexed bag: reads the chunk record at `pos` and indexes its
+  // records; sets *stop (with salvage_note_ saying why) when nothing after
+  // it can be trusted. Errors only for I/O failures.
+  Status SalvageChunk(uint64_t pos, const RecordHeader& header, uint64_t data_pos,
+                      uint32_t data_len, bool* stop);
+  // The one dispatch of the records inside a chunk (`size` uncompressed bytes
+  // of chunk `chunk_index`): connection records add their connection, message
+  // data records an index entry. Another op is skipped, or ends the records
+  // of an `open` chunk (one whose size was never written). *end is the offset
+  // just past the last record taken.
+  Status IndexChunkRecords(const uint8_t* records, size_t size, uint32_t chunk_index, bool open,
+                           size_t* end);
+  void AddSalvagedEntry(uint32_t conn, RosTime time, uint32_t chunk, uint32_t offset);
   Status AddConnection(const RecordHeader& header, const uint8_t* data, size_t size,
                        uint64_t pos);
   // Loads chunk `chunk_index` decompressed into `dst` (sized to the chunk size).
@@ -146,4 +179,4 @@ class Ros1BagReader {
 
 }  // namespace tiltcal::ros1
 
-#endif  // TILTCAL_STAGES_DECODE_ROS1_BAG_READER_H_
+#endif  // TILTCAL_BAG_ROS1_BAG_READER_H_

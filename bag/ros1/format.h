@@ -1,9 +1,8 @@
-#ifndef TILTCAL_STAGES_DECODE_ROS1_FORMAT_H_
-#define TILTCAL_STAGES_DECODE_ROS1_FORMAT_H_
+#ifndef TILTCAL_BAG_ROS1_FORMAT_H_
+#define TILTCAL_BAG_ROS1_FORMAT_H_
 
 // Primitives of the ROS1 bag format 2.0 (wiki.ros.org/Bags/Format/2.0),
-// shared by the bag reader (tiltcal_decode) and the bag writer of
-// tiltcal_simulate. Nothing here does file I/O.
+// shared by the bag reader and the bag writer. Nothing here does file I/O.
 //
 // File layout:
 //   "#ROSBAG V2.0\n" · bag header record (padded so header_len + data_len = 4096)
@@ -54,7 +53,7 @@ enum class Op : uint8_t {
 const char* OpName(uint8_t op);
 
 // ---- Little-endian helpers (unaligned-safe: always memcpy). ----
-// The host is little-endian (checked in ros1_format.cc).
+// The host is little-endian (checked in format.cc).
 template <typename T>
 inline T LoadLe(const void* p) {
   T value;
@@ -141,4 +140,4 @@ void AppendRecord(std::string* out, const HeaderFields& fields, std::string_view
 
 }  // namespace tiltcal::ros1
 
-#endif  // TILTCAL_STAGES_DECODE_ROS1_FORMAT_H_
+#endif  // TILTCAL_BAG_ROS1_FORMAT_H_

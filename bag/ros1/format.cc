@@ -1,4 +1,4 @@
-#include "stages/decode/ros1_format.h"
+#include "bag/ros1/format.h"
 
 namespace tiltcal::ros1 {
 

@@ -1,21 +1,21 @@
 // The ROS1 bag writer, checked against the real ROS library: bags written
 // with each compression are read by Debian's python3-rosbag and every
 // message (raw bytes CRC, record time, header) must match what was written.
-#include "stages/simulate/ros1_bag_writer.h"
+#include "bag/ros1/bag_writer.h"
 
 #include <cstring>
+#include <random>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
 
+#include "bag/ros1/message_encoding.h"
 #include "common/io/atomic_file.h"
-#include "stages/simulate/random.h"
-#include "stages/simulate/ros1_messages.h"
-#include "tests/stages/simulate/sim_bag_dump.h"
+#include "tests/bag/ros1/rosbag_oracle.h"
 #include "tests/testing/test_env.h"
 
-namespace tiltcal::simulate {
+namespace tiltcal::ros1 {
 namespace {
 
 using testing::BagDump;
@@ -34,25 +34,26 @@ struct Written {
 
 // Writes a bag with an IMU topic, a topic without a leading slash and a
 // PointCloud2 topic larger than the chunk threshold; returns what was written.
-std::vector<Written> WriteTestBag(const std::string& path, Ros1BagWriter::Compression compression,
+std::vector<Written> WriteTestBag(const std::string& path, ChunkCompression compression,
                                   uint32_t chunk_threshold, unsigned compression_threads = 1) {
-  Ros1BagWriter writer;
+  BagWriter writer;
   EXPECT_TRUE(writer.Open(path, compression, chunk_threshold, compression_threads).ok());
-  const RosMessageType& imu = ImuMessageType();
-  const RosMessageType& cloud = PointCloud2MessageType();
+  const MessageType& imu = ImuMessageType();
+  const MessageType& cloud = PointCloud2MessageType();
   const uint32_t c_imu = writer.AddConnection("/imu/data", imu.type, imu.md5sum, imu.definition);
   const uint32_t c_raw = writer.AddConnection("imu_raw", imu.type, imu.md5sum, imu.definition);
   const uint32_t c_cloud =
       writer.AddConnection("/points", cloud.type, cloud.md5sum, cloud.definition);
-  Rng rng(42);
+  std::mt19937_64 rng(42);
+  std::normal_distribution<double> gaussian;
   std::vector<Written> written;
   const int64_t t0 = 1600000000123456789LL;
   for (int i = 0; i < 300; ++i) {
     const int64_t stamp = t0 + i * 5000000LL;
     Written w{i % 3 == 2 ? "imu_raw" : "/imu/data", stamp + 1000000, stamp,
               static_cast<uint32_t>(i), "imu_link", ""};
-    const Eigen::Vector3d omega(rng.Gaussian(), rng.Gaussian(), rng.Gaussian());
-    const Eigen::Vector3d accel(rng.Gaussian(), rng.Gaussian(), 9.81 + rng.Gaussian());
+    const Eigen::Vector3d omega(gaussian(rng), gaussian(rng), gaussian(rng));
+    const Eigen::Vector3d accel(gaussian(rng), gaussian(rng), 9.81 + gaussian(rng));
     EXPECT_TRUE(SerializeImu(w.seq, stamp, w.frame_id, omega, accel, 1e-6, 1e-4, &w.bytes));
     EXPECT_TRUE(writer.Write(i % 3 == 2 ? c_raw : c_imu, w.record_ns, w.bytes).ok());
     written.push_back(w);
@@ -60,7 +61,7 @@ std::vector<Written> WriteTestBag(const std::string& path, Ros1BagWriter::Compre
       // A cloud of random bytes (5000 points x 16 bytes): layout does not matter here.
       Written c{"/points", stamp + 2000000, stamp, static_cast<uint32_t>(i / 50), "lidar", ""};
       std::string data(5000 * 16, '\0');
-      for (char& b : data) b = static_cast<char>(rng.NextU64() & 0xFF);
+      for (char& b : data) b = static_cast<char>(rng() & 0xFF);
       const std::vector<PointField> fields = {{"x", 0, kFloat32, 1}, {"y", 4, kFloat32, 1},
                                               {"z", 8, kFloat32, 1}, {"t", 12, kUint32, 1}};
       EXPECT_TRUE(SerializePointCloud2(c.seq, stamp, c.frame_id, 1, 5000, fields, 16, data, true,
@@ -73,9 +74,9 @@ std::vector<Written> WriteTestBag(const std::string& path, Ros1BagWriter::Compre
   return written;
 }
 
-class Ros1BagWriterRosbagTest : public ::testing::TestWithParam<Ros1BagWriter::Compression> {};
+class BagWriterRosbagTest : public ::testing::TestWithParam<ChunkCompression> {};
 
-TEST_P(Ros1BagWriterRosbagTest, RealRosLibraryReadsEveryMessage) {
+TEST_P(BagWriterRosbagTest, RealRosLibraryReadsEveryMessage) {
   if (!tiltcal::testing::HaveRosbagPython()) {
     GTEST_SKIP() << "Debian python3-rosbag (/usr/bin/python3) is not installed";
   }
@@ -85,7 +86,7 @@ TEST_P(Ros1BagWriterRosbagTest, RealRosLibraryReadsEveryMessage) {
   BagDump dump;
   std::string error;
   ASSERT_TRUE(DumpBagWithRosbag(bag, dir.File("dump.txt"), {}, &dump, &error)) << error;
-  EXPECT_EQ(dump.compression, Ros1BagWriter::CompressionName(GetParam()));
+  EXPECT_EQ(dump.compression, ChunkCompressionName(GetParam()));
   for (const std::string topic : {"/imu/data", "imu_raw", "/points"}) {
     std::vector<const Written*> expected;
     for (const Written& w : written) {
@@ -105,18 +106,17 @@ TEST_P(Ros1BagWriterRosbagTest, RealRosLibraryReadsEveryMessage) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Compressions, Ros1BagWriterRosbagTest,
-                         ::testing::Values(Ros1BagWriter::Compression::kNone,
-                                           Ros1BagWriter::Compression::kBz2,
-                                           Ros1BagWriter::Compression::kLz4),
+INSTANTIATE_TEST_SUITE_P(Compressions, BagWriterRosbagTest,
+                         ::testing::Values(ChunkCompression::kNone, ChunkCompression::kBz2,
+                                           ChunkCompression::kLz4),
                          [](const auto& info) {
-                           return std::string(Ros1BagWriter::CompressionName(info.param));
+                           return std::string(ChunkCompressionName(info.param));
                          });
 
-TEST(Ros1BagWriterTest, LayoutOfTheFileStart) {
+TEST(BagWriterTest, LayoutOfTheFileStart) {
   TempDir dir;
   const std::string bag = dir.File("layout.bag");
-  WriteTestBag(bag, Ros1BagWriter::Compression::kLz4, 1 << 20);
+  WriteTestBag(bag, ChunkCompression::kLz4, 1 << 20);
   std::string bytes;
   ASSERT_TRUE(ReadFileToString(bag, &bytes).ok());
   ASSERT_GT(bytes.size(), 4200u);
@@ -139,25 +139,25 @@ TEST(Ros1BagWriterTest, LayoutOfTheFileStart) {
   EXPECT_EQ(d[5], 0x60);
 }
 
-TEST(Ros1BagWriterTest, CompressionThreadsDoNotChangeTheBytes) {
+TEST(BagWriterTest, CompressionThreadsDoNotChangeTheBytes) {
   TempDir dir;
-  for (const auto c : {Ros1BagWriter::Compression::kBz2, Ros1BagWriter::Compression::kLz4}) {
+  for (const auto c : {ChunkCompression::kBz2, ChunkCompression::kLz4}) {
     WriteTestBag(dir.File("one.bag"), c, 4096, 1);
     WriteTestBag(dir.File("four.bag"), c, 4096, 4);
     std::string one, four;
     ASSERT_TRUE(ReadFileToString(dir.File("one.bag"), &one).ok());
     ASSERT_TRUE(ReadFileToString(dir.File("four.bag"), &four).ok());
-    EXPECT_TRUE(one == four) << Ros1BagWriter::CompressionName(c);
+    EXPECT_TRUE(one == four) << ChunkCompressionName(c);
   }
 }
 
-TEST(Ros1BagWriterTest, NothingIsLeftWithoutClose) {
+TEST(BagWriterTest, NothingIsLeftWithoutClose) {
   TempDir dir;
   const std::string bag = dir.File("unfinished.bag");
   {
-    Ros1BagWriter writer;
-    ASSERT_TRUE(writer.Open(bag, Ros1BagWriter::Compression::kNone, 4096).ok());
-    const RosMessageType& imu = ImuMessageType();
+    BagWriter writer;
+    ASSERT_TRUE(writer.Open(bag, ChunkCompression::kNone, 4096).ok());
+    const MessageType& imu = ImuMessageType();
     const uint32_t c = writer.AddConnection("/imu", imu.type, imu.md5sum, imu.definition);
     std::string msg;
     ASSERT_TRUE(SerializeImu(0, 1000000000, "imu", Eigen::Vector3d::Zero(),
@@ -167,15 +167,15 @@ TEST(Ros1BagWriterTest, NothingIsLeftWithoutClose) {
   EXPECT_FALSE(tiltcal::testing::FileExists(bag));
 }
 
-TEST(Ros1BagWriterTest, RejectsTimesOutsideRosTime) {
+TEST(BagWriterTest, RejectsTimesOutsideRosTime) {
   TempDir dir;
-  Ros1BagWriter writer;
-  ASSERT_TRUE(writer.Open(dir.File("bad.bag"), Ros1BagWriter::Compression::kNone, 4096).ok());
-  const RosMessageType& imu = ImuMessageType();
+  BagWriter writer;
+  ASSERT_TRUE(writer.Open(dir.File("bad.bag"), ChunkCompression::kNone, 4096).ok());
+  const MessageType& imu = ImuMessageType();
   const uint32_t c = writer.AddConnection("/imu", imu.type, imu.md5sum, imu.definition);
   EXPECT_FALSE(writer.Write(c, -5, "x").ok());
   EXPECT_FALSE(writer.Write(c + 7, 5, "x").ok());
 }
 
 }  // namespace
-}  // namespace tiltcal::simulate
+}  // namespace tiltcal::ros1

@@ -1,7 +1,7 @@
 // lz4 chunks as roslz4 writes them (one LZ4 frame, content checksum, no
 // block checksums) and with block checksums: decoded exactly, and every
 // single corrupted byte of the frame is reported as an error.
-#include "stages/decode/chunk_decompressor.h"
+#include "bag/ros1/chunk_codec.h"
 
 #include <lz4frame.h>
 

@@ -1,9 +1,10 @@
-#ifndef TILTCAL_STAGES_DECODE_ROS1_MESSAGES_H_
-#define TILTCAL_STAGES_DECODE_ROS1_MESSAGES_H_
+#ifndef TILTCAL_BAG_ROS1_MESSAGES_H_
+#define TILTCAL_BAG_ROS1_MESSAGES_H_
 
-// Decoding of sensor_msgs/Imu and sensor_msgs/PointCloud2 from the ROS1 wire
-// format: little-endian, no padding, string = u32 length + bytes, T[] = u32
-// count + elements, T[N] = N elements, time = u32 sec + u32 nsec.
+// The layouts of sensor_msgs/Imu, sensor_msgs/PointCloud2 and PointField,
+// and their decoding from the ROS1 wire format: little-endian, no padding,
+// string = u32 length + bytes, T[] = u32 count + elements, T[N] = N
+// elements, time = u32 sec + u32 nsec. Encoding: message_encoding.h.
 // Every read is bounds-checked; a message that runs past its record is an
 // error saying which field did (the caller adds file, topic and index).
 
@@ -12,8 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "bag/ros1/format.h"
 #include "common/status.h"
-#include "stages/decode/ros1_format.h"
 
 namespace tiltcal::ros1 {
 
@@ -83,4 +84,4 @@ Status DecodePointCloud2(const uint8_t* data, size_t size, PointCloud2View* clou
 
 }  // namespace tiltcal::ros1
 
-#endif  // TILTCAL_STAGES_DECODE_ROS1_MESSAGES_H_
+#endif  // TILTCAL_BAG_ROS1_MESSAGES_H_

@@ -1,5 +1,5 @@
-#ifndef TILTCAL_STAGES_SIMULATE_ROS1_BAG_WRITER_H_
-#define TILTCAL_STAGES_SIMULATE_ROS1_BAG_WRITER_H_
+#ifndef TILTCAL_BAG_ROS1_BAG_WRITER_H_
+#define TILTCAL_BAG_ROS1_BAG_WRITER_H_
 
 #include <cstdint>
 #include <map>
@@ -8,13 +8,14 @@
 #include <string_view>
 #include <vector>
 
+#include "bag/ros1/chunk_codec.h"
 #include "common/io/atomic_file.h"
 #include "common/status.h"
 
-namespace tiltcal::simulate {
+namespace tiltcal::ros1 {
 
 // Writes a ROS1 bag, format 2.0, as ros_comm's rosbag does
-// (wiki.ros.org/Bags/Format/2.0; record primitives in stages/decode/ros1_format.h):
+// (wiki.ros.org/Bags/Format/2.0; record primitives in bag/ros1/format.h):
 //   version line · bag header (padded to 4096 bytes, rewritten on Close) ·
 //   { chunk (connection records on first use + message data records),
 //     compressed none / bz2 / lz4 (one LZ4 frame, 1 MiB independent blocks,
@@ -23,18 +24,16 @@ namespace tiltcal::simulate {
 // A chunk is closed when its uncompressed size reaches the threshold. The
 // output is written atomically: nothing is left at `path` unless Close()
 // succeeds. The bytes depend only on the calls made (no clock, no host data).
-class Ros1BagWriter {
+class BagWriter {
  public:
-  enum class Compression { kNone, kBz2, kLz4 };
-
-  Ros1BagWriter() = default;
-  Ros1BagWriter(const Ros1BagWriter&) = delete;
-  Ros1BagWriter& operator=(const Ros1BagWriter&) = delete;
+  BagWriter() = default;
+  BagWriter(const BagWriter&) = delete;
+  BagWriter& operator=(const BagWriter&) = delete;
 
   // `compression_threads` chunks are compressed in parallel (bz2 is slow);
   // the bytes do not depend on it.
-  Status Open(const std::string& path, Compression compression, uint32_t chunk_threshold_bytes,
-              unsigned compression_threads = 1);
+  Status Open(const std::string& path, ChunkCompression compression,
+              uint32_t chunk_threshold_bytes, unsigned compression_threads = 1);
   // Registers a connection (topic, message type); returns its id.
   uint32_t AddConnection(const std::string& topic, const std::string& type,
                          const std::string& md5sum, const std::string& definition);
@@ -44,7 +43,6 @@ class Ros1BagWriter {
   Status Close();
 
   uint64_t bytes_written() const { return position_; }
-  static const char* CompressionName(Compression compression);
 
  private:
   struct Connection {
@@ -77,7 +75,7 @@ class Ros1BagWriter {
 
   AtomicFile file_;
   std::string path_;
-  Compression compression_ = Compression::kNone;
+  ChunkCompression compression_ = ChunkCompression::kNone;
   uint32_t chunk_threshold_ = 768 * 1024;
   uint64_t position_ = 0;
   std::vector<Connection> connections_;
@@ -90,6 +88,6 @@ class Ros1BagWriter {
   bool open_ = false;
 };
 
-}  // namespace tiltcal::simulate
+}  // namespace tiltcal::ros1
 
-#endif  // TILTCAL_STAGES_SIMULATE_ROS1_BAG_WRITER_H_
+#endif  // TILTCAL_BAG_ROS1_BAG_WRITER_H_

@@ -1,4 +1,4 @@
-#include "stages/decode/ros1_messages.h"
+#include "bag/ros1/messages.h"
 
 #include <cstring>
 

@@ -1,4 +1,4 @@
-#include "stages/decode/ros1_bag_reader.h"
+#include "bag/ros1/bag_reader.h"
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -14,7 +14,7 @@
 namespace tiltcal::ros1 {
 
 // A chunk record: where its data is and how to decompress it.
-struct Ros1BagReader::Chunk {
+struct BagReader::Chunk {
   uint64_t pos = 0;        // file offset of the chunk record
   uint64_t data_pos = 0;   // file offset of its (compressed) data
   uint32_t data_len = 0;   // compressed bytes
@@ -26,7 +26,7 @@ struct Ros1BagReader::Chunk {
 };
 
 // Where one message record is: 16 bytes per message.
-struct Ros1BagReader::Entry {
+struct BagReader::Entry {
   int64_t time_ns;
   uint32_t chunk;   // index into chunks_ (sorted by file position)
   uint32_t offset;  // record offset in the uncompressed chunk
@@ -61,13 +61,29 @@ std::string Quoted(const std::string& s) { return "'" + s + "'"; }
 
 }  // namespace
 
+// Reads the fields of a chunk record header: compression and uncompressed size.
+Status BagReader::ParseChunkHeader(const RecordHeader& header, Chunk* chunk) {
+  std::string compression;
+  TILTCAL_RETURN_IF_ERROR(header.GetString("compression", &compression));
+  TILTCAL_RETURN_IF_ERROR(header.GetU32("size", &chunk->size));
+  if (!ParseChunkCompression(compression, &chunk->compression)) {
+    return Status::Error("unsupported chunk compression " + Quoted(compression) +
+                         " (supported: none, bz2, lz4)");
+  }
+  if (chunk->size > kMaxChunkBytes) {
+    return Status::Error("implausible uncompressed size " + std::to_string(chunk->size) +
+                         " (> 1 GiB; corrupt bag?)");
+  }
+  return Status::Ok();
+}
+
 // LRU cache of decompressed chunks, keyed by chunk index.
-class Ros1BagReader::ChunkCache {
+class BagReader::ChunkCache {
  public:
   explicit ChunkCache(size_t capacity) : slots_(std::max<size_t>(capacity, 1)) {}
 
   // The decompressed bytes of chunk `chunk`, loading it on a miss.
-  Status Get(Ros1BagReader* reader, uint32_t chunk, const uint8_t** data) {
+  Status Get(BagReader* reader, uint32_t chunk, const uint8_t** data) {
     ++clock_;
     Slot* victim = &slots_[0];
     for (Slot& slot : slots_) {
@@ -98,17 +114,17 @@ class Ros1BagReader::ChunkCache {
   uint64_t clock_ = 0;
 };
 
-Ros1BagReader::Ros1BagReader() = default;
+BagReader::BagReader() = default;
 
-Ros1BagReader::~Ros1BagReader() {
+BagReader::~BagReader() {
   if (fd_ >= 0) ::close(fd_);
 }
 
-Status Ros1BagReader::Error(uint64_t pos, const std::string& what) const {
+Status BagReader::Error(uint64_t pos, const std::string& what) const {
   return Status::Error(path_ + ": record at byte " + std::to_string(pos) + ": " + what);
 }
 
-Status Ros1BagReader::ReadAt(uint64_t pos, size_t size, void* dst) const {
+Status BagReader::ReadAt(uint64_t pos, size_t size, void* dst) const {
   if (pos > file_size_ || size > file_size_ - pos) {
     return Status::Error(path_ + ": read of " + std::to_string(size) + " bytes at byte " +
                          std::to_string(pos) + " runs past the end of the file (" +
@@ -128,9 +144,8 @@ Status Ros1BagReader::ReadAt(uint64_t pos, size_t size, void* dst) const {
   return Status::Ok();
 }
 
-Status Ros1BagReader::ReadRecordHeaderAt(uint64_t pos, std::string* buffer,
-                                         RecordHeader* header, uint64_t* data_pos,
-                                         uint32_t* data_len) const {
+Status BagReader::ReadRecordHeaderAt(uint64_t pos, std::string* buffer, RecordHeader* header,
+                                     uint64_t* data_pos, uint32_t* data_len) const {
   if (pos > file_size_ || file_size_ - pos < 8) {
     return Error(pos, "record runs past the end of the file (" + std::to_string(file_size_) +
                           " bytes; truncated?)");
@@ -160,15 +175,15 @@ Status Ros1BagReader::ReadRecordHeaderAt(uint64_t pos, std::string* buffer,
   return Status::Ok();
 }
 
-int Ros1BagReader::ConnectionSlot(uint32_t id) const {
+int BagReader::ConnectionSlot(uint32_t id) const {
   for (size_t i = 0; i < connections_.size(); ++i) {
     if (connections_[i].id == id) return static_cast<int>(i);
   }
   return -1;
 }
 
-Status Ros1BagReader::AddConnection(const RecordHeader& header, const uint8_t* data,
-                                    size_t size, uint64_t pos) {
+Status BagReader::AddConnection(const RecordHeader& header, const uint8_t* data, size_t size,
+                                uint64_t pos) {
   Connection connection;
   Status status = header.GetU32("conn", &connection.id);
   if (status.ok()) status = header.GetString("topic", &connection.topic);
@@ -190,7 +205,7 @@ Status Ros1BagReader::AddConnection(const RecordHeader& header, const uint8_t* d
   return Status::Ok();
 }
 
-Status Ros1BagReader::Open(const std::string& path) {
+Status BagReader::Open(const std::string& path) {
   path_ = path;
   fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd_ < 0) return Status::Error(path + ": cannot open: " + std::strerror(errno));
@@ -261,35 +276,53 @@ Status Ros1BagReader::Open(const std::string& path) {
   return ReadIndexed(index_pos, conn_count, chunk_count);
 }
 
-Status Ros1BagReader::ReadIndexed(uint64_t index_pos, uint32_t conn_count,
-                                  uint32_t chunk_count) {
+Status BagReader::ReadIndexed(uint64_t index_pos, uint32_t conn_count, uint32_t chunk_count) {
   if (index_pos > file_size_) {
     return Status::Error(path_ + ": bag is truncated: its index at byte " +
                          std::to_string(index_pos) + " lies past the end of the file (" +
                          std::to_string(file_size_) + " bytes)");
   }
+  uint64_t pos = index_pos;
+  TILTCAL_RETURN_IF_ERROR(ReadConnectionRecords(conn_count, &pos));
+  TILTCAL_RETURN_IF_ERROR(ReadChunkInfos(chunk_count, pos));
+  TILTCAL_RETURN_IF_ERROR(ReadChunkHeaders());
+  std::sort(chunks_.begin(), chunks_.end(),
+            [](const Chunk& a, const Chunk& b) { return a.pos < b.pos; });
+  return Status::Ok();
+}
+
+Status BagReader::ReadConnectionRecords(uint32_t conn_count, uint64_t* pos) {
   std::string buffer;
   std::string data;
   RecordHeader header;
-  uint64_t pos = index_pos;
   uint64_t data_pos = 0;
   uint32_t data_len = 0;
   uint8_t op = 0;
   for (uint32_t i = 0; i < conn_count; ++i) {
-    TILTCAL_RETURN_IF_ERROR(ReadRecordHeaderAt(pos, &buffer, &header, &data_pos, &data_len));
+    TILTCAL_RETURN_IF_ERROR(ReadRecordHeaderAt(*pos, &buffer, &header, &data_pos, &data_len));
     Status status = header.GetOp(&op);
-    if (!status.ok()) return Error(pos, status.message());
+    if (!status.ok()) return Error(*pos, status.message());
     if (op != static_cast<uint8_t>(Op::kConnection)) {
-      return Error(pos, "expected connection record " + std::to_string(i + 1) + " of " +
+      return Error(*pos, "expected connection record " + std::to_string(i + 1) + " of " +
                             std::to_string(conn_count) + ", found op " + std::to_string(op) +
                             " (" + OpName(op) + ")");
     }
     data.resize(data_len);
     TILTCAL_RETURN_IF_ERROR(ReadAt(data_pos, data_len, data.data()));
     TILTCAL_RETURN_IF_ERROR(AddConnection(
-        header, reinterpret_cast<const uint8_t*>(data.data()), data.size(), pos));
-    pos = data_pos + data_len;
+        header, reinterpret_cast<const uint8_t*>(data.data()), data.size(), *pos));
+    *pos = data_pos + data_len;
   }
+  return Status::Ok();
+}
+
+Status BagReader::ReadChunkInfos(uint32_t chunk_count, uint64_t pos) {
+  std::string buffer;
+  std::string data;
+  RecordHeader header;
+  uint64_t data_pos = 0;
+  uint32_t data_len = 0;
+  uint8_t op = 0;
   std::set<uint64_t> chunk_positions;
   for (uint32_t i = 0; i < chunk_count; ++i) {
     TILTCAL_RETURN_IF_ERROR(ReadRecordHeaderAt(pos, &buffer, &header, &data_pos, &data_len));
@@ -342,26 +375,23 @@ Status Ros1BagReader::ReadIndexed(uint64_t index_pos, uint32_t conn_count,
     chunks_.push_back(std::move(chunk));
     pos = data_pos + data_len;
   }
-  // Chunk headers: compression, sizes; index data records follow the data.
+  return Status::Ok();
+}
+
+// Chunk headers: compression, sizes; index data records follow the data.
+Status BagReader::ReadChunkHeaders() {
+  std::string buffer;
+  RecordHeader header;
+  uint8_t op = 0;
   for (Chunk& chunk : chunks_) {
     TILTCAL_RETURN_IF_ERROR(
         ReadRecordHeaderAt(chunk.pos, &buffer, &header, &chunk.data_pos, &chunk.data_len));
-    std::string compression;
     Status status = header.GetOp(&op);
     if (status.ok() && op != static_cast<uint8_t>(Op::kChunk)) {
       status = Status::Error("chunk info points to a record with op " + std::to_string(op) +
                              " (" + OpName(op) + "), not a chunk");
     }
-    if (status.ok()) status = header.GetString("compression", &compression);
-    if (status.ok()) status = header.GetU32("size", &chunk.size);
-    if (status.ok() && !ParseChunkCompression(compression, &chunk.compression)) {
-      status = Status::Error("unsupported chunk compression " + Quoted(compression) +
-                             " (supported: none, bz2, lz4)");
-    }
-    if (status.ok() && chunk.size > kMaxChunkBytes) {
-      status = Status::Error("implausible uncompressed size " + std::to_string(chunk.size) +
-                             " (> 1 GiB; corrupt bag?)");
-    }
+    if (status.ok()) status = ParseChunkHeader(header, &chunk);
     if (status.ok() && chunk.compression == ChunkCompression::kNone &&
         chunk.size != chunk.data_len) {
       status = Status::Error("uncompressed chunk of size " + std::to_string(chunk.size) +
@@ -370,13 +400,10 @@ Status Ros1BagReader::ReadIndexed(uint64_t index_pos, uint32_t conn_count,
     if (!status.ok()) return Error(chunk.pos, "chunk: " + status.message());
     chunk.index_pos = chunk.data_pos + chunk.data_len;
   }
-  std::sort(chunks_.begin(), chunks_.end(),
-            [](const Chunk& a, const Chunk& b) { return a.pos < b.pos; });
   return Status::Ok();
 }
 
-Status Ros1BagReader::ReadChunkIndex(size_t chunk_index,
-                                     const std::vector<size_t>& connection_slots) {
+Status BagReader::ReadChunkIndex(size_t chunk_index, const std::vector<size_t>& connection_slots) {
   const Chunk& chunk = chunks_[chunk_index];
   std::string buffer;
   RecordHeader header;
@@ -445,8 +472,7 @@ Status Ros1BagReader::ReadChunkIndex(size_t chunk_index,
   return Status::Ok();
 }
 
-Status Ros1BagReader::LoadChunk(size_t chunk_index, std::vector<uint8_t>* compressed,
-                                uint8_t* dst) {
+Status BagReader::LoadChunk(size_t chunk_index, std::vector<uint8_t>* compressed, uint8_t* dst) {
   const Chunk& chunk = chunks_[chunk_index];
   stats_.chunks_decompressed += 1;
   stats_.compressed_bytes_read += chunk.data_len;
@@ -514,36 +540,117 @@ Status ParseBufferRecord(const uint8_t* buffer, size_t size, size_t offset, Buff
 
 }  // namespace
 
-Status Ros1BagReader::ScanUnindexed(uint64_t first_record_pos) {
+void BagReader::AddSalvagedEntry(uint32_t conn, RosTime time, uint32_t chunk, uint32_t offset) {
+  const int slot = ConnectionSlot(conn);
+  if (slot < 0) return;  // message of a connection never described: unusable
+  const int64_t time_ns = RosTimeToNs(time);
+  entries_[slot].push_back(Entry{time_ns, chunk, offset});
+  message_counts_[slot] += 1;
+  start_ns_ = std::min(start_ns_, time_ns);
+  end_ns_ = std::max(end_ns_, time_ns);
+  ++num_salvaged_;
+}
+
+Status BagReader::IndexChunkRecords(const uint8_t* records, size_t size, uint32_t chunk_index,
+                                    bool open, size_t* end) {
+  const uint64_t chunk_pos = chunks_[chunk_index].pos;
+  size_t offset = 0;
+  while (offset < size) {
+    BufferRecord record;
+    TILTCAL_RETURN_IF_ERROR(ParseBufferRecord(records, size, offset, &record));
+    if (record.op == static_cast<uint8_t>(Op::kConnection)) {
+      TILTCAL_RETURN_IF_ERROR(
+          AddConnection(record.header, record.data, record.data_len, chunk_pos));
+    } else if (record.op == static_cast<uint8_t>(Op::kMessageData)) {
+      uint32_t conn = 0;
+      RosTime time;
+      TILTCAL_RETURN_IF_ERROR(record.header.GetU32("conn", &conn));
+      TILTCAL_RETURN_IF_ERROR(record.header.GetTime("time", &time));
+      AddSalvagedEntry(conn, time, chunk_index, static_cast<uint32_t>(offset));
+    } else if (open) {
+      break;  // an open chunk has no size: any other record ends it
+    }
+    offset = record.end;
+    *end = offset;
+  }
+  return Status::Ok();
+}
+
+Status BagReader::SalvageChunk(uint64_t pos, const RecordHeader& header, uint64_t data_pos,
+                               uint32_t data_len, bool* stop) {
+  Chunk chunk;
+  chunk.pos = pos;
+  chunk.data_pos = data_pos;
+  chunk.data_len = data_len;
+  Status status = ParseChunkHeader(header, &chunk);
+  if (!status.ok()) {
+    salvage_note_ = "stopped at a bad chunk at byte " + std::to_string(pos) + ": " +
+                    status.message();
+    *stop = true;
+    return Status::Ok();
+  }
+  const uint32_t chunk_index = static_cast<uint32_t>(chunks_.size());
+  const bool open = chunk.size == 0 && data_len == 0;
+  if (open && chunk.compression != ChunkCompression::kNone) {
+    salvage_note_ = std::string("the open ") + ChunkCompressionName(chunk.compression) +
+                    " chunk at byte " + std::to_string(pos) +
+                    " cannot be recovered (its compressor kept the data)";
+    *stop = true;
+    return Status::Ok();
+  }
+  std::vector<uint8_t> records;
+  if (open) {
+    // A chunk still open when recording stopped: its records run to EOF.
+    records.resize(file_size_ - data_pos);
+    TILTCAL_RETURN_IF_ERROR(ReadAt(data_pos, records.size(), records.data()));
+  } else {
+    records.resize(std::max<uint32_t>(chunk.size, 1));
+  }
+  chunks_.push_back(chunk);
+  size_t end = 0;
+  if (open) {
+    // The records end at the first one that is incomplete or of another kind.
+    (void)IndexChunkRecords(records.data(), records.size(), chunk_index, /*open=*/true, &end);
+    chunks_[chunk_index].data_len = static_cast<uint32_t>(end);
+    chunks_[chunk_index].size = static_cast<uint32_t>(end);
+    if (data_pos + end < file_size_) {
+      salvage_note_ = "the open chunk at byte " + std::to_string(pos) + " ends with " +
+                      std::to_string(file_size_ - data_pos - end) +
+                      " bytes of an incomplete record";
+    }
+    *stop = true;
+    return Status::Ok();
+  }
+  std::vector<uint8_t> compressed;
+  status = LoadChunk(chunk_index, &compressed, records.data());
+  if (status.ok()) {
+    status = IndexChunkRecords(records.data(), chunk.size, chunk_index, /*open=*/false, &end);
+  }
+  if (!status.ok()) {
+    salvage_note_ = "stopped at the damaged chunk at byte " + std::to_string(pos) + ": " +
+                    status.message();
+    *stop = true;
+  }
+  return Status::Ok();
+}
+
+Status BagReader::ScanUnindexed(uint64_t first_record_pos) {
   std::string buffer;
   RecordHeader header;
   std::string data;
-  std::vector<uint8_t> compressed;
-  ByteBuffer decompressed;
   uint64_t pos = first_record_pos;
-  auto note = [&](const std::string& what) { salvage_note_ = what; };
-  auto add_entry = [&](uint32_t conn, RosTime time, uint32_t chunk, uint32_t offset) {
-    const int slot = ConnectionSlot(conn);
-    if (slot < 0) return;  // message of a connection never described: unusable
-    const int64_t time_ns = RosTimeToNs(time);
-    entries_[slot].push_back(Entry{time_ns, chunk, offset});
-    message_counts_[slot] += 1;
-    start_ns_ = std::min(start_ns_, time_ns);
-    end_ns_ = std::max(end_ns_, time_ns);
-    ++num_salvaged_;
-  };
-  while (pos < file_size_) {
+  bool stop = false;
+  while (pos < file_size_ && !stop) {
     uint64_t data_pos = 0;
     uint32_t data_len = 0;
-    Status status = ReadRecordHeaderAt(pos, &buffer, &header, &data_pos, &data_len);
-    if (!status.ok()) {
-      note("stopped at an incomplete record at byte " + std::to_string(pos) + " (" +
-           std::to_string(file_size_ - pos) + " bytes to the end of the file)");
+    if (!ReadRecordHeaderAt(pos, &buffer, &header, &data_pos, &data_len).ok()) {
+      salvage_note_ = "stopped at an incomplete record at byte " + std::to_string(pos) + " (" +
+                      std::to_string(file_size_ - pos) + " bytes to the end of the file)";
       break;
     }
     uint8_t op = 0;
     if (!header.GetOp(&op).ok()) {
-      note("stopped at a record without op at byte " + std::to_string(pos));
+      salvage_note_ = "stopped at a record without op at byte " + std::to_string(pos);
       break;
     }
     if (op == static_cast<uint8_t>(Op::kConnection)) {
@@ -552,96 +659,12 @@ Status Ros1BagReader::ScanUnindexed(uint64_t first_record_pos) {
       TILTCAL_RETURN_IF_ERROR(AddConnection(
           header, reinterpret_cast<const uint8_t*>(data.data()), data.size(), pos));
     } else if (op == static_cast<uint8_t>(Op::kChunk)) {
-      Chunk chunk;
-      chunk.pos = pos;
-      chunk.data_pos = data_pos;
-      chunk.data_len = data_len;
-      std::string compression;
-      status = header.GetString("compression", &compression);
-      if (status.ok()) status = header.GetU32("size", &chunk.size);
-      if (status.ok() && !ParseChunkCompression(compression, &chunk.compression)) {
-        status = Status::Error("unsupported chunk compression " + Quoted(compression));
-      }
-      if (status.ok() && chunk.size > kMaxChunkBytes) {
-        status = Status::Error("implausible uncompressed size " + std::to_string(chunk.size));
-      }
-      if (!status.ok()) {
-        note("stopped at a bad chunk at byte " + std::to_string(pos) + ": " + status.message());
-        break;
-      }
-      const uint32_t chunk_index = static_cast<uint32_t>(chunks_.size());
-      if (chunk.size == 0 && data_len == 0) {
-        // A chunk still open when recording stopped: its records run to EOF.
-        if (chunk.compression != ChunkCompression::kNone) {
-          note(std::string("the open ") + ChunkCompressionName(chunk.compression) +
-               " chunk at byte " + std::to_string(pos) +
-               " cannot be recovered (its compressor kept the data)");
-          break;
-        }
-        uint64_t p = data_pos;
-        while (p < file_size_) {
-          uint64_t rec_data_pos = 0;
-          uint32_t rec_data_len = 0;
-          if (!ReadRecordHeaderAt(p, &buffer, &header, &rec_data_pos, &rec_data_len).ok()) break;
-          uint8_t rec_op = 0;
-          if (!header.GetOp(&rec_op).ok()) break;
-          if (rec_op == static_cast<uint8_t>(Op::kConnection)) {
-            data.resize(rec_data_len);
-            TILTCAL_RETURN_IF_ERROR(ReadAt(rec_data_pos, rec_data_len, data.data()));
-            if (!AddConnection(header, reinterpret_cast<const uint8_t*>(data.data()),
-                               data.size(), p).ok()) {
-              break;
-            }
-          } else if (rec_op == static_cast<uint8_t>(Op::kMessageData)) {
-            uint32_t conn = 0;
-            RosTime time;
-            if (!header.GetU32("conn", &conn).ok() || !header.GetTime("time", &time).ok()) break;
-            add_entry(conn, time, chunk_index, static_cast<uint32_t>(p - data_pos));
-          } else {
-            break;
-          }
-          p = rec_data_pos + rec_data_len;
-        }
-        chunk.data_len = static_cast<uint32_t>(p - data_pos);
-        chunk.size = chunk.data_len;
-        chunks_.push_back(std::move(chunk));
-        if (p < file_size_) {
-          note("the open chunk at byte " + std::to_string(pos) + " ends with " +
-               std::to_string(file_size_ - p) + " bytes of an incomplete record");
-        }
-        pos = file_size_;
-        break;
-      }
-      chunks_.push_back(chunk);
-      uint8_t* dst = decompressed.Reserve(std::max<uint32_t>(chunk.size, 1));
-      status = LoadChunk(chunk_index, &compressed, dst);
-      size_t offset = 0;
-      while (status.ok() && offset < chunk.size) {
-        BufferRecord record;
-        status = ParseBufferRecord(dst, chunk.size, offset, &record);
-        if (!status.ok()) break;
-        if (record.op == static_cast<uint8_t>(Op::kConnection)) {
-          status = AddConnection(record.header, record.data, record.data_len, pos);
-        } else if (record.op == static_cast<uint8_t>(Op::kMessageData)) {
-          uint32_t conn = 0;
-          RosTime time;
-          status = record.header.GetU32("conn", &conn);
-          if (status.ok()) status = record.header.GetTime("time", &time);
-          if (status.ok()) add_entry(conn, time, chunk_index, static_cast<uint32_t>(offset));
-        }
-        offset = record.end;
-      }
-      if (!status.ok()) {
-        note("stopped at the damaged chunk at byte " + std::to_string(pos) + ": " +
-             status.message());
-        break;
-      }
-    } else if (op == static_cast<uint8_t>(Op::kIndexData) ||
-               op == static_cast<uint8_t>(Op::kChunkInfo)) {
-      // Index records: the scan rebuilds the index from the chunks themselves.
-    } else {
-      note("stopped at an unexpected record (op " + std::to_string(op) + ", " + OpName(op) +
-           ") at byte " + std::to_string(pos));
+      TILTCAL_RETURN_IF_ERROR(SalvageChunk(pos, header, data_pos, data_len, &stop));
+    } else if (op != static_cast<uint8_t>(Op::kIndexData) &&
+               op != static_cast<uint8_t>(Op::kChunkInfo)) {
+      // Index records are skipped: the scan rebuilds the index from the chunks.
+      salvage_note_ = "stopped at an unexpected record (op " + std::to_string(op) + ", " +
+                      OpName(op) + ") at byte " + std::to_string(pos);
       break;
     }
     pos = data_pos + data_len;
@@ -654,7 +677,7 @@ Status Ros1BagReader::ScanUnindexed(uint64_t first_record_pos) {
   return Status::Ok();
 }
 
-std::vector<std::string> Ros1BagReader::TopicsOfType(const std::string& type) const {
+std::vector<std::string> BagReader::TopicsOfType(const std::string& type) const {
   std::set<std::string> topics;
   for (const Connection& c : connections_) {
     if (c.type == type) topics.insert(c.topic);
@@ -662,20 +685,20 @@ std::vector<std::string> Ros1BagReader::TopicsOfType(const std::string& type) co
   return {topics.begin(), topics.end()};
 }
 
-std::vector<std::string> Ros1BagReader::Topics() const {
+std::vector<std::string> BagReader::Topics() const {
   std::set<std::string> topics;
   for (const Connection& c : connections_) topics.insert(c.topic);
   return {topics.begin(), topics.end()};
 }
 
-std::string Ros1BagReader::TopicType(const std::string& topic) const {
+std::string BagReader::TopicType(const std::string& topic) const {
   for (const Connection& c : connections_) {
     if (c.topic == topic) return c.type;
   }
   return "";
 }
 
-int64_t Ros1BagReader::MessageCount(const std::string& topic) const {
+int64_t BagReader::MessageCount(const std::string& topic) const {
   int64_t count = 0;
   for (size_t i = 0; i < connections_.size(); ++i) {
     if (connections_[i].topic == topic) count += message_counts_[i];
@@ -683,21 +706,60 @@ int64_t Ros1BagReader::MessageCount(const std::string& topic) const {
   return count;
 }
 
-int64_t Ros1BagReader::TotalMessageCount() const {
+int64_t BagReader::TotalMessageCount() const {
   int64_t count = 0;
   for (int64_t c : message_counts_) count += c;
   return count;
 }
 
-bool Ros1BagReader::TimeRange(int64_t* start_ns, int64_t* end_ns) const {
+bool BagReader::TimeRange(int64_t* start_ns, int64_t* end_ns) const {
   if (start_ns_ > end_ns_) return false;
   *start_ns = start_ns_;
   *end_ns = end_ns_;
   return true;
 }
 
-Status Ros1BagReader::ReadMessages(const ReadOptions& options,
-                                   const std::function<Status(const MessageView&)>& fn) {
+Status BagReader::LoadEntries(const std::vector<size_t>& slots) {
+  std::vector<size_t> to_load;
+  for (size_t slot : slots) {
+    if (!entries_loaded_[slot]) to_load.push_back(slot);
+  }
+  if (to_load.empty()) return Status::Ok();
+  for (size_t c = 0; c < chunks_.size(); ++c) {
+    const bool wanted = std::any_of(
+        chunks_[c].connection_counts.begin(), chunks_[c].connection_counts.end(),
+        [&](const auto& cc) {
+          return std::find(to_load.begin(), to_load.end(), static_cast<size_t>(cc.first)) !=
+                 to_load.end();
+        });
+    if (wanted) TILTCAL_RETURN_IF_ERROR(ReadChunkIndex(c, to_load));
+  }
+  for (size_t slot : to_load) entries_loaded_[slot] = true;
+  return Status::Ok();
+}
+
+std::vector<BagReader::Item> BagReader::MergedItems(const std::vector<size_t>& slots,
+                                                    const ReadOptions& options) const {
+  std::vector<Item> items;
+  size_t total = 0;
+  for (size_t slot : slots) total += entries_[slot].size();
+  items.reserve(total);
+  for (size_t slot : slots) {
+    for (const Entry& e : entries_[slot]) {
+      if (e.time_ns >= options.start_ns && e.time_ns < options.end_ns) {
+        items.push_back(Item{e.time_ns, e.chunk, e.offset, static_cast<uint32_t>(slot)});
+      }
+    }
+  }
+  // chunks_ is sorted by file position, so the chunk index orders as chunk_pos.
+  std::sort(items.begin(), items.end(), [](const Item& a, const Item& b) {
+    return std::tie(a.time_ns, a.chunk, a.offset) < std::tie(b.time_ns, b.chunk, b.offset);
+  });
+  return items;
+}
+
+Status BagReader::ReadMessages(const ReadOptions& options,
+                               const std::function<Status(const MessageView&)>& fn) {
   std::vector<size_t> slots;
   for (size_t i = 0; i < connections_.size(); ++i) {
     if (options.topics.empty() ||
@@ -711,46 +773,8 @@ Status Ros1BagReader::ReadMessages(const ReadOptions& options,
       return Status::Error(path_ + ": no topic '" + topic + "' in the bag");
     }
   }
-  // Load the index entries of the selected connections that are not loaded.
-  std::vector<size_t> to_load;
-  for (size_t slot : slots) {
-    if (!entries_loaded_[slot]) to_load.push_back(slot);
-  }
-  if (!to_load.empty()) {
-    for (size_t c = 0; c < chunks_.size(); ++c) {
-      const bool wanted = std::any_of(
-          chunks_[c].connection_counts.begin(), chunks_[c].connection_counts.end(),
-          [&](const auto& cc) {
-            return std::find(to_load.begin(), to_load.end(), static_cast<size_t>(cc.first)) !=
-                   to_load.end();
-          });
-      if (wanted) TILTCAL_RETURN_IF_ERROR(ReadChunkIndex(c, to_load));
-    }
-    for (size_t slot : to_load) entries_loaded_[slot] = true;
-  }
-
-  // Merge the selected connections and order by (time, chunk_pos, offset);
-  // chunks_ is sorted by file position, so the chunk index orders as chunk_pos.
-  struct Item {
-    int64_t time_ns;
-    uint32_t chunk;
-    uint32_t offset;
-    uint32_t slot;
-  };
-  std::vector<Item> items;
-  size_t total = 0;
-  for (size_t slot : slots) total += entries_[slot].size();
-  items.reserve(total);
-  for (size_t slot : slots) {
-    for (const Entry& e : entries_[slot]) {
-      if (e.time_ns >= options.start_ns && e.time_ns < options.end_ns) {
-        items.push_back(Item{e.time_ns, e.chunk, e.offset, static_cast<uint32_t>(slot)});
-      }
-    }
-  }
-  std::sort(items.begin(), items.end(), [](const Item& a, const Item& b) {
-    return std::tie(a.time_ns, a.chunk, a.offset) < std::tie(b.time_ns, b.chunk, b.offset);
-  });
+  TILTCAL_RETURN_IF_ERROR(LoadEntries(slots));
+  const std::vector<Item> items = MergedItems(slots, options);
 
   ChunkCache cache(options.chunk_cache_size);
   MessageView view;

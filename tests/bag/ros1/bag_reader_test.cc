@@ -1,8 +1,8 @@
-// The reader on small bags assembled here record by record (ros1_format's
+// The reader on small bags assembled here record by record (format.h's
 // writer side), for the cases the public and python-written bags lack:
 // several connections on one topic, time ties, encrypted bags, broken
 // indexes, eviction from a one-chunk cache, truncation and byte flips.
-#include "stages/decode/ros1_bag_reader.h"
+#include "bag/ros1/bag_reader.h"
 
 #include <cstdio>
 #include <fstream>
@@ -134,7 +134,7 @@ std::string BuildBag(const std::vector<Conn>& conns, const std::vector<std::vect
   return bag + body;
 }
 
-class Ros1BagReaderTest : public ::testing::Test {
+class BagReaderTest : public ::testing::Test {
  protected:
   std::string Write(const std::string& bytes, const std::string& name = "test.bag") {
     const std::string path = tmp_.File(name);
@@ -150,7 +150,7 @@ struct Seen {
   std::string data;
 };
 
-Status ReadAll(Ros1BagReader* reader, std::vector<Seen>* seen, ReadOptions options = {}) {
+Status ReadAll(BagReader* reader, std::vector<Seen>* seen, ReadOptions options = {}) {
   return reader->ReadMessages(options, [&](const MessageView& m) {
     seen->push_back({m.connection->topic, m.time_ns,
                      std::string(reinterpret_cast<const char*>(m.data), m.size)});
@@ -162,11 +162,11 @@ const std::vector<Conn> kTwoImuConns = {{1, "/imu", "sensor_msgs/Imu"},
                                         {2, "/imu", "sensor_msgs/Imu"},
                                         {5, "points", "sensor_msgs/PointCloud2"}};
 
-TEST_F(Ros1BagReaderTest, ConnectionsOfOneTopicAreMergedInTimeOrder) {
-  const std::string path = Write(BuildBag(
-      kTwoImuConns, {{{1, 1000, "a"}, {2, 2000, "b"}, {5, 2500, "p"}, {1, 3000, "c"}},
-                     {{2, 4000, "d"}, {1, 5000, "e"}}}));
-  Ros1BagReader reader;
+TEST_F(BagReaderTest, ConnectionsOfOneTopicAreMergedInTimeOrder) {
+  const std::string path = Write(
+      BuildBag(kTwoImuConns, {{{1, 1000, "a"}, {2, 2000, "b"}, {5, 2500, "p"}, {1, 3000, "c"}},
+                              {{2, 4000, "d"}, {1, 5000, "e"}}}));
+  BagReader reader;
   Status status = reader.Open(path);
   ASSERT_TRUE(status.ok()) << status.message();
   EXPECT_EQ(reader.TopicsOfType("sensor_msgs/Imu"), std::vector<std::string>{"/imu"});
@@ -201,11 +201,11 @@ TEST_F(Ros1BagReaderTest, ConnectionsOfOneTopicAreMergedInTimeOrder) {
   EXPECT_NE(status.message().find("no topic '/nope'"), std::string::npos);
 }
 
-TEST_F(Ros1BagReaderTest, TimeTiesFollowChunkPositionThenOffset) {
+TEST_F(BagReaderTest, TimeTiesFollowChunkPositionThenOffset) {
   // Equal record times: file order decides (chunk_pos, then offset).
-  const std::string path = Write(BuildBag(
-      kTwoImuConns, {{{2, 7000, "1"}, {1, 7000, "2"}}, {{1, 7000, "3"}, {2, 6000, "0"}}}));
-  Ros1BagReader reader;
+  const std::string path = Write(
+      BuildBag(kTwoImuConns, {{{2, 7000, "1"}, {1, 7000, "2"}}, {{1, 7000, "3"}, {2, 6000, "0"}}}));
+  BagReader reader;
   ASSERT_TRUE(reader.Open(path).ok());
   std::vector<Seen> seen;
   ASSERT_TRUE(ReadAll(&reader, &seen).ok());
@@ -213,14 +213,14 @@ TEST_F(Ros1BagReaderTest, TimeTiesFollowChunkPositionThenOffset) {
   for (size_t i = 0; i < 4; ++i) EXPECT_EQ(seen[i].data, std::to_string(i));
 }
 
-TEST_F(Ros1BagReaderTest, OneChunkCacheReloadsChunksAndStaysCorrect) {
+TEST_F(BagReaderTest, OneChunkCacheReloadsChunksAndStaysCorrect) {
   // Ten chunks whose times interleave: reading in time order alternates chunks.
   std::vector<std::vector<Msg>> chunks(10);
   for (int k = 0; k < 10; ++k) {
     chunks[k] = {{1, 1000 + k, "a" + std::to_string(k)}, {1, 2000 + k, "b" + std::to_string(k)}};
   }
   const std::string path = Write(BuildBag(kTwoImuConns, chunks));
-  Ros1BagReader reader;
+  BagReader reader;
   ASSERT_TRUE(reader.Open(path).ok());
   std::vector<Seen> seen;
   ReadOptions options;
@@ -234,12 +234,12 @@ TEST_F(Ros1BagReaderTest, OneChunkCacheReloadsChunksAndStaysCorrect) {
   EXPECT_EQ(reader.stats().chunks_decompressed, 20u);  // every chunk loaded twice
 }
 
-TEST_F(Ros1BagReaderTest, UnindexedBagIsScanned) {
+TEST_F(BagReaderTest, UnindexedBagIsScanned) {
   BagOptions options;
   options.indexed = false;
   const std::string path = Write(BuildBag(
       kTwoImuConns, {{{1, 1000, "a"}, {5, 1500, "p"}}, {{2, 500, "z"}, {1, 3000, "c"}}}, options));
-  Ros1BagReader reader;
+  BagReader reader;
   Status status = reader.Open(path);
   ASSERT_TRUE(status.ok()) << status.message();
   EXPECT_FALSE(reader.indexed());
@@ -253,7 +253,7 @@ TEST_F(Ros1BagReaderTest, UnindexedBagIsScanned) {
   EXPECT_EQ(seen[2].topic, "points");
 }
 
-TEST_F(Ros1BagReaderTest, OpenChunksOfAnInterruptedRecording) {
+TEST_F(BagReaderTest, OpenChunksOfAnInterruptedRecording) {
   BagOptions options;
   options.indexed = false;
   options.open_last_chunk_compression = "none";
@@ -261,11 +261,11 @@ TEST_F(Ros1BagReaderTest, OpenChunksOfAnInterruptedRecording) {
   // Open uncompressed chunk: its records are read up to the end of the file,
   // an incomplete last record is left out.
   const std::string bag = BuildBag(kTwoImuConns, chunks, options);
-  Ros1BagReader reader;
+  BagReader reader;
   ASSERT_TRUE(reader.Open(Write(bag, "a.bag")).ok());
   EXPECT_EQ(reader.num_salvaged_messages(), 3);
   EXPECT_EQ(reader.salvage_note(), "");
-  Ros1BagReader cut;
+  BagReader cut;
   ASSERT_TRUE(cut.Open(Write(bag.substr(0, bag.size() - 2), "b.bag")).ok());
   EXPECT_EQ(cut.num_salvaged_messages(), 2);
   EXPECT_NE(cut.salvage_note().find("incomplete record"), std::string::npos) << cut.salvage_note();
@@ -275,29 +275,29 @@ TEST_F(Ros1BagReaderTest, OpenChunksOfAnInterruptedRecording) {
   EXPECT_EQ(seen[1].data, "b");
   // Open lz4 chunk: nothing to recover, and the note says so.
   options.open_last_chunk_compression = "lz4";
-  Ros1BagReader lz4;
+  BagReader lz4;
   ASSERT_TRUE(lz4.Open(Write(BuildBag(kTwoImuConns, chunks, options), "c.bag")).ok());
   EXPECT_EQ(lz4.num_salvaged_messages(), 1);
   EXPECT_NE(lz4.salvage_note().find("open lz4 chunk"), std::string::npos) << lz4.salvage_note();
 }
 
-TEST_F(Ros1BagReaderTest, EncryptedBagIsRejected) {
+TEST_F(BagReaderTest, EncryptedBagIsRejected) {
   BagOptions options;
   options.encryptor = "rosbag/AesCbcEncryptor";
   const std::string path = Write(BuildBag(kTwoImuConns, {{{1, 1000, "a"}}}, options));
-  Ros1BagReader reader;
+  BagReader reader;
   Status status = reader.Open(path);
   ASSERT_FALSE(status.ok());
   EXPECT_NE(status.message().find("encrypted bag"), std::string::npos) << status.message();
   EXPECT_NE(status.message().find(path), std::string::npos);
 }
 
-TEST_F(Ros1BagReaderTest, IndexInconsistenciesAreErrors) {
+TEST_F(BagReaderTest, IndexInconsistenciesAreErrors) {
   {
     BagOptions options;
     options.index_count_delta = 1;
     const std::string path = Write(BuildBag(kTwoImuConns, {{{1, 1000, "a"}}}, options), "a.bag");
-    Ros1BagReader reader;
+    BagReader reader;
     ASSERT_TRUE(reader.Open(path).ok());
     std::vector<Seen> seen;
     Status status = ReadAll(&reader, &seen);
@@ -309,7 +309,7 @@ TEST_F(Ros1BagReaderTest, IndexInconsistenciesAreErrors) {
     BagOptions options;
     options.chunk_info_version = 2;
     const std::string path = Write(BuildBag(kTwoImuConns, {{{1, 1000, "a"}}}, options), "b.bag");
-    Ros1BagReader reader;
+    BagReader reader;
     Status status = reader.Open(path);
     ASSERT_FALSE(status.ok());
     EXPECT_NE(status.message().find("chunk info version 2"), std::string::npos)
@@ -319,7 +319,7 @@ TEST_F(Ros1BagReaderTest, IndexInconsistenciesAreErrors) {
     BagOptions options;
     options.compression = "zstd";
     const std::string path = Write(BuildBag(kTwoImuConns, {{{1, 1000, "a"}}}, options), "c.bag");
-    Ros1BagReader reader;
+    BagReader reader;
     Status status = reader.Open(path);
     ASSERT_FALSE(status.ok());
     EXPECT_NE(status.message().find("unsupported chunk compression 'zstd'"), std::string::npos)
@@ -329,7 +329,7 @@ TEST_F(Ros1BagReaderTest, IndexInconsistenciesAreErrors) {
 
 // Any prefix or any single corrupted byte gives a result or an error, never
 // a crash or a read outside the buffers (run under TILTCAL_SANITIZE to check).
-TEST_F(Ros1BagReaderTest, TruncationsAndByteFlipsNeverCrash) {
+TEST_F(BagReaderTest, TruncationsAndByteFlipsNeverCrash) {
   for (bool indexed : {true, false}) {
     BagOptions options;
     options.indexed = indexed;
@@ -341,7 +341,7 @@ TEST_F(Ros1BagReaderTest, TruncationsAndByteFlipsNeverCrash) {
     int variant = 0;
     auto try_read = [&](const std::string& bytes) {
       const std::string path = Write(bytes, "v" + std::to_string(variant++) + ".bag");
-      Ros1BagReader reader;
+      BagReader reader;
       std::vector<Seen> seen;
       const bool opened = reader.Open(path).ok();
       if (opened) {
@@ -369,7 +369,7 @@ TEST_F(Ros1BagReaderTest, TruncationsAndByteFlipsNeverCrash) {
   const size_t first_chunk_end = BuildBag(kTwoImuConns, {{{1, 1000, "a"}}}, options).size();
   ASSERT_EQ(bag.substr(0, first_chunk_end),
             BuildBag(kTwoImuConns, {{{1, 1000, "a"}}}, options));
-  Ros1BagReader reader;
+  BagReader reader;
   ASSERT_TRUE(reader.Open(Write(bag.substr(0, first_chunk_end + 30))).ok());
   EXPECT_EQ(reader.num_salvaged_messages(), 1);
   EXPECT_NE(reader.salvage_note().find("incomplete record"), std::string::npos)

@@ -1,8 +1,8 @@
-#include "stages/decode/ros1_format.h"
+#include "bag/ros1/format.h"
 
 #include <gtest/gtest.h>
 
-#include "tests/stages/decode/decode_test_util.h"
+#include "tests/bag/ros1/bag_test_util.h"
 #include "tests/testing/test_env.h"
 
 namespace tiltcal::ros1 {

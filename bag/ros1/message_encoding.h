@@ -1,5 +1,5 @@
-#ifndef TILTCAL_STAGES_SIMULATE_ROS1_MESSAGES_H_
-#define TILTCAL_STAGES_SIMULATE_ROS1_MESSAGES_H_
+#ifndef TILTCAL_BAG_ROS1_MESSAGE_ENCODING_H_
+#define TILTCAL_BAG_ROS1_MESSAGE_ENCODING_H_
 
 #include <cstdint>
 #include <string>
@@ -7,19 +7,22 @@
 
 #include <Eigen/Core>
 
-namespace tiltcal::simulate {
+#include "bag/ros1/messages.h"
 
-// ROS1 wire format (little-endian, no padding; string = u32 length + bytes;
-// T[] = u32 count + elements; T[N] = N elements) of the two messages the
-// simulator writes.
+namespace tiltcal::ros1 {
 
-struct RosMessageType {
+// Encoding of sensor_msgs/Imu and sensor_msgs/PointCloud2 into the ROS1 wire
+// format (little-endian, no padding; string = u32 length + bytes; T[] = u32
+// count + elements; T[N] = N elements), and the connection data a bag
+// records for them. The decoding side is messages.h.
+
+struct MessageType {
   const char* type;        // "sensor_msgs/Imu"
   const char* md5sum;      // ROS1 MD5 of the definition
   const char* definition;  // full text as in a bag's connection record
 };
-const RosMessageType& ImuMessageType();
-const RosMessageType& PointCloud2MessageType();
+const MessageType& ImuMessageType();
+const MessageType& PointCloud2MessageType();
 
 // std_msgs/Header: seq, stamp (u32 sec, u32 nsec), frame_id.
 // Returns false when stamp_ns is not representable as ROS time.
@@ -32,24 +35,12 @@ bool SerializeImu(uint32_t seq, int64_t stamp_ns, const std::string& frame_id,
                   const Eigen::Vector3d& linear_acceleration_mps2, double gyro_variance,
                   double accel_variance, std::string* out);
 
-// sensor_msgs/PointField.
-struct PointField {
-  std::string name;
-  uint32_t offset;
-  uint8_t datatype;  // 1 INT8 … 7 FLOAT32, 8 FLOAT64
-  uint32_t count;
-};
-enum PointFieldType : uint8_t {
-  kInt8 = 1, kUint8 = 2, kInt16 = 3, kUint16 = 4, kInt32 = 5, kUint32 = 6, kFloat32 = 7,
-  kFloat64 = 8
-};
-
 // sensor_msgs/PointCloud2 with `data` = height * row_step bytes.
 bool SerializePointCloud2(uint32_t seq, int64_t stamp_ns, const std::string& frame_id,
                           uint32_t height, uint32_t width, const std::vector<PointField>& fields,
                           uint32_t point_step, const std::string& data, bool is_dense,
                           std::string* out);
 
-}  // namespace tiltcal::simulate
+}  // namespace tiltcal::ros1
 
-#endif  // TILTCAL_STAGES_SIMULATE_ROS1_MESSAGES_H_
+#endif  // TILTCAL_BAG_ROS1_MESSAGE_ENCODING_H_

@@ -1,6 +1,7 @@
-#include "stages/decode/chunk_decompressor.h"
+#include "bag/ros1/chunk_codec.h"
 
 #include <bzlib.h>
+#include <lz4frame.h>
 
 #include <cstring>
 #include <string>
@@ -46,7 +47,49 @@ const char* Bz2ErrorName(int code) {
   }
 }
 
+// roslz4's frame: block independence, 1 MiB blocks (id 6), content checksum,
+// no content size, no block checksums (FLG 0x64, BD 0x60).
+Status CompressLz4(const std::string& in, std::string* out) {
+  LZ4F_preferences_t prefs = LZ4F_INIT_PREFERENCES;
+  prefs.frameInfo.blockSizeID = LZ4F_max1MB;
+  prefs.frameInfo.blockMode = LZ4F_blockIndependent;
+  prefs.frameInfo.contentChecksumFlag = LZ4F_contentChecksumEnabled;
+  prefs.frameInfo.contentSize = 0;
+  prefs.frameInfo.blockChecksumFlag = LZ4F_noBlockChecksum;
+  prefs.compressionLevel = 0;
+  out->resize(LZ4F_compressFrameBound(in.size(), &prefs));
+  const size_t n = LZ4F_compressFrame(out->data(), out->size(), in.data(), in.size(), &prefs);
+  if (LZ4F_isError(n)) {
+    return Status::Error(std::string("lz4 compression failed: ") + LZ4F_getErrorName(n));
+  }
+  out->resize(n);
+  return Status::Ok();
+}
+
+// One bzip2 stream, block size 900k ("BZh9"), as ros_comm's bz2 stream.
+Status CompressBz2(const std::string& in, std::string* out) {
+  unsigned int size = static_cast<unsigned int>(in.size() + in.size() / 100 + 600);
+  out->resize(size);
+  const int rc = BZ2_bzBuffToBuffCompress(out->data(), &size, const_cast<char*>(in.data()),
+                                          static_cast<unsigned int>(in.size()), 9, 0, 30);
+  if (rc != BZ_OK) return Status::Error("bz2 compression failed, code " + std::to_string(rc));
+  out->resize(size);
+  return Status::Ok();
+}
+
 }  // namespace
+
+Status CompressChunk(ChunkCompression compression, const std::string& uncompressed,
+                     std::string* compressed) {
+  switch (compression) {
+    case ChunkCompression::kNone:
+      *compressed = uncompressed;
+      return Status::Ok();
+    case ChunkCompression::kBz2: return CompressBz2(uncompressed, compressed);
+    case ChunkCompression::kLz4: return CompressLz4(uncompressed, compressed);
+  }
+  return Status::Error("unknown chunk compression");
+}
 
 ChunkDecompressor::ChunkDecompressor() = default;
 
