@@ -598,30 +598,14 @@ Status BagReader::SalvageChunk(uint64_t pos, const RecordHeader& header, uint64_
     *stop = true;
     return Status::Ok();
   }
-  std::vector<uint8_t> records;
-  if (open) {
-    // A chunk still open when recording stopped: its records run to EOF.
-    records.resize(file_size_ - data_pos);
-    TILTCAL_RETURN_IF_ERROR(ReadAt(data_pos, records.size(), records.data()));
-  } else {
-    records.resize(std::max<uint32_t>(chunk.size, 1));
-  }
   chunks_.push_back(chunk);
-  size_t end = 0;
   if (open) {
-    // The records end at the first one that is incomplete or of another kind.
-    (void)IndexChunkRecords(records.data(), records.size(), chunk_index, /*open=*/true, &end);
-    chunks_[chunk_index].data_len = static_cast<uint32_t>(end);
-    chunks_[chunk_index].size = static_cast<uint32_t>(end);
-    if (data_pos + end < file_size_) {
-      salvage_note_ = "the open chunk at byte " + std::to_string(pos) + " ends with " +
-                      std::to_string(file_size_ - data_pos - end) +
-                      " bytes of an incomplete record";
-    }
-    *stop = true;
-    return Status::Ok();
+    *stop = true;  // its records run to the end of the file
+    return SalvageOpenChunk(chunk_index);
   }
+  std::vector<uint8_t> records(std::max<uint32_t>(chunk.size, 1));
   std::vector<uint8_t> compressed;
+  size_t end = 0;
   status = LoadChunk(chunk_index, &compressed, records.data());
   if (status.ok()) {
     status = IndexChunkRecords(records.data(), chunk.size, chunk_index, /*open=*/false, &end);
@@ -630,6 +614,23 @@ Status BagReader::SalvageChunk(uint64_t pos, const RecordHeader& header, uint64_
     salvage_note_ = "stopped at the damaged chunk at byte " + std::to_string(pos) + ": " +
                     status.message();
     *stop = true;
+  }
+  return Status::Ok();
+}
+
+Status BagReader::SalvageOpenChunk(uint32_t chunk_index) {
+  Chunk& chunk = chunks_[chunk_index];
+  std::vector<uint8_t> records(file_size_ - chunk.data_pos);
+  TILTCAL_RETURN_IF_ERROR(ReadAt(chunk.data_pos, records.size(), records.data()));
+  // The records end at the first one that is incomplete or of another kind.
+  size_t end = 0;
+  (void)IndexChunkRecords(records.data(), records.size(), chunk_index, /*open=*/true, &end);
+  chunk.data_len = static_cast<uint32_t>(end);
+  chunk.size = static_cast<uint32_t>(end);
+  if (chunk.data_pos + end < file_size_) {
+    salvage_note_ = "the open chunk at byte " + std::to_string(chunk.pos) + " ends with " +
+                    std::to_string(file_size_ - chunk.data_pos - end) +
+                    " bytes of an incomplete record";
   }
   return Status::Ok();
 }

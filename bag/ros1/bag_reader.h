@@ -145,6 +145,9 @@ class BagReader {
   // it can be trusted. Errors only for I/O failures.
   Status SalvageChunk(uint64_t pos, const RecordHeader& header, uint64_t data_pos,
                       uint32_t data_len, bool* stop);
+  // A chunk still open when the recording stopped (size and data length 0):
+  // its records run to the end of the file, up to the first incomplete one.
+  Status SalvageOpenChunk(uint32_t chunk_index);
   // The one dispatch of the records inside a chunk (`size` uncompressed bytes
   // of chunk `chunk_index`): connection records add their connection, message
   // data records an index entry. Another op is skipped, or ends the records
