@@ -9,11 +9,13 @@
 #include <iostream>
 #include <vector>
 
+#include <fmt/format.h>
+
 #include "bag/ros1/bag_reader.h"
 #include "bag/ros1/messages.h"
 #include "common/io/provenance.h"
 #include "common/io/record_stream.h"
-#include "common/io/text_proto.h"
+#include "common/io/rig.h"
 #include "stages/decode/async_record_writer.h"
 #include "stages/decode/point_cloud_conversion.h"
 #include "tiltcal/proto/imu.pb.h"
@@ -30,11 +32,7 @@ using Clock = std::chrono::steady_clock;
 std::string FormatSeconds(int64_t ns) {
   const bool negative = ns < 0;
   const uint64_t abs_ns = negative ? 0 - static_cast<uint64_t>(ns) : static_cast<uint64_t>(ns);
-  char buffer[48];
-  std::snprintf(buffer, sizeof(buffer), "%s%llu.%09llu", negative ? "-" : "",
-                static_cast<unsigned long long>(abs_ns / 1000000000),
-                static_cast<unsigned long long>(abs_ns % 1000000000));
-  return buffer;
+  return fmt::format("{}{}.{:09}", negative ? "-" : "", abs_ns / 1000000000, abs_ns % 1000000000);
 }
 
 std::string Join(const std::vector<std::string>& items) {
@@ -109,56 +107,42 @@ double RateHz(int64_t count, int64_t first_ns, int64_t last_ns) {
   return static_cast<double>(count - 1) / (static_cast<double>(last_ns - first_ns) * 1e-9);
 }
 
-// printf into a std::string.
-template <typename... Args>
-std::string Format(const char* format, Args... args) {
-  std::string out(static_cast<size_t>(std::snprintf(nullptr, 0, format, args...)), '\0');
-  std::snprintf(out.data(), out.size() + 1, format, args...);
-  return out;
-}
-
 void PrintSummary(std::ostream* log, const DecodePaths& paths, const DecodeSummary& s) {
   if (log == nullptr) return;
   const double mb = static_cast<double>(s.bag_bytes) * 1e-6;
-  *log << Format("tiltcal_decode: %s: %.1f MB, %s\n", paths.bag.c_str(), mb,
-                 s.indexed ? "indexed" : "UNINDEXED (linear scan)");
+  *log << fmt::format("tiltcal_decode: {}: {:.1f} MB, {}\n", paths.bag, mb,
+                      s.indexed ? "indexed" : "UNINDEXED (linear scan)");
   if (!s.indexed) {
-    *log << Format("  salvaged %lld messages from the unindexed bag%s%s\n",
-                   static_cast<long long>(s.salvaged_messages),
-                   s.salvage_note.empty() ? "" : "; ", s.salvage_note.c_str());
+    *log << fmt::format("  salvaged {} messages from the unindexed bag{}{}\n",
+                        s.salvaged_messages, s.salvage_note.empty() ? "" : "; ",
+                        s.salvage_note);
   }
-  *log << Format("  imu   '%s': %lld msgs, %lld written, %.2f Hz, stamps %s .. %s s (%.3f s); "
-                 "dropped %lld duplicate + %lld conflicting stamps\n",
-                 s.imu_topic.c_str(), static_cast<long long>(s.imu_messages),
-                 static_cast<long long>(s.imu_written),
-                 RateHz(s.imu_written, s.imu_first_stamp_ns, s.imu_last_stamp_ns),
-                 FormatSeconds(s.imu_first_stamp_ns).c_str(),
-                 FormatSeconds(s.imu_last_stamp_ns).c_str(),
-                 static_cast<double>(s.imu_last_stamp_ns - s.imu_first_stamp_ns) * 1e-9,
-                 static_cast<long long>(s.imu_duplicates_dropped),
-                 static_cast<long long>(s.imu_conflicting_dropped));
-  *log << Format("  lidar '%s': %lld msgs, %lld written, %.2f Hz, stamps %s .. %s s (%.3f s); "
-                 "dropped %lld non-monotonic + %lld empty scans\n",
-                 s.lidar_topic.c_str(), static_cast<long long>(s.scan_messages),
-                 static_cast<long long>(s.scans_written),
-                 RateHz(s.scans_written, s.scan_first_stamp_ns, s.scan_last_stamp_ns),
-                 FormatSeconds(s.scan_first_stamp_ns).c_str(),
-                 FormatSeconds(s.scan_last_stamp_ns).c_str(),
-                 static_cast<double>(s.scan_last_stamp_ns - s.scan_first_stamp_ns) * 1e-9,
-                 static_cast<long long>(s.scans_non_monotonic_dropped),
-                 static_cast<long long>(s.scans_empty_dropped));
-  *log << Format("  points: %lld written; dropped %lld NaN/Inf, %lld zero/short range\n",
-                 static_cast<long long>(s.points_written),
-                 static_cast<long long>(s.points_dropped_invalid),
-                 static_cast<long long>(s.points_dropped_range));
+  *log << fmt::format(
+      "  imu   '{}': {} msgs, {} written, {:.2f} Hz, stamps {} .. {} s ({:.3f} s); "
+      "dropped {} duplicate + {} conflicting stamps\n",
+      s.imu_topic, s.imu_messages, s.imu_written,
+      RateHz(s.imu_written, s.imu_first_stamp_ns, s.imu_last_stamp_ns),
+      FormatSeconds(s.imu_first_stamp_ns), FormatSeconds(s.imu_last_stamp_ns),
+      static_cast<double>(s.imu_last_stamp_ns - s.imu_first_stamp_ns) * 1e-9,
+      s.imu_duplicates_dropped, s.imu_conflicting_dropped);
+  *log << fmt::format(
+      "  lidar '{}': {} msgs, {} written, {:.2f} Hz, stamps {} .. {} s ({:.3f} s); "
+      "dropped {} non-monotonic + {} empty scans\n",
+      s.lidar_topic, s.scan_messages, s.scans_written,
+      RateHz(s.scans_written, s.scan_first_stamp_ns, s.scan_last_stamp_ns),
+      FormatSeconds(s.scan_first_stamp_ns), FormatSeconds(s.scan_last_stamp_ns),
+      static_cast<double>(s.scan_last_stamp_ns - s.scan_first_stamp_ns) * 1e-9,
+      s.scans_non_monotonic_dropped, s.scans_empty_dropped);
+  *log << fmt::format("  points: {} written; dropped {} NaN/Inf, {} zero/short range\n",
+                      s.points_written, s.points_dropped_invalid, s.points_dropped_range);
   if (s.scans_without_point_time > 0) {
-    *log << Format("  WARNING: %lld scans have no per-point time field (time_source "
-                   "POINT_TIME_NONE): they cannot be deskewed\n",
-                   static_cast<long long>(s.scans_without_point_time));
+    *log << fmt::format(
+        "  WARNING: {} scans have no per-point time field (time_source POINT_TIME_NONE): "
+        "they cannot be deskewed\n",
+        s.scans_without_point_time);
   }
-  *log << Format("  wall %.3f s, %.1f MB/s, %llu chunks decompressed\n", s.wall_s,
-                 s.wall_s > 0 ? mb / s.wall_s : 0.0,
-                 static_cast<unsigned long long>(s.chunks_decompressed));
+  *log << fmt::format("  wall {:.3f} s, {:.1f} MB/s, {} chunks decompressed\n", s.wall_s,
+                      s.wall_s > 0 ? mb / s.wall_s : 0.0, s.chunks_decompressed);
 }
 
 // Where a message came from, for its errors.
@@ -188,9 +172,9 @@ class ProgressLine {
     const Clock::time_point now = Clock::now();
     if (now - last_ <= std::chrono::milliseconds(250)) return;
     last_ = now;
-    *log_ << Format("\rtiltcal_decode: %3.0f%% (%llu / %lld messages)",
-                    total_ > 0 ? 100.0 * static_cast<double>(sequence) / total_ : 0.0,
-                    static_cast<unsigned long long>(sequence), static_cast<long long>(total_))
+    *log_ << fmt::format("\rtiltcal_decode: {:3.0f}% ({} / {} messages)",
+                         total_ > 0 ? 100.0 * static_cast<double>(sequence) / total_ : 0.0,
+                         sequence, total_)
           << std::flush;
   }
 
@@ -433,7 +417,7 @@ Status Decode(const DecodePaths& paths, const proto::DecodeParams& params, std::
   DecodeSummary s;
   TILTCAL_RETURN_IF_ERROR(CheckPaths(paths));
   proto::Rig rig;
-  if (!paths.rig.empty()) TILTCAL_RETURN_IF_ERROR(ReadTextProto(paths.rig, &rig));
+  if (!paths.rig.empty()) TILTCAL_RETURN_IF_ERROR(LoadRig(paths.rig, &rig));
   ros1::BagReader reader;
   TILTCAL_RETURN_IF_ERROR(OpenBag(paths, params, rig, &reader, &s));
   ros1::ReadOptions options;

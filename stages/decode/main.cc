@@ -1,49 +1,37 @@
-// tiltcal_decode --bag=IN.bag --params=P.txtpb [--rig=rig.txtpb]
-//                --out_imu=imu.binpb --out_scans=scans.binpb.lz4
-// Decodes the IMU and LiDAR topics of a ROS1 bag into record streams.
-#include <cstdio>
+// tiltcal_decode: the IMU and LiDAR topics of a ROS1 bag into record streams.
 #include <iostream>
 
-#include <gflags/gflags.h>
-
+#include "common/cli/command_line.h"
 #include "common/io/params.h"
-#include "common/io/provenance.h"
 #include "stages/decode/decode.h"
+#include "stages/decode/default_params_text.h"
 #include "tiltcal/proto/decode_params.pb.h"
 
-DEFINE_string(bag, "", "input ROS1 bag (.bag)");
-DEFINE_string(params, "", "decode params (text format; see stages/decode/default_params.txtpb)");
-DEFINE_string(rig, "", "optional rig.txtpb (imu_topic / lidar_topic)");
-DEFINE_string(out_imu, "", "output IMU stream (imu.binpb)");
-DEFINE_string(out_scans, "", "output scan stream (scans.binpb.lz4)");
-
 int main(int argc, char** argv) {
-  const std::string command_line = tiltcal::JoinCommandLine(argc, argv);
-  gflags::SetUsageMessage(
-      "--bag=IN.bag --params=P.txtpb [--rig=rig.txtpb] --out_imu=imu.binpb "
-      "--out_scans=scans.binpb.lz4");
-  gflags::ParseCommandLineFlags(&argc, &argv, true);
-  tiltcal::Status status = tiltcal::Status::Ok();
+  tiltcal::cli::CommandLine cli(
+      "tiltcal_decode",
+      "decodes the IMU and LiDAR topics of a ROS1 bag (none / bz2 / lz4 chunks, indexed or "
+      "not) into imu.binpb and scans.binpb.lz4");
+  cli.AddFlag("bag", "input: the ROS1 bag (.bag)", tiltcal::cli::kRequired);
+  cli.AddFlag("rig", "input: the dataset's rig.txtpb (imu_topic / lidar_topic)");
+  cli.AddFlag("params",
+              "decode params, text format (default: stages/decode/default_params.txtpb)");
+  cli.AddFlag("out_imu", "output: the IMU stream (imu.binpb)", tiltcal::cli::kRequired);
+  cli.AddFlag("out_scans", "output: the scan stream (scans.binpb.lz4)", tiltcal::cli::kRequired);
+  cli.AddExample(
+      "tiltcal_decode --bag=datasets/husky/run1.bag --rig=datasets/husky/rig.txtpb "
+      "--out_imu=out/run1/imu.binpb --out_scans=out/run1/scans.binpb.lz4");
+  if (const auto exit_code = cli.Parse(argc, argv)) return *exit_code;
+  tiltcal::DecodePaths paths;
+  paths.bag = cli.Get("bag");
+  paths.rig = cli.Get("rig");
+  paths.out_imu = cli.Get("out_imu");
+  paths.out_scans = cli.Get("out_scans");
+  paths.params = cli.Get("params");
+  paths.command_line = cli.command_line();
   tiltcal::proto::DecodeParams params;
-  if (FLAGS_params.empty()) {
-    status = tiltcal::Status::Error(
-        "--params is required (start from stages/decode/default_params.txtpb)");
-  } else {
-    status = tiltcal::LoadParams(FLAGS_params, &params);
-  }
-  if (status.ok()) {
-    tiltcal::DecodePaths paths;
-    paths.bag = FLAGS_bag;
-    paths.rig = FLAGS_rig;
-    paths.out_imu = FLAGS_out_imu;
-    paths.out_scans = FLAGS_out_scans;
-    paths.params = FLAGS_params;
-    paths.command_line = command_line;
-    status = tiltcal::Run(paths, params, &std::cerr);
-  }
-  if (!status.ok()) {
-    std::fprintf(stderr, "tiltcal_decode: %s\n", status.message().c_str());
-    return 1;
-  }
-  return 0;
+  tiltcal::Status status = tiltcal::LoadParamsOrDefaults(
+      paths.params, tiltcal::decode::DefaultParamsText(), &params);
+  if (status.ok()) status = tiltcal::Run(paths, params, &std::cerr);
+  return cli.Finish(status);
 }

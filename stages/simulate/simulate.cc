@@ -5,12 +5,12 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <iostream>
 #include <thread>
 #include <vector>
 
 #include <Eigen/Geometry>
+#include <fmt/format.h>
 
 #include "bag/ros1/bag_writer.h"
 #include "bag/ros1/message_encoding.h"
@@ -475,8 +475,9 @@ class ScanWriter {
         FillTruthScan(scenario_, frames, scans_[j], params_.start_stamp_ns(), stamp,
                       truth->add_scans());
         if (progress != nullptr) {
-          *progress << "\rtiltcal_simulate: scan " << k + 1 << " / " << num_scans
-                    << (k + 1 == num_scans ? "\n" : "") << std::flush;
+          *progress << fmt::format("\rtiltcal_simulate: scan {} / {}{}", k + 1, num_scans,
+                                   k + 1 == num_scans ? "\n" : "")
+                    << std::flush;
         }
       }
     }
@@ -523,13 +524,11 @@ class ScanWriter {
 
 void PrintSummary(std::ostream* log, const SimulateSummary& s) {
   if (log == nullptr) return;
-  char line[256];
-  std::snprintf(line, sizeof(line),
-                "tiltcal_simulate: %d IMU samples, %d scans, %llu points, %.1f MB bag; "
-                "ray casting %.2f s, total %.2f s\n",
-                s.num_imu_samples, s.num_scans, static_cast<unsigned long long>(s.num_points),
-                s.bag_bytes / 1e6, s.raycast_seconds, s.total_seconds);
-  *log << line;
+  *log << fmt::format(
+      "tiltcal_simulate: {} IMU samples, {} scans, {} points, {:.1f} MB bag; "
+      "ray casting {:.2f} s, total {:.2f} s\n",
+      s.num_imu_samples, s.num_scans, s.num_points, s.bag_bytes / 1e6, s.raycast_seconds,
+      s.total_seconds);
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 // tiltcal_decode as a user runs it: bad input gives ONE error line naming the
 // file (and record), a non-zero exit and no output file; params are checked.
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -13,6 +14,10 @@ namespace tiltcal {
 namespace {
 
 namespace fs = std::filesystem;
+
+// The extrinsic part of a valid rig.txtpb.
+const std::string kRigText =
+    "imu_from_lidar { rotation { w: 1 } translation { x: 0.1 } }\nimu_height_m: 0.3\n";
 
 class DecodeCli : public ::testing::Test {
  protected:
@@ -70,7 +75,7 @@ class DecodeCli : public ::testing::Test {
 TEST_F(DecodeCli, DecodesAWrittenBagWithRig) {
   REQUIRE_WRITTEN_BAG(bag, "velodyne_bz2.bag");
   const std::string rig = tmp_.File("rig.txtpb");
-  WriteFile(rig, "imu_topic: \"/imu/data\"\nlidar_topic: \"/points\"\n");
+  WriteFile(rig, kRigText + "imu_topic: \"/imu/data\"\nlidar_topic: \"/points\"\n");
   std::string output;
   EXPECT_EQ(Decode(bag, params_, &output, "--rig=" + rig), 0) << output;
   EXPECT_TRUE(testing::FileExists(tmp_.File("out/imu.binpb")));
@@ -190,10 +195,45 @@ TEST_F(DecodeCli, ParamsUnknownField) {
   ExpectCleanFailure(rc, output, {params, "min_rang_m"});
 }
 
-TEST_F(DecodeCli, ParamsMissing) {
+// Without --params the stage runs on its defaults, the values of
+// stages/decode/default_params.txtpb: the same counts as with that file.
+TEST_F(DecodeCli, MissingParamsMeanTheDefaults) {
+  REQUIRE_WRITTEN_BAG(bag, "velodyne_bz2.bag");
+  const std::string rig = tmp_.File("rig.txtpb");
+  WriteFile(rig, kRigText + "imu_topic: \"/imu/data\"\nlidar_topic: \"/points\"\n");
+  std::string with_file;
+  ASSERT_EQ(Decode(bag, params_, &with_file, "--rig=" + rig), 0) << with_file;
+  std::string with_defaults;
+  const std::string command = testing::ToolPath("tiltcal_decode") + " --bag='" + bag +
+                              "' --rig=" + rig + " --out_imu=" + tmp_.File("out/imu.binpb") +
+                              " --out_scans=" + tmp_.File("out/scans.binpb.lz4");
+  ASSERT_EQ(testing::RunCommand(command, &with_defaults), 0) << with_defaults;
+  // Every line but the wall time.
+  auto counts = [](const std::string& output) { return output.substr(0, output.find("  wall")); };
+  EXPECT_NE(counts(with_file).find("points: "), std::string::npos) << with_file;
+  EXPECT_EQ(counts(with_defaults), counts(with_file));
+}
+
+// A missing output flag is a usage error (exit 2) naming the flag.
+TEST_F(DecodeCli, RequiredFlagMissing) {
   std::string output;
-  const int rc = Decode("/nonexistent.bag", "", &output);
-  ExpectCleanFailure(rc, output, {"--params"});
+  const int rc = testing::RunCommand(
+      testing::ToolPath("tiltcal_decode") + " --bag=/nonexistent.bag --out_imu=" +
+          tmp_.File("out/imu.binpb"),
+      &output);
+  EXPECT_EQ(rc, 2);
+  EXPECT_NE(output.find("--out_scans"), std::string::npos) << output;
+  EXPECT_EQ(std::count(output.begin(), output.end(), '\n'), 1) << output;
+  EXPECT_TRUE(fs::is_empty(tmp_.File("out")));
+}
+
+// The rig is validated: a zero rotation quaternion is an error naming the field.
+TEST_F(DecodeCli, InvalidRigIsRejected) {
+  const std::string rig = tmp_.File("rig.txtpb");
+  WriteFile(rig, "imu_from_lidar { rotation { w: 0 } translation {} }\n");
+  std::string output;
+  const int rc = Decode("/nonexistent.bag", params_, &output, "--rig=" + rig);
+  ExpectCleanFailure(rc, output, {rig, "imu_from_lidar.rotation"});
 }
 
 TEST_F(DecodeCli, MissingBag) {

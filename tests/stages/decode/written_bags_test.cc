@@ -14,7 +14,9 @@
 #include "common/io/record_stream.h"
 #include "common/io/text_proto.h"
 #include "stages/decode/decode.h"
+#include "stages/decode/default_params_text.h"
 #include "tests/bag/ros1/bag_test_util.h"
+#include "tests/testing/params_text.h"
 #include "tests/testing/test_env.h"
 #include "tiltcal/proto/imu.pb.h"
 #include "tiltcal/proto/rig.pb.h"
@@ -121,9 +123,11 @@ class WrittenBags : public ::testing::Test {
                       "cannot write the test bags";
     }
     ASSERT_FALSE(dir_.empty()) << "write_test_bags.py failed:\n" << log;
-    params_.set_min_range_m(kMinRangeM);
-    params_.set_drop_non_monotonic(true);
-    params_.set_chunk_cache_size(2);  // small: evictions happen
+    // min_range_m as MIN_RANGE_M of write_test_bags.py; a small chunk cache:
+    // evictions happen.
+    params_ = testing::DefaultParamsWith<proto::DecodeParams>(
+        decode::DefaultParamsText(), "min_range_m: " + std::to_string(kMinRangeM) +
+                                         " drop_non_monotonic: true chunk_cache_size: 2");
   }
 
   Status Decode(const std::string& bag, const proto::DecodeParams& params,
@@ -279,7 +283,8 @@ TEST_F(WrittenBags, SeveralImuTopicsNeedAChoice) {
 }
 
 TEST_F(WrittenBags, RigChoosesTopicsAndParamsWin) {
-  proto::Rig rig;
+  proto::Rig rig = testing::ParamsFromText<proto::Rig>(
+      "imu_from_lidar { rotation { w: 1 } translation {} } imu_height_m: 0.3");
   rig.set_imu_topic("/imu/a");
   const std::string rig_path = tmp_.File("rig.txtpb");
   ASSERT_TRUE(WriteTextProto(rig_path, rig).ok());
