@@ -14,11 +14,9 @@
 #include "bag/ros1/bag_reader.h"
 #include "bag/ros1/messages.h"
 #include "common/io/provenance.h"
-#include "common/io/record_stream.h"
 #include "common/io/rig.h"
 #include "stages/decode/async_record_writer.h"
-#include "stages/decode/point_cloud_conversion.h"
-#include "tiltcal/proto/imu.pb.h"
+#include "stages/decode/message_sinks.h"
 #include "tiltcal/proto/rig.pb.h"
 #include "tiltcal/proto/scan.pb.h"
 
@@ -27,13 +25,6 @@ namespace tiltcal {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-// ns -> "sec.nnnnnnnnn" exactly (no rounding through a double).
-std::string FormatSeconds(int64_t ns) {
-  const bool negative = ns < 0;
-  const uint64_t abs_ns = negative ? 0 - static_cast<uint64_t>(ns) : static_cast<uint64_t>(ns);
-  return fmt::format("{}{}.{:09}", negative ? "-" : "", abs_ns / 1000000000, abs_ns % 1000000000);
-}
 
 std::string Join(const std::vector<std::string>& items) {
   std::string out;
@@ -84,24 +75,6 @@ Status ChooseTopic(const ros1::BagReader& reader, const std::string& type,
   return Status::Ok();
 }
 
-// One IMU sample kept until the end (sorted by stamp before writing).
-struct ImuRecord {
-  int64_t stamp_ns;
-  int64_t record_ns;
-  double angular_velocity[3];
-  double linear_acceleration[3];
-};
-
-bool SameValues(const ImuRecord& a, const ImuRecord& b) {
-  for (int i = 0; i < 3; ++i) {
-    if (a.angular_velocity[i] != b.angular_velocity[i] ||
-        a.linear_acceleration[i] != b.linear_acceleration[i]) {
-      return false;
-    }
-  }
-  return true;
-}
-
 double RateHz(int64_t count, int64_t first_ns, int64_t last_ns) {
   if (count < 2 || last_ns <= first_ns) return 0.0;
   return static_cast<double>(count - 1) / (static_cast<double>(last_ns - first_ns) * 1e-9);
@@ -145,13 +118,6 @@ void PrintSummary(std::ostream* log, const DecodePaths& paths, const DecodeSumma
                       s.wall_s > 0 ? mb / s.wall_s : 0.0, s.chunks_decompressed);
 }
 
-// Where a message came from, for its errors.
-std::string MessageContext(const std::string& bag, const ros1::MessageView& m, int64_t index) {
-  return bag + ": topic '" + m.connection->topic + "' message " + std::to_string(index) +
-         " (record time " + FormatSeconds(m.time_ns) + " s, chunk at byte " +
-         std::to_string(m.chunk_pos) + ")";
-}
-
 // True when `log` is the standard error stream and that is a terminal.
 bool IsTerminal(const std::ostream* log) {
   return (log == &std::cerr || log == &std::clog) && ::isatty(STDERR_FILENO);
@@ -182,161 +148,6 @@ class ProgressLine {
   std::ostream* log_;
   int64_t total_;
   Clock::time_point last_;
-};
-
-// The IMU messages: kept in memory, then sorted by stamp, cleared of
-// repeated stamps and written.
-class ImuSink {
- public:
-  ImuSink(const std::string& bag, int64_t expected_messages) : bag_(bag) {
-    samples_.reserve(static_cast<size_t>(std::max<int64_t>(expected_messages, 0)));
-  }
-
-  // Decodes one sensor_msgs/Imu message and keeps its sample.
-  Status Add(const ros1::MessageView& m, DecodeSummary* s) {
-    const int64_t index = s->imu_messages++;
-    Status status = ros1::DecodeImu(m.data, m.size, &message_);
-    if (!status.ok()) {
-      return status.WithContext(MessageContext(bag_, m, index) + ": sensor_msgs/Imu");
-    }
-    ImuRecord r;
-    r.stamp_ns = ros1::RosTimeToNs(message_.header.stamp);
-    r.record_ns = m.time_ns;
-    for (int i = 0; i < 3; ++i) {
-      r.angular_velocity[i] = message_.angular_velocity[i];
-      r.linear_acceleration[i] = message_.linear_acceleration[i];
-      if (!std::isfinite(r.angular_velocity[i]) || !std::isfinite(r.linear_acceleration[i])) {
-        return Status::Error(MessageContext(bag_, m, index) +
-                             ": sensor_msgs/Imu has a NaN or Inf angular velocity or linear "
-                             "acceleration");
-      }
-    }
-    samples_.push_back(r);
-    return Status::Ok();
-  }
-
-  bool empty() const { return samples_.empty(); }
-
-  // Sorts by stamp (stable: record order among equal stamps), drops repeated
-  // stamps (the first sample of a stamp is kept) and writes the stream.
-  Status Write(const std::string& path, const proto::Provenance& provenance, DecodeSummary* s) {
-    std::stable_sort(samples_.begin(), samples_.end(),
-                     [](const ImuRecord& a, const ImuRecord& b) { return a.stamp_ns < b.stamp_ns; });
-    RecordWriter writer;
-    TILTCAL_RETURN_IF_ERROR(writer.Open(path, proto::ImuSample::descriptor()->full_name(),
-                                        provenance, /*compress=*/false));
-    proto::ImuSample sample;
-    size_t first_of_stamp = 0;
-    for (size_t i = 0; i < samples_.size(); ++i) {
-      const ImuRecord& r = samples_[i];
-      if (i > 0 && r.stamp_ns == samples_[i - 1].stamp_ns) {
-        // Compared with the kept sample of this stamp.
-        ++(SameValues(r, samples_[first_of_stamp]) ? s->imu_duplicates_dropped
-                                                   : s->imu_conflicting_dropped);
-        continue;
-      }
-      first_of_stamp = i;
-      ToSample(r, &sample);
-      TILTCAL_RETURN_IF_ERROR(writer.Write(sample));
-      if (s->imu_written == 0) s->imu_first_stamp_ns = r.stamp_ns;
-      s->imu_last_stamp_ns = r.stamp_ns;
-      ++s->imu_written;
-    }
-    return writer.Close();
-  }
-
- private:
-  static void ToSample(const ImuRecord& r, proto::ImuSample* sample) {
-    sample->set_stamp_ns(r.stamp_ns);
-    sample->set_record_stamp_ns(r.record_ns);
-    auto* w = sample->mutable_angular_velocity_radps();
-    w->set_x(r.angular_velocity[0]);
-    w->set_y(r.angular_velocity[1]);
-    w->set_z(r.angular_velocity[2]);
-    auto* a = sample->mutable_linear_acceleration_mps2();
-    a->set_x(r.linear_acceleration[0]);
-    a->set_y(r.linear_acceleration[1]);
-    a->set_z(r.linear_acceleration[2]);
-  }
-
-  std::string bag_;
-  std::vector<ImuRecord> samples_;
-  ros1::ImuMessage message_;
-};
-
-// The PointCloud2 messages: each converted to a Scan and handed to the
-// writer thread, unless it has no valid point or its stamp does not advance.
-class ScanSink {
- public:
-  ScanSink(const std::string& bag, const proto::DecodeParams& params, AsyncRecordWriter* writer)
-      : bag_(bag), params_(params), writer_(writer) {
-    conversion_.min_range_m = params.min_range_m();
-  }
-
-  Status Add(const ros1::MessageView& m, DecodeSummary* s) {
-    const int64_t index = s->scan_messages++;
-    auto* scan = static_cast<proto::Scan*>(writer_->Acquire());
-    Status status = Convert(m, index, scan, s);
-    if (!status.ok() || !keep_) {
-      writer_->Release(scan);
-      return status;
-    }
-    return writer_->Submit(scan);
-  }
-
- private:
-  // Converts the message into *scan and decides keep_.
-  Status Convert(const ros1::MessageView& m, int64_t index, proto::Scan* scan,
-                 DecodeSummary* s) {
-    keep_ = false;
-    Status status = ros1::DecodePointCloud2(m.data, m.size, &cloud_);
-    if (status.ok()) status = ConvertPointCloud2ToScan(cloud_, conversion_, scan);
-    if (!status.ok()) {
-      return status.WithContext(MessageContext(bag_, m, index) + ": sensor_msgs/PointCloud2");
-    }
-    s->points_dropped_invalid += scan->num_dropped_invalid();
-    s->points_dropped_range += scan->num_dropped_zero_range();
-    if (scan->time_source() == proto::POINT_TIME_NONE) {
-      if (params_.require_point_time()) {
-        return Status::Error(MessageContext(bag_, m, index) +
-                             ": sensor_msgs/PointCloud2 has no per-point time field (fields: " +
-                             DescribeFields(cloud_) + ") and require_point_time is set");
-      }
-      ++s->scans_without_point_time;
-    }
-    if (scan->x_size() == 0) {
-      ++s->scans_empty_dropped;
-      return Status::Ok();
-    }
-    if (scan->stamp_ns() <= last_stamp_ns_) {
-      if (!params_.drop_non_monotonic()) {
-        return Status::Error(MessageContext(bag_, m, index) + ": scan stamp " +
-                             FormatSeconds(scan->stamp_ns()) +
-                             " s is not after the previous scan's " +
-                             FormatSeconds(last_stamp_ns_) +
-                             " s (set drop_non_monotonic to drop such scans)");
-      }
-      ++s->scans_non_monotonic_dropped;
-      return Status::Ok();
-    }
-    last_stamp_ns_ = scan->stamp_ns();
-    scan->set_index(static_cast<uint32_t>(s->scans_written));
-    scan->set_record_stamp_ns(m.time_ns);
-    if (s->scans_written == 0) s->scan_first_stamp_ns = scan->stamp_ns();
-    s->scan_last_stamp_ns = scan->stamp_ns();
-    ++s->scans_written;
-    s->points_written += scan->x_size();
-    keep_ = true;
-    return Status::Ok();
-  }
-
-  std::string bag_;
-  const proto::DecodeParams& params_;
-  AsyncRecordWriter* writer_;
-  PointConversionOptions conversion_;
-  ros1::PointCloud2View cloud_;
-  int64_t last_stamp_ns_ = INT64_MIN;
-  bool keep_ = false;
 };
 
 Status CheckPaths(const DecodePaths& paths) {

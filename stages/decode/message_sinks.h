@@ -1,0 +1,84 @@
+#ifndef TILTCAL_STAGES_DECODE_MESSAGE_SINKS_H_
+#define TILTCAL_STAGES_DECODE_MESSAGE_SINKS_H_
+
+// Where the decode stage puts the messages of its two topics, one message at
+// a time in record-time order: the IMU sink keeps the samples to sort them
+// by stamp at the end, the scan sink converts each cloud and hands it to the
+// writer thread. Both count what they keep and drop in the DecodeSummary.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "bag/ros1/bag_reader.h"
+#include "bag/ros1/messages.h"
+#include "common/status.h"
+#include "stages/decode/async_record_writer.h"
+#include "stages/decode/decode.h"
+#include "stages/decode/point_cloud_conversion.h"
+#include "tiltcal/proto/decode_params.pb.h"
+#include "tiltcal/proto/imu.pb.h"
+#include "tiltcal/proto/scan.pb.h"
+#include "tiltcal/proto/stream.pb.h"
+
+namespace tiltcal {
+
+// ns -> "sec.nnnnnnnnn" exactly (no rounding through a double).
+std::string FormatSeconds(int64_t ns);
+
+// The sensor_msgs/Imu messages: kept in memory, then sorted by stamp,
+// cleared of repeated stamps and written.
+class ImuSink {
+ public:
+  ImuSink(const std::string& bag, int64_t expected_messages);
+
+  // Decodes one message and keeps its sample. A NaN or Inf value is an error.
+  Status Add(const ros1::MessageView& m, DecodeSummary* s);
+
+  bool empty() const { return samples_.empty(); }
+
+  // Sorts by stamp (stable: record order among equal stamps), drops repeated
+  // stamps (the first sample of a stamp is kept) and writes the stream.
+  Status Write(const std::string& path, const proto::Provenance& provenance, DecodeSummary* s);
+
+ private:
+  // One IMU sample kept until the end.
+  struct Record {
+    int64_t stamp_ns;
+    int64_t record_ns;
+    double angular_velocity[3];
+    double linear_acceleration[3];
+  };
+  static bool SameValues(const Record& a, const Record& b);
+  static void ToSample(const Record& r, proto::ImuSample* sample);
+
+  std::string bag_;
+  std::vector<Record> samples_;
+  ros1::ImuMessage message_;
+};
+
+// The sensor_msgs/PointCloud2 messages: each converted to a Scan and handed
+// to the writer thread, unless it has no valid point or its stamp does not
+// advance (an error unless params.drop_non_monotonic).
+class ScanSink {
+ public:
+  ScanSink(const std::string& bag, const proto::DecodeParams& params, AsyncRecordWriter* writer);
+
+  Status Add(const ros1::MessageView& m, DecodeSummary* s);
+
+ private:
+  // Converts the message into *scan; *keep says whether it is written.
+  Status Convert(const ros1::MessageView& m, int64_t index, proto::Scan* scan, bool* keep,
+                 DecodeSummary* s);
+
+  std::string bag_;
+  const proto::DecodeParams& params_;
+  AsyncRecordWriter* writer_;
+  PointConversionOptions conversion_;
+  ros1::PointCloud2View cloud_;
+  int64_t last_stamp_ns_ = INT64_MIN;
+};
+
+}  // namespace tiltcal
+
+#endif  // TILTCAL_STAGES_DECODE_MESSAGE_SINKS_H_
