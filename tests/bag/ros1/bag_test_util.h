@@ -1,9 +1,10 @@
 #ifndef TILTCAL_TESTS_BAG_ROS1_BAG_TEST_UTIL_H_
 #define TILTCAL_TESTS_BAG_ROS1_BAG_TEST_UTIL_H_
 
-// Helpers of the decode tests: oracle output from Debian's python rosbag,
-// cached in the build tree (keyed by the script's contents) so that each test
-// process does not rerun python.
+// Helpers of the tests that read ROS1 bags (tests/bag/ros1, the decode
+// stage): bags written and oracle output dumped by Debian's python rosbag
+// (tests/oracle/), cached in the build tree (keyed by the script's contents)
+// so that each test process does not rerun python.
 
 #include <unistd.h>
 
