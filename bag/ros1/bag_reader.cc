@@ -59,6 +59,18 @@ class ByteBuffer {
 
 std::string Quoted(const std::string& s) { return "'" + s + "'"; }
 
+// The op of `header` must be `expected`; otherwise the error is "expected
+// <what>, found op N (name)".
+Status RequireOp(const RecordHeader& header, Op expected, const std::string& what) {
+  uint8_t op = 0;
+  TILTCAL_RETURN_IF_ERROR(header.GetOp(&op));
+  if (op != static_cast<uint8_t>(expected)) {
+    return Status::Error("expected " + what + ", found op " + std::to_string(op) + " (" +
+                         OpName(op) + ")");
+  }
+  return Status::Ok();
+}
+
 }  // namespace
 
 // Reads the fields of a chunk record header: compression and uncompressed size.
@@ -245,16 +257,10 @@ Status BagReader::Open(const std::string& path) {
   RecordHeader header;
   uint64_t data_pos = 0;
   uint32_t data_len = 0;
-  TILTCAL_RETURN_IF_ERROR(ReadRecordHeaderAt(header_pos, &buffer, &header, &data_pos, &data_len));
-  uint8_t op = 0;
-  uint64_t index_pos = 0;
+  TILTCAL_RETURN_IF_ERROR(ReadRecordHeaderAt(header_pos, &buffer, &header, &data_pos, &data_len));  uint64_t index_pos = 0;
   uint32_t conn_count = 0;
   uint32_t chunk_count = 0;
-  Status status = header.GetOp(&op);
-  if (status.ok() && op != static_cast<uint8_t>(Op::kBagHeader)) {
-    status = Status::Error(std::string("expected the bag header record, found op ") +
-                           std::to_string(op) + " (" + OpName(op) + ")");
-  }
+  Status status = RequireOp(header, Op::kBagHeader, "the bag header record");
   if (status.ok()) status = header.GetU64("index_pos", &index_pos);
   if (status.ok()) status = header.GetU32("conn_count", &conn_count);
   if (status.ok()) status = header.GetU32("chunk_count", &chunk_count);
@@ -297,16 +303,12 @@ Status BagReader::ReadConnectionRecords(uint32_t conn_count, uint64_t* pos) {
   RecordHeader header;
   uint64_t data_pos = 0;
   uint32_t data_len = 0;
-  uint8_t op = 0;
   for (uint32_t i = 0; i < conn_count; ++i) {
     TILTCAL_RETURN_IF_ERROR(ReadRecordHeaderAt(*pos, &buffer, &header, &data_pos, &data_len));
-    Status status = header.GetOp(&op);
+    const Status status = RequireOp(header, Op::kConnection,
+                                    "connection record " + std::to_string(i + 1) + " of " +
+                                        std::to_string(conn_count));
     if (!status.ok()) return Error(*pos, status.message());
-    if (op != static_cast<uint8_t>(Op::kConnection)) {
-      return Error(*pos, "expected connection record " + std::to_string(i + 1) + " of " +
-                            std::to_string(conn_count) + ", found op " + std::to_string(op) +
-                            " (" + OpName(op) + ")");
-    }
     data.resize(data_len);
     TILTCAL_RETURN_IF_ERROR(ReadAt(data_pos, data_len, data.data()));
     TILTCAL_RETURN_IF_ERROR(AddConnection(
@@ -322,7 +324,6 @@ Status BagReader::ReadChunkInfos(uint32_t chunk_count, uint64_t pos) {
   RecordHeader header;
   uint64_t data_pos = 0;
   uint32_t data_len = 0;
-  uint8_t op = 0;
   std::set<uint64_t> chunk_positions;
   for (uint32_t i = 0; i < chunk_count; ++i) {
     TILTCAL_RETURN_IF_ERROR(ReadRecordHeaderAt(pos, &buffer, &header, &data_pos, &data_len));
@@ -331,12 +332,9 @@ Status BagReader::ReadChunkInfos(uint32_t chunk_count, uint64_t pos) {
     uint32_t count = 0;
     RosTime start;
     RosTime end;
-    Status status = header.GetOp(&op);
-    if (status.ok() && op != static_cast<uint8_t>(Op::kChunkInfo)) {
-      status = Status::Error("expected chunk info record " + std::to_string(i + 1) + " of " +
-                             std::to_string(chunk_count) + ", found op " + std::to_string(op) +
-                             " (" + OpName(op) + ")");
-    }
+    Status status = RequireOp(header, Op::kChunkInfo,
+                              "chunk info record " + std::to_string(i + 1) + " of " +
+                                  std::to_string(chunk_count));
     if (status.ok()) status = header.GetU32("ver", &version);
     if (status.ok() && version != kChunkInfoVersion) {
       status = Status::Error("chunk info version " + std::to_string(version) + " (expected 1)");
@@ -413,17 +411,13 @@ Status BagReader::ReadChunkIndex(size_t chunk_index, const std::vector<size_t>& 
   std::string data;
   for (size_t k = 0; k < chunk.connection_counts.size(); ++k) {
     TILTCAL_RETURN_IF_ERROR(ReadRecordHeaderAt(pos, &buffer, &header, &data_pos, &data_len));
-    uint8_t op = 0;
     uint32_t version = 0;
     uint32_t conn = 0;
     uint32_t count = 0;
-    Status status = header.GetOp(&op);
-    if (status.ok() && op != static_cast<uint8_t>(Op::kIndexData)) {
-      status = Status::Error("expected index data record " + std::to_string(k + 1) + " of " +
-                             std::to_string(chunk.connection_counts.size()) +
-                             " of the chunk at byte " + std::to_string(chunk.pos) +
-                             ", found op " + std::to_string(op) + " (" + OpName(op) + ")");
-    }
+    Status status = RequireOp(header, Op::kIndexData,
+                              "index data record " + std::to_string(k + 1) + " of " +
+                                  std::to_string(chunk.connection_counts.size()) +
+                                  " of the chunk at byte " + std::to_string(chunk.pos));
     if (status.ok()) status = header.GetU32("ver", &version);
     if (status.ok() && version != kIndexDataVersion) {
       status = Status::Error("index data version " + std::to_string(version) + " (expected 1)");

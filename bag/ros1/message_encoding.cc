@@ -1,6 +1,7 @@
 #include "bag/ros1/message_encoding.h"
 
 #include <cstring>
+#include <string>
 
 #include "bag/ros1/format.h"
 
@@ -8,8 +9,28 @@ namespace tiltcal::ros1 {
 
 // Full message definitions as recorded by rosbag (the top-level .msg, then
 // each dependency after a line of 80 '=' and "MSG: pkg/Type"), from
-// ros/common_msgs (sensor_msgs, geometry_msgs) and ros/std_msgs, noetic.
-const char kImuDefinition[] = R"msgdef(# This is a message to hold data from an IMU (Inertial Measurement Unit)
+// ros/common_msgs (sensor_msgs, geometry_msgs) and ros/std_msgs, noetic, in
+// pieces: the top-level .msg, std_msgs/Header (the first dependency of both
+// messages), the other dependencies.
+const char kHeaderDefinition[] = R"msgdef(================================================================================
+MSG: std_msgs/Header
+# Standard metadata for higher-level stamped data types.
+# This is generally used to communicate timestamped data 
+# in a particular coordinate frame.
+# 
+# sequence ID: consecutively increasing ID 
+uint32 seq
+#Two-integer timestamp that is expressed as:
+# * stamp.sec: seconds (stamp_secs) since epoch (in Python the variable is called 'secs')
+# * stamp.nsec: nanoseconds since stamp_secs (in Python the variable is called 'nsecs')
+# time-handling sugar is provided by the client library
+time stamp
+#Frame this data is associated with
+string frame_id
+
+)msgdef";
+
+const char kImuDefinitionTop[] = R"msgdef(# This is a message to hold data from an IMU (Inertial Measurement Unit)
 #
 # Accelerations should be in m/s^2 (not in g's), and rotational velocity should be in rad/sec
 #
@@ -34,23 +55,8 @@ float64[9] angular_velocity_covariance # Row major about x, y, z axes
 geometry_msgs/Vector3 linear_acceleration
 float64[9] linear_acceleration_covariance # Row major x, y z 
 
-================================================================================
-MSG: std_msgs/Header
-# Standard metadata for higher-level stamped data types.
-# This is generally used to communicate timestamped data 
-# in a particular coordinate frame.
-# 
-# sequence ID: consecutively increasing ID 
-uint32 seq
-#Two-integer timestamp that is expressed as:
-# * stamp.sec: seconds (stamp_secs) since epoch (in Python the variable is called 'secs')
-# * stamp.nsec: nanoseconds since stamp_secs (in Python the variable is called 'nsecs')
-# time-handling sugar is provided by the client library
-time stamp
-#Frame this data is associated with
-string frame_id
-
-================================================================================
+)msgdef";
+const char kImuDefinitionDependencies[] = R"msgdef(================================================================================
 MSG: geometry_msgs/Quaternion
 # This represents an orientation in free space in quaternion form.
 
@@ -72,7 +78,7 @@ float64 x
 float64 y
 float64 z)msgdef";
 
-const char kPointCloud2Definition[] = R"msgdef(# This message holds a collection of N-dimensional points, which may
+const char kPointCloud2DefinitionTop[] = R"msgdef(# This message holds a collection of N-dimensional points, which may
 # contain additional information such as normals, intensity, etc. The
 # point data is stored as a binary blob, its layout described by the
 # contents of the "fields" array.
@@ -100,23 +106,8 @@ uint8[] data         # Actual point data, size is (row_step*height)
 
 bool is_dense        # True if there are no invalid points
 
-================================================================================
-MSG: std_msgs/Header
-# Standard metadata for higher-level stamped data types.
-# This is generally used to communicate timestamped data 
-# in a particular coordinate frame.
-# 
-# sequence ID: consecutively increasing ID 
-uint32 seq
-#Two-integer timestamp that is expressed as:
-# * stamp.sec: seconds (stamp_secs) since epoch (in Python the variable is called 'secs')
-# * stamp.nsec: nanoseconds since stamp_secs (in Python the variable is called 'nsecs')
-# time-handling sugar is provided by the client library
-time stamp
-#Frame this data is associated with
-string frame_id
-
-================================================================================
+)msgdef";
+const char kPointCloud2DefinitionDependencies[] = R"msgdef(================================================================================
 MSG: sensor_msgs/PointField
 # This message holds the description of one point entry in the
 # PointCloud2 message format.
@@ -136,13 +127,18 @@ uint32 count     # How many elements in the field
 )msgdef";
 
 const MessageType& ImuMessageType() {
-  static const MessageType kType{kImuType, "6a62c6daae103f4ff57a132d6f95cec2", kImuDefinition};
+  static const std::string kDefinition =
+      std::string(kImuDefinitionTop) + kHeaderDefinition + kImuDefinitionDependencies;
+  static const MessageType kType{kImuType, "6a62c6daae103f4ff57a132d6f95cec2",
+                                 kDefinition.c_str()};
   return kType;
 }
 
 const MessageType& PointCloud2MessageType() {
+  static const std::string kDefinition = std::string(kPointCloud2DefinitionTop) +
+                                         kHeaderDefinition + kPointCloud2DefinitionDependencies;
   static const MessageType kType{kPointCloud2Type, "1158d486dd51d683ce2f1be655c3c181",
-                                 kPointCloud2Definition};
+                                 kDefinition.c_str()};
   return kType;
 }
 

@@ -80,6 +80,18 @@ double RateHz(int64_t count, int64_t first_ns, int64_t last_ns) {
   return static_cast<double>(count - 1) / (static_cast<double>(last_ns - first_ns) * 1e-9);
 }
 
+// One topic's line of the summary: messages read and written, rate, stamp
+// range and what was dropped.
+std::string TopicLine(const char* label, const std::string& topic, int64_t messages,
+                      int64_t written, int64_t first_ns, int64_t last_ns,
+                      const std::string& dropped) {
+  return fmt::format("  {} '{}': {} msgs, {} written, {:.2f} Hz, stamps {} .. {} s ({:.3f} s); "
+                     "dropped {}\n",
+                     label, topic, messages, written, RateHz(written, first_ns, last_ns),
+                     FormatSeconds(first_ns), FormatSeconds(last_ns),
+                     static_cast<double>(last_ns - first_ns) * 1e-9, dropped);
+}
+
 void PrintSummary(std::ostream* log, const DecodePaths& paths, const DecodeSummary& s) {
   if (log == nullptr) return;
   const double mb = static_cast<double>(s.bag_bytes) * 1e-6;
@@ -90,22 +102,14 @@ void PrintSummary(std::ostream* log, const DecodePaths& paths, const DecodeSumma
                         s.salvaged_messages, s.salvage_note.empty() ? "" : "; ",
                         s.salvage_note);
   }
-  *log << fmt::format(
-      "  imu   '{}': {} msgs, {} written, {:.2f} Hz, stamps {} .. {} s ({:.3f} s); "
-      "dropped {} duplicate + {} conflicting stamps\n",
-      s.imu_topic, s.imu_messages, s.imu_written,
-      RateHz(s.imu_written, s.imu_first_stamp_ns, s.imu_last_stamp_ns),
-      FormatSeconds(s.imu_first_stamp_ns), FormatSeconds(s.imu_last_stamp_ns),
-      static_cast<double>(s.imu_last_stamp_ns - s.imu_first_stamp_ns) * 1e-9,
-      s.imu_duplicates_dropped, s.imu_conflicting_dropped);
-  *log << fmt::format(
-      "  lidar '{}': {} msgs, {} written, {:.2f} Hz, stamps {} .. {} s ({:.3f} s); "
-      "dropped {} non-monotonic + {} empty scans\n",
-      s.lidar_topic, s.scan_messages, s.scans_written,
-      RateHz(s.scans_written, s.scan_first_stamp_ns, s.scan_last_stamp_ns),
-      FormatSeconds(s.scan_first_stamp_ns), FormatSeconds(s.scan_last_stamp_ns),
-      static_cast<double>(s.scan_last_stamp_ns - s.scan_first_stamp_ns) * 1e-9,
-      s.scans_non_monotonic_dropped, s.scans_empty_dropped);
+  *log << TopicLine("imu  ", s.imu_topic, s.imu_messages, s.imu_written, s.imu_first_stamp_ns,
+                    s.imu_last_stamp_ns,
+                    fmt::format("{} duplicate + {} conflicting stamps", s.imu_duplicates_dropped,
+                                s.imu_conflicting_dropped));
+  *log << TopicLine("lidar", s.lidar_topic, s.scan_messages, s.scans_written,
+                    s.scan_first_stamp_ns, s.scan_last_stamp_ns,
+                    fmt::format("{} non-monotonic + {} empty scans",
+                                s.scans_non_monotonic_dropped, s.scans_empty_dropped));
   *log << fmt::format("  points: {} written; dropped {} NaN/Inf, {} zero/short range\n",
                       s.points_written, s.points_dropped_invalid, s.points_dropped_range);
   if (s.scans_without_point_time > 0) {

@@ -15,10 +15,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// The extrinsic part of a valid rig.txtpb.
-const std::string kRigText =
-    "imu_from_lidar { rotation { w: 1 } translation { x: 0.1 } }\nimu_height_m: 0.3\n";
-
 class DecodeCli : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -62,6 +58,15 @@ class DecodeCli : public ::testing::Test {
     out << contents;
   }
 
+  // A valid rig.txtpb naming the topics of the written velodyne bags.
+  std::string WriteRigWithTopics() {
+    const std::string rig = tmp_.File("rig.txtpb");
+    WriteFile(rig,
+              "imu_from_lidar { rotation { w: 1 } translation { x: 0.1 } }\nimu_height_m: 0.3\n"
+              "imu_topic: \"/imu/data\"\nlidar_topic: \"/points\"\n");
+    return rig;
+  }
+
   testing::TempDir tmp_;
   std::string params_;
 };
@@ -74,8 +79,7 @@ class DecodeCli : public ::testing::Test {
 
 TEST_F(DecodeCli, DecodesAWrittenBagWithRig) {
   REQUIRE_WRITTEN_BAG(bag, "velodyne_bz2.bag");
-  const std::string rig = tmp_.File("rig.txtpb");
-  WriteFile(rig, kRigText + "imu_topic: \"/imu/data\"\nlidar_topic: \"/points\"\n");
+  const std::string rig = WriteRigWithTopics();
   std::string output;
   EXPECT_EQ(Decode(bag, params_, &output, "--rig=" + rig), 0) << output;
   EXPECT_TRUE(testing::FileExists(tmp_.File("out/imu.binpb")));
@@ -199,8 +203,7 @@ TEST_F(DecodeCli, ParamsUnknownField) {
 // stages/decode/default_params.txtpb: the same counts as with that file.
 TEST_F(DecodeCli, MissingParamsMeanTheDefaults) {
   REQUIRE_WRITTEN_BAG(bag, "velodyne_bz2.bag");
-  const std::string rig = tmp_.File("rig.txtpb");
-  WriteFile(rig, kRigText + "imu_topic: \"/imu/data\"\nlidar_topic: \"/points\"\n");
+  const std::string rig = WriteRigWithTopics();
   std::string with_file;
   ASSERT_EQ(Decode(bag, params_, &with_file, "--rig=" + rig), 0) << with_file;
   std::string with_defaults;
