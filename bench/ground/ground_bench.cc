@@ -182,7 +182,7 @@ int main(int argc, char** argv) {
     }
     tiltcal::imu::GyroIntegrator integrator(imu, Eigen::Vector3d::Zero());
     tiltcal::ground::Deskewer deskewer(&integrator, -1000000000LL, Eigen::Matrix3d::Identity(),
-                                       0, params.deskew_node_spacing_s());
+                                       params.deskew());
     PrintRow("  + deskewing (timing only)", TimeScans(params, vlp, passes, &deskewer), 0.0);
   }
 

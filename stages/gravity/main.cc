@@ -32,7 +32,7 @@ int main(int argc, char** argv) {
   if (status.ok()) {
     status = tiltcal::gravity::Run({FLAGS_imu, FLAGS_ground, FLAGS_rig, FLAGS_calibration,
                                     FLAGS_params, FLAGS_out, command_line},
-                                   params);
+                                   params, &std::cerr);
   }
   if (!status.ok()) {
     std::cerr << "tiltcal_gravity: " << status.message() << "\n";

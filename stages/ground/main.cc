@@ -34,10 +34,11 @@ int main(int argc, char** argv) {
     paths.imu = FLAGS_imu;
     paths.scans = FLAGS_scans;
     paths.rig = FLAGS_rig;
+    paths.params = FLAGS_params;
     paths.out_ground = FLAGS_out_ground;
     paths.out_scans = FLAGS_out_scans;
     paths.command_line = command_line;
-    status = tiltcal::ground::Run(paths, params, nullptr, &std::cerr);
+    status = tiltcal::ground::Run(paths, params, &std::cerr);
   }
   if (!status.ok()) {
     std::cerr << "tiltcal_ground: " << status.message() << "\n";

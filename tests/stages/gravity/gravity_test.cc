@@ -152,14 +152,14 @@ TEST(Gravity, RunWritesTheReferenceAndFailsCleanlyOnBadInputs) {
   proto::Rig rig = scenario.inputs.rig;
   rig.set_gravity_reference("flat/gravity.txtpb");
   ASSERT_TRUE(WriteTextProto(dir.File("rig.txtpb"), rig).ok());
-  RunPaths paths;
+  GravityPaths paths;
   paths.imu = dir.File("imu.binpb");
   paths.ground = dir.File("ground.binpb");
   paths.rig = dir.File("rig.txtpb");
   paths.out = dir.File("gravity.txtpb");
 
   // The reference named by the rig does not exist yet.
-  Status status = gravity::Run(paths, DefaultParams());
+  Status status = gravity::Run(paths, DefaultParams(), nullptr);
   ASSERT_FALSE(status.ok());
   EXPECT_NE(status.message().find("flat/gravity.txtpb"), std::string::npos) << status.message();
   EXPECT_FALSE(testing::FileExists(paths.out));
@@ -169,7 +169,7 @@ TEST(Gravity, RunWritesTheReferenceAndFailsCleanlyOnBadInputs) {
   flat.set_has_gravity_flat(true);
   *flat.mutable_gravity_flat_in_imu() = ToProto(scenario.FlatGravityInImu());
   ASSERT_TRUE(WriteTextProto(dir.File("flat/gravity.txtpb"), flat).ok());
-  status = gravity::Run(paths, DefaultParams());
+  status = gravity::Run(paths, DefaultParams(), nullptr);
   ASSERT_TRUE(status.ok()) << status.message();
   proto::GravityReference out;
   ASSERT_TRUE(ReadTextProto(paths.out, &out).ok());
@@ -178,7 +178,7 @@ TEST(Gravity, RunWritesTheReferenceAndFailsCleanlyOnBadInputs) {
   EXPECT_NEAR(out.inclination(50).inclination_deg(), 8.0, 0.3);
 
   paths.imu = dir.File("missing.binpb");
-  status = gravity::Run(paths, DefaultParams());
+  status = gravity::Run(paths, DefaultParams(), nullptr);
   ASSERT_FALSE(status.ok());
   EXPECT_NE(status.message().find("missing.binpb"), std::string::npos);
 }

@@ -121,7 +121,7 @@ TEST(GroundCli, PlanesMatchTheTruthAndDeskewedScansAreWritten) {
       ReadAllRecords<proto::GroundPlane>(dir.File("ground.binpb"), &planes, &header);
   ASSERT_TRUE(status.ok()) << status.message();
   EXPECT_EQ(header.provenance().producer(), "tiltcal_ground");
-  EXPECT_NE(header.provenance().params_txtpb().find("fit_radius_first_ring_ratio"),
+  EXPECT_NE(header.provenance().params_txtpb().find("radius_first_ring_ratio"),
             std::string::npos);
   ASSERT_EQ(planes.size(), static_cast<size_t>(kNumScans));
   for (int k = 0; k < kNumScans; ++k) {
@@ -161,7 +161,8 @@ TEST(GroundCli, InspectCsvAndPcdShowThePlanesAndLabels) {
   ASSERT_TRUE(ReadAllRecords<proto::GroundPlane>(dir.File("ground.binpb"), &planes).ok());
   const std::string inspect = testing::ToolPath("tiltcal_inspect");
 
-  // CSV: dotted names of DESIGN §8, one row per plane, values as written.
+  // CSV: a header of dotted field paths (normal_in_lidar.z), one row per
+  // plane, values as written.
   std::string csv;
   ASSERT_EQ(testing::RunCommand("(" + inspect + " csv " + dir.File("ground.binpb") +
                                     " 2>/dev/null)", &csv), 0) << csv;
@@ -262,14 +263,15 @@ TEST(GroundCli, NonMonotonicImuIsAnError) {
 TEST(GroundCli, BadParamsNameTheField) {
   TempDir dir;
   const Dataset data = WriteDataset(dir, false, false);
+  // A fifth zone ring count: within the schema bounds, but 4 zones.
   const std::string params = dir.File("params.txtpb");
-  ASSERT_TRUE(WriteTextProto(params, testing::DefaultGroundParams()).ok());
-  std::string text;
-  ASSERT_TRUE(ReadFileToString(params, &text).ok());
-  ASSERT_TRUE(WriteFileAtomically(params, text + "zone_rings: 5\n").ok());
+  proto::GroundParams five_zones = testing::DefaultGroundParams();
+  five_zones.mutable_zone_model()->add_rings(5);
+  ASSERT_TRUE(WriteTextProto(params, five_zones).ok());
   std::string output;
   EXPECT_EQ(testing::RunCommand(Command(data, dir, params), &output), 1);
-  EXPECT_NE(output.find("zone_rings"), std::string::npos) << output;
+  EXPECT_NE(output.find("zone_model.rings must have exactly 4 values"), std::string::npos)
+      << output;
   EXPECT_FALSE(testing::FileExists(dir.File("ground.binpb")));
 }
 

@@ -5,6 +5,7 @@
 #include <string>
 
 #include <Eigen/Core>
+#include <google/protobuf/text_format.h>
 #include <gtest/gtest.h>
 
 #include "common/io/params.h"
@@ -20,6 +21,15 @@ inline proto::GroundParams DefaultGroundParams() {
   const Status status =
       LoadParams(SourceDir() + "/stages/ground/default_params.txtpb", &params);
   EXPECT_TRUE(status.ok()) << status.message();
+  return params;
+}
+
+// The shipped defaults with `override_text` (text format) merged in: the
+// scalars it sets replace the defaults (repeated fields would be appended).
+inline proto::GroundParams GroundParamsWith(const std::string& override_text) {
+  proto::GroundParams params = DefaultGroundParams();
+  EXPECT_TRUE(google::protobuf::TextFormat::MergeFromString(override_text, &params))
+      << override_text;
   return params;
 }
 
