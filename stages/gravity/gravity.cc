@@ -71,7 +71,7 @@ StaticForce AddStaticWindows(const GravityInputs& inputs,
 // t = t_scan + τ (returned in *ups) and, for a valid plane and a rig with
 // C_bl, the ground slope ∠(g̃_b, C_bl n_l) (returned in *slopes).
 void AddInclinationSamples(const GravityInputs& inputs, const imu::ImuInitialisation& init,
-                           const proto::GravityParams& params, bool has_extrinsic,
+                           double time_offset_s, bool has_extrinsic,
                            proto::GravityReference* out, std::vector<Eigen::Vector3d>* ups,
                            std::vector<double>* slopes) {
   const imu::GyroIntegrator attitude(inputs.imu, init.gyro_bias_radps);
@@ -79,7 +79,7 @@ void AddInclinationSamples(const GravityInputs& inputs, const imu::ImuInitialisa
   const Eigen::Quaterniond imu_from_lidar = ToEigen(inputs.rig.imu_from_lidar().rotation());
   for (const proto::GroundPlane& plane : inputs.ground) {
     const double t = static_cast<double>(plane.stamp_ns() - inputs.first_imu_stamp_ns) * 1e-9 +
-                     params.time_offset_s();
+                     time_offset_s;
     const Eigen::Vector3d up_in_imu = attitude.Rotation(t).conjugate() * up_in_world;
     proto::InclinationSample* sample = out->add_inclination();
     sample->set_stamp_ns(plane.stamp_ns());
@@ -169,7 +169,7 @@ Status EstimateGravityReference(const GravityInputs& inputs, const proto::Gravit
   const bool has_extrinsic = HasValidRotation(inputs.rig.imu_from_lidar());
   std::vector<Eigen::Vector3d> ups;
   std::vector<double> slopes;
-  AddInclinationSamples(inputs, init, params, has_extrinsic, out, &ups, &slopes);
+  AddInclinationSamples(inputs, init, params.time_offset_s(), has_extrinsic, out, &ups, &slopes);
   SetLevelVerdict(slopes, has_extrinsic, params.level_verdict(), out);
   SetFlatGravity(inputs, params.gravity_norm_mps2(), static_force, out);
   if (out->has_gravity_flat()) {
