@@ -2,9 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <vector>
+
+#include <fmt/format.h>
 
 #include "common/imu/gyro_integrator.h"
 #include "common/imu/imu_initialisation.h"
@@ -12,6 +13,7 @@
 #include "common/io/imu_stream.h"
 #include "common/io/provenance.h"
 #include "common/io/record_stream.h"
+#include "common/io/rig.h"
 #include "common/io/static_detection_params.h"
 #include "common/io/text_proto.h"
 
@@ -32,12 +34,6 @@ double Percentile(std::vector<double> values, double percentile) {
   const size_t low = static_cast<size_t>(std::floor(rank));
   const size_t high = std::min(low + 1, values.size() - 1);
   return values[low] + (rank - low) * (values[high] - values[low]);
-}
-
-std::string Format(const char* format, double a, double b = 0, double c = 0) {
-  char buffer[256];
-  std::snprintf(buffer, sizeof(buffer), format, a, b, c);
-  return buffer;
 }
 
 // The specific force of the static windows (−g_b on level ground): summed
@@ -68,12 +64,11 @@ StaticForce AddStaticWindows(const GravityInputs& inputs,
 }
 
 // One inclination sample per ground plane: g̃_b = −C_ab(t)^T g_a / |g_a| at
-// t = t_scan + τ (returned in *ups) and, for a valid plane and a rig with
-// C_bl, the ground slope ∠(g̃_b, C_bl n_l) (returned in *slopes).
+// t = t_scan + τ (returned in *ups) and, for a valid plane, the ground slope
+// ∠(g̃_b, C_bl n_l) (returned in *slopes).
 void AddInclinationSamples(const GravityInputs& inputs, const imu::ImuInitialisation& init,
-                           double time_offset_s, bool has_extrinsic,
-                           proto::GravityReference* out, std::vector<Eigen::Vector3d>* ups,
-                           std::vector<double>* slopes) {
+                           double time_offset_s, proto::GravityReference* out,
+                           std::vector<Eigen::Vector3d>* ups, std::vector<double>* slopes) {
   const imu::GyroIntegrator attitude(inputs.imu, init.gyro_bias_radps);
   const Eigen::Vector3d up_in_world = -init.gravity_in_world_mps2.normalized();
   const Eigen::Quaterniond imu_from_lidar = ToEigen(inputs.rig.imu_from_lidar().rotation());
@@ -85,7 +80,7 @@ void AddInclinationSamples(const GravityInputs& inputs, const imu::ImuInitialisa
     sample->set_stamp_ns(plane.stamp_ns());
     *sample->mutable_up_in_imu() = ToProto(up_in_imu);
     ups->push_back(up_in_imu);
-    if (plane.valid() && has_extrinsic) {
+    if (plane.valid()) {
       const double slope = AngleDeg(up_in_imu, imu_from_lidar * ToEigen(plane.normal_in_lidar()));
       sample->set_ground_slope_deg(slope);
       slopes->push_back(slope);
@@ -95,25 +90,22 @@ void AddInclinationSamples(const GravityInputs& inputs, const imu::ImuInitialisa
 
 // Level when the percentile of the ground slopes is below the threshold; not
 // level when no slope is known.
-void SetLevelVerdict(const std::vector<double>& slopes, bool has_extrinsic,
-                     const proto::LevelVerdictParams& params, proto::GravityReference* out) {
+void SetLevelVerdict(const std::vector<double>& slopes, const proto::LevelVerdictParams& params,
+                     proto::GravityReference* out) {
   if (slopes.empty()) {
     out->set_is_level(false);
-    out->set_level_statistic(has_extrinsic
-                                 ? "no valid ground plane: the ground slope is unknown, so the "
-                                   "sequence is not taken as level"
-                                 : "the rig has no imu_from_lidar: the ground slope is unknown, "
-                                   "so the sequence is not taken as level");
+    out->set_level_statistic(
+        "no valid ground plane: the ground slope is unknown, so the sequence is not taken as "
+        "level");
     return;
   }
   const double statistic = Percentile(slopes, params.percentile());
   out->set_level_statistic_deg(statistic);
   out->set_is_level(statistic < params.threshold_deg());
-  out->set_level_statistic(Format("%.0fth percentile of the ground slope over %.0f valid "
-                                  "ground planes: %.3f deg",
-                                  params.percentile(), static_cast<double>(slopes.size()),
-                                  statistic) +
-                           Format(" (level below %.3f deg)", params.threshold_deg()));
+  out->set_level_statistic(
+      fmt::format("{:.0f}th percentile of the ground slope over {} valid ground planes: {:.3f} "
+                  "deg (level below {:.3f} deg)",
+                  params.percentile(), slopes.size(), statistic, params.threshold_deg()));
 }
 
 // g_f: from the dataset when it names one; else on a level sequence from the
@@ -166,11 +158,10 @@ Status EstimateGravityReference(const GravityInputs& inputs, const proto::Gravit
   *out->mutable_gyro_bias_radps() = ToProto(init.gyro_bias_radps);
   const StaticForce static_force = AddStaticWindows(inputs, init_options.static_detection, out);
 
-  const bool has_extrinsic = HasValidRotation(inputs.rig.imu_from_lidar());
   std::vector<Eigen::Vector3d> ups;
   std::vector<double> slopes;
-  AddInclinationSamples(inputs, init, params.time_offset_s(), has_extrinsic, out, &ups, &slopes);
-  SetLevelVerdict(slopes, has_extrinsic, params.level_verdict(), out);
+  AddInclinationSamples(inputs, init, params.time_offset_s(), out, &ups, &slopes);
+  SetLevelVerdict(slopes, params.level_verdict(), out);
   SetFlatGravity(inputs, params.gravity_norm_mps2(), static_force, out);
   if (out->has_gravity_flat()) {
     const Eigen::Vector3d up_flat = -ToEigen(out->gravity_flat_in_imu()).normalized();
@@ -214,16 +205,15 @@ void LogSummary(const proto::GravityReference& out, const proto::GravityParams& 
        << (out.is_level() ? "level" : "tilted") << ": " << out.level_statistic() << "\n";
   if (out.has_gravity_flat()) {
     const Eigen::Vector3d g_f = ToEigen(out.gravity_flat_in_imu());
-    *log << Format("tiltcal_gravity: g_f = (%.4f, %.4f, %.4f) m/s^2 from ", g_f.x(), g_f.y(),
-                   g_f.z())
-         << out.gravity_flat_source() << "\n";
+    *log << fmt::format("tiltcal_gravity: g_f = ({:.4f}, {:.4f}, {:.4f}) m/s^2 from {}\n",
+                        g_f.x(), g_f.y(), g_f.z(), out.gravity_flat_source());
   } else {
     *log << "tiltcal_gravity: no g_f (tilted sequence and none in the rig)\n";
   }
   if (out.sources_disagreement_deg() > params.max_sources_disagreement_deg()) {
-    *log << Format("tiltcal_gravity: warning: g_f from the static windows and from the "
-                   "calibration disagree by %.3f deg\n",
-                   out.sources_disagreement_deg());
+    *log << fmt::format("tiltcal_gravity: warning: g_f from the static windows and from the "
+                        "calibration disagree by {:.3f} deg\n",
+                        out.sources_disagreement_deg());
   }
 }
 
@@ -235,7 +225,7 @@ Status Run(const GravityPaths& paths, const proto::GravityParams& params, std::o
   if (!paths.ground.empty()) {
     TILTCAL_RETURN_IF_ERROR(ReadAllRecords<proto::GroundPlane>(paths.ground, &inputs.ground));
   }
-  TILTCAL_RETURN_IF_ERROR(ReadTextProto(paths.rig, &inputs.rig));
+  TILTCAL_RETURN_IF_ERROR(LoadRig(paths.rig, &inputs.rig));
   TILTCAL_RETURN_IF_ERROR(ReadDatasetReference(paths.rig, inputs.rig, &inputs.dataset_reference,
                                                &inputs.dataset_reference_source));
   proto::CalibrationResult calibration;
@@ -249,6 +239,7 @@ Status Run(const GravityPaths& paths, const proto::GravityParams& params, std::o
   std::vector<InputPath> input_paths = {{"imu", paths.imu}, {"rig", paths.rig}};
   if (!paths.ground.empty()) input_paths.push_back({"ground", paths.ground});
   if (!paths.calibration.empty()) input_paths.push_back({"calibration", paths.calibration});
+  if (!paths.params.empty()) input_paths.push_back({"params", paths.params});
   *out.mutable_provenance() =
       MakeProvenance("tiltcal_gravity", params, input_paths, paths.command_line);
   TILTCAL_RETURN_IF_ERROR(WriteTextProto(paths.out, out));

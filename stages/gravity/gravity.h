@@ -20,7 +20,7 @@ struct GravityInputs {
   std::vector<imu::ImuReading> imu;  // times relative to first_imu_stamp_ns
   int64_t first_imu_stamp_ns = 0;
   std::vector<proto::GroundPlane> ground;   // may be empty
-  proto::Rig rig;
+  proto::Rig rig;                           // passed ValidateRig (common/io/rig.h)
   // g_f given by the dataset: the rig's gravity_flat_in_imu or the file its
   // gravity_reference names (has_gravity_flat false otherwise).
   proto::GravityReference dataset_reference;

@@ -3,11 +3,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <map>
 #include <memory>
 #include <vector>
 
+#include <fmt/format.h>
 #include <unistd.h>
 
 #include "common/imu/gyro_integrator.h"
@@ -17,8 +17,8 @@
 #include "common/io/imu_stream.h"
 #include "common/io/provenance.h"
 #include "common/io/record_stream.h"
+#include "common/io/rig.h"
 #include "common/io/static_detection_params.h"
-#include "common/io/text_proto.h"
 #include "stages/ground/deskew.h"
 #include "stages/ground/ground_params.h"
 #include "stages/ground/scan_plane.h"
@@ -42,25 +42,6 @@ struct RunSummary {
   double static_duration_s = 0.0;
   double deskew_s = 0.0, segment_s = 0.0, fit_s = 0.0, total_s = 0.0;
 };
-
-bool Finite(const proto::Vector3& v) {
-  return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z());
-}
-
-Status ReadRig(const std::string& path, proto::Rig* rig) {
-  TILTCAL_RETURN_IF_ERROR(ReadTextProto(path, rig));
-  const auto& q = rig->imu_from_lidar().rotation();
-  const double q_norm = std::sqrt(q.w() * q.w() + q.x() * q.x() + q.y() * q.y() + q.z() * q.z());
-  if (!(std::fabs(q_norm - 1.0) < 1e-3)) {
-    return Status::Error(path + ": imu_from_lidar.rotation is not a unit quaternion (norm " +
-                         std::to_string(q_norm) + ")");
-  }
-  if (!Finite(rig->imu_from_lidar().translation()) || !Finite(rig->gravity_flat_in_imu()) ||
-      !std::isfinite(rig->imu_height_m())) {
-    return Status::Error(path + ": non-finite value");
-  }
-  return Status::Ok();
-}
 
 // C_ab(t) for deskewing: the gyro integrated from the first IMU stamp with
 // the bias of the static start (zero without one). Empty (the IMU file not
@@ -150,16 +131,14 @@ Status WriteGroundPlanes(const std::vector<proto::GroundPlane>& planes, RecordWr
 void LogSummary(const RunSummary& summary, std::ostream* log) {
   if (log == nullptr) return;
   const double per_scan = summary.num_scans > 0 ? 1e3 / summary.num_scans : 0.0;
-  char line[256];
-  std::snprintf(line, sizeof(line),
-                "tiltcal_ground: %d scans, %d valid, %d deskewed; gyro bias from static start: "
-                "%s (%.2f s); per scan: deskew %.2f ms, segment %.2f ms, fit %.2f ms; "
-                "total %.2f s\n",
-                summary.num_scans, summary.num_valid, summary.num_deskewed,
-                summary.static_start ? "yes" : "no", summary.static_duration_s,
-                summary.deskew_s * per_scan, summary.segment_s * per_scan,
-                summary.fit_s * per_scan, summary.total_s);
-  *log << line;
+  *log << fmt::format(
+      "tiltcal_ground: {} scans, {} valid, {} deskewed; gyro bias from static start: {} "
+      "({:.2f} s); per scan: deskew {:.2f} ms, segment {:.2f} ms, fit {:.2f} ms; "
+      "total {:.2f} s\n",
+      summary.num_scans, summary.num_valid, summary.num_deskewed,
+      summary.static_start ? "yes" : "no", summary.static_duration_s,
+      summary.deskew_s * per_scan, summary.segment_s * per_scan, summary.fit_s * per_scan,
+      summary.total_s);
   if (!summary.rejected.empty()) {
     *log << "tiltcal_ground: rejected:";
     for (const auto& [reason, count] : summary.rejected) {
@@ -187,7 +166,7 @@ Status Run(const GroundPaths& paths, const proto::GroundParams& params, std::ost
     return Status::Error("--imu, --scans, --rig and --out_ground are required");
   }
   proto::Rig rig;
-  TILTCAL_RETURN_IF_ERROR(ReadRig(paths.rig, &rig));
+  TILTCAL_RETURN_IF_ERROR(LoadRig(paths.rig, &rig));
   ImuAttitude attitude;
   TILTCAL_RETURN_IF_ERROR(ReadImuAttitude(paths.imu, params.deskew(), &attitude));
   RunSummary summary;
@@ -201,9 +180,10 @@ Status Run(const GroundPaths& paths, const proto::GroundParams& params, std::ost
 
   RecordReader reader;
   TILTCAL_RETURN_IF_ERROR(reader.Open(paths.scans, proto::Scan::descriptor()->full_name()));
-  const proto::Provenance provenance = MakeProvenance(
-      "tiltcal_ground", params,
-      {{"imu", paths.imu}, {"scans", paths.scans}, {"rig", paths.rig}}, paths.command_line);
+  std::vector<InputPath> inputs = {{"imu", paths.imu}, {"scans", paths.scans}, {"rig", paths.rig}};
+  if (!paths.params.empty()) inputs.push_back({"params", paths.params});
+  const proto::Provenance provenance =
+      MakeProvenance("tiltcal_ground", params, inputs, paths.command_line);
   std::unique_ptr<RecordWriter> scan_writer;
   if (!paths.out_scans.empty()) {
     scan_writer = std::make_unique<RecordWriter>();

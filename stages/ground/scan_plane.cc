@@ -2,19 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
+
+#include <fmt/format.h>
 
 namespace tiltcal::ground {
 
 namespace {
 
 constexpr double kRadToDeg = 180.0 / M_PI;
-
-std::string Format(const char* format, double a, double b = 0.0) {
-  char buffer[160];
-  std::snprintf(buffer, sizeof(buffer), format, a, b);
-  return buffer;
-}
 
 // Range histograms: 5 cm bins.
 constexpr float kRangeBinM = 0.05f;
@@ -45,8 +40,8 @@ ScanPlane ScanPlaneFitter::Fit(const GroundSegmenter& segmenter,
   inlier->assign(segmenter.num_binned(), 0);
   if (summary.num_binned == 0) {
     out.reason = proto::GROUND_EMPTY_SCAN;
-    out.detail = Format("no finite point within %.1f..%.1f m", segmenter.min_range_m(),
-                        segmenter.max_range_m());
+    out.detail = fmt::format("no finite point within {:.1f}..{:.1f} m", segmenter.min_range_m(),
+                             segmenter.max_range_m());
     return out;
   }
   num_range_bins_ = static_cast<size_t>(segmenter.max_range_m() / kRangeBinM) + 2;
@@ -55,14 +50,14 @@ ScanPlane ScanPlaneFitter::Fit(const GroundSegmenter& segmenter,
   out.num_candidates = static_cast<uint32_t>(candidates_.size());
   if (candidates_.size() < gates_.min_inliers()) {
     out.reason = proto::GROUND_TOO_FEW_POINTS;
-    out.detail = Format("%.0f ground points within %.2f m, need min_inliers", candidates_.size(),
-                        out.fit_radius_m);
+    out.detail = fmt::format("{} ground points within {:.2f} m, need min_inliers",
+                             candidates_.size(), out.fit_radius_m);
     return out;
   }
   out.fit = FitCandidates(segmenter, out.fit_radius_m);
   if (!out.fit.ok) {
     out.reason = proto::GROUND_FIT_FAILED;
-    out.detail = Format("degenerate plane from %.0f points", candidates_.size());
+    out.detail = fmt::format("degenerate plane from {} points", candidates_.size());
     return out;
   }
   // Sign rule: the normal points towards the sensor (origin), d > 0.
@@ -201,29 +196,29 @@ void ApplyScanPlaneGates(const proto::ScanPlaneGateParams& gates, double height_
   if (plane->num_inliers < gates.min_inliers()) {
     plane->reason = proto::GROUND_TOO_FEW_POINTS;
     plane->detail =
-        Format("%.0f inliers < min_inliers %.0f", plane->num_inliers, gates.min_inliers());
+        fmt::format("{} inliers < min_inliers {}", plane->num_inliers, gates.min_inliers());
   } else if (!(height > 0.0)) {
     plane->reason = proto::GROUND_FIT_FAILED;
-    plane->detail = Format("plane through the sensor (d = %.3f m)", height);
+    plane->detail = fmt::format("plane through the sensor (d = {:.3f} m)", height);
   } else if (plane->tilt_from_up_deg > gates.max_normal_tilt_deg()) {
     plane->reason = proto::GROUND_NORMAL_NOT_UP;
-    plane->detail = Format("normal %.2f deg from up > %.2f deg", plane->tilt_from_up_deg,
-                           gates.max_normal_tilt_deg());
+    plane->detail = fmt::format("normal {:.2f} deg from up > {:.2f} deg", plane->tilt_from_up_deg,
+                                gates.max_normal_tilt_deg());
   } else if (plane->coverage < gates.min_azimuth_coverage()) {
     plane->reason = proto::GROUND_POOR_COVERAGE;
-    plane->detail =
-        Format("azimuth coverage %.3f < %.3f", plane->coverage, gates.min_azimuth_coverage());
+    plane->detail = fmt::format("azimuth coverage {:.3f} < {:.3f}", plane->coverage,
+                                gates.min_azimuth_coverage());
   } else if (plane->radial_spread < gates.min_radial_spread_ratio()) {
     plane->reason = proto::GROUND_POOR_COVERAGE;
-    plane->detail = Format("radial spread %.3f < %.3f (ground seen by a single beam?)",
-                           plane->radial_spread, gates.min_radial_spread_ratio());
+    plane->detail = fmt::format("radial spread {:.3f} < {:.3f} (ground seen by a single beam?)",
+                                plane->radial_spread, gates.min_radial_spread_ratio());
   } else if (plane->rms_m > gates.max_rms_m()) {
     plane->reason = proto::GROUND_HIGH_RMS;
-    plane->detail = Format("rms %.4f m > %.4f m", plane->rms_m, gates.max_rms_m());
+    plane->detail = fmt::format("rms {:.4f} m > {:.4f} m", plane->rms_m, gates.max_rms_m());
   } else if (height_prior_m > 0.0 &&
              std::fabs(height - height_prior_m) > gates.max_height_deviation_m()) {
     plane->reason = proto::GROUND_HEIGHT_PRIOR;
-    plane->detail = Format("height %.3f m vs prior %.3f m", height, height_prior_m);
+    plane->detail = fmt::format("height {:.3f} m vs prior {:.3f} m", height, height_prior_m);
   }
 }
 
@@ -258,8 +253,8 @@ void ApplyTiltJumpGate(const proto::TiltJumpGateParams& gate,
     if (max_tilt_jump_deg > 0.0 && jump_deg > max_tilt_jump_deg) {
       p.set_valid(false);
       p.set_reject_reason(proto::GROUND_TILT_JUMP);
-      p.set_reject_detail(Format("normal %.2f deg from its neighbours' mean > %.2f deg",
-                                 jump_deg, max_tilt_jump_deg));
+      p.set_reject_detail(fmt::format("normal {:.2f} deg from its neighbours' mean > {:.2f} deg",
+                                      jump_deg, max_tilt_jump_deg));
     }
   }
 }

@@ -10,7 +10,9 @@
 #include "common/io/eigen_proto.h"
 #include "common/io/record_stream.h"
 #include "common/io/text_proto.h"
+#include "stages/gravity/default_params_text.h"
 #include "tests/common/imu/synthetic_imu.h"
+#include "tests/testing/params_text.h"
 #include "tests/testing/test_env.h"
 #include "tiltcal/proto/imu.pb.h"
 
@@ -20,11 +22,9 @@ namespace {
 constexpr double kDeg = M_PI / 180.0;
 const Eigen::Vector3d kGravityWorld(0, 0, -9.81);
 
+// The shipped defaults (stages/gravity/default_params.txtpb, compiled in).
 proto::GravityParams DefaultParams() {
-  proto::GravityParams params;
-  EXPECT_TRUE(ReadTextProto(testing::SourceDir() + "/stages/gravity/default_params.txtpb", &params)
-                  .ok());
-  return params;
+  return testing::DefaultParamsWith<proto::GravityParams>(DefaultParamsText());
 }
 
 // A vehicle on a plane tilted by `tilt_deg` about x: still for 2 s, then
@@ -176,6 +176,15 @@ TEST(Gravity, RunWritesTheReferenceAndFailsCleanlyOnBadInputs) {
   EXPECT_EQ(out.gravity_flat_source(), "reference flat/gravity.txtpb");
   EXPECT_EQ(out.provenance().producer(), "tiltcal_gravity");
   EXPECT_NEAR(out.inclination(50).inclination_deg(), 8.0, 0.3);
+
+  // A rig without the measured extrinsic is an error naming the field.
+  proto::Rig no_extrinsic = rig;
+  no_extrinsic.mutable_imu_from_lidar()->clear_rotation();
+  ASSERT_TRUE(WriteTextProto(dir.File("rig.txtpb"), no_extrinsic).ok());
+  status = gravity::Run(paths, DefaultParams(), nullptr);
+  ASSERT_FALSE(status.ok());
+  EXPECT_NE(status.message().find("imu_from_lidar.rotation"), std::string::npos)
+      << status.message();
 
   paths.imu = dir.File("missing.binpb");
   status = gravity::Run(paths, DefaultParams(), nullptr);

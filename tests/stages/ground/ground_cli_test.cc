@@ -101,9 +101,11 @@ Dataset WriteDataset(const TempDir& dir, bool corrupt_scan, bool bad_imu_stamp) 
   return data;
 }
 
+// The command line of tiltcal_ground on `data`; without --params when
+// `params` is empty.
 std::string Command(const Dataset& data, const TempDir& dir, const std::string& params) {
   return testing::ToolPath("tiltcal_ground") + " --imu=" + data.imu + " --scans=" + data.scans +
-         " --rig=" + data.rig + " --params=" + params + " --out_ground=" +
+         " --rig=" + data.rig + (params.empty() ? "" : " --params=" + params) + " --out_ground=" +
          dir.File("ground.binpb") + " --out_scans=" + dir.File("deskewed.binpb.lz4");
 }
 
@@ -257,6 +259,38 @@ TEST(GroundCli, NonMonotonicImuIsAnError) {
   std::string output;
   EXPECT_EQ(testing::RunCommand(Command(data, dir, data.params), &output), 1);
   EXPECT_NE(output.find("imu.binpb: IMU sample 200"), std::string::npos) << output;
+  EXPECT_FALSE(testing::FileExists(dir.File("ground.binpb")));
+}
+
+TEST(GroundCli, WithoutParamsTheDefaultsAreUsed) {
+  TempDir dir;
+  const Dataset data = WriteDataset(dir, false, false);
+  std::string output;
+  ASSERT_EQ(testing::RunCommand(Command(data, dir, data.params), &output), 0) << output;
+  std::vector<proto::GroundPlane> with_file;
+  ASSERT_TRUE(ReadAllRecords<proto::GroundPlane>(dir.File("ground.binpb"), &with_file).ok());
+  ASSERT_EQ(testing::RunCommand(Command(data, dir, ""), &output), 0) << output;
+  std::vector<proto::GroundPlane> without;
+  proto::StreamHeader header;
+  ASSERT_TRUE(
+      ReadAllRecords<proto::GroundPlane>(dir.File("ground.binpb"), &without, &header).ok());
+  ASSERT_EQ(without.size(), with_file.size());
+  for (size_t k = 0; k < without.size(); ++k) {
+    EXPECT_EQ(without[k].SerializeAsString(), with_file[k].SerializeAsString()) << k;
+  }
+  EXPECT_NE(header.provenance().params_txtpb().find("radius_first_ring_ratio"),
+            std::string::npos);
+}
+
+TEST(GroundCli, MissingRequiredFlagIsAUsageError) {
+  TempDir dir;
+  std::string output;
+  EXPECT_EQ(testing::RunCommand(testing::ToolPath("tiltcal_ground") + " --imu=a --scans=b " +
+                                    "--out_ground=" + dir.File("ground.binpb"),
+                                &output),
+            2);
+  EXPECT_NE(output.find("--rig"), std::string::npos) << output;
+  EXPECT_EQ(std::count(output.begin(), output.end(), '\n'), 1) << output;
   EXPECT_FALSE(testing::FileExists(dir.File("ground.binpb")));
 }
 

@@ -26,8 +26,9 @@ TEST(GroundParams, DefaultsAreValid) {
 }
 
 TEST(GroundParams, SchemaBoundsAreChecked) {
-  ExpectRejected(GroundParamsWith("gates { min_inliers: 2 }"),
-                 "field gates.min_inliers = 2 is below its minimum 3");
+  proto::GroundParams two_inliers = DefaultGroundParams();
+  two_inliers.mutable_gates()->set_min_inliers(2);
+  ExpectRejected(two_inliers, "field gates.min_inliers = 2 is below its minimum 3");
   proto::GroundParams no_zone_model = DefaultGroundParams();
   no_zone_model.clear_zone_model();
   ExpectRejected(no_zone_model, "field zone_model is required");

@@ -5,32 +5,25 @@
 #include <string>
 
 #include <Eigen/Core>
-#include <google/protobuf/text_format.h>
 #include <gtest/gtest.h>
 
-#include "common/io/params.h"
+#include "stages/ground/default_params_text.h"
+#include "tests/testing/params_text.h"
 #include "tests/testing/test_env.h"
 #include "tiltcal/proto/ground.pb.h"
 #include "tiltcal/proto/ground_params.pb.h"
 
 namespace tiltcal::testing {
 
-// The shipped defaults (stages/ground/default_params.txtpb).
+// The shipped defaults (stages/ground/default_params.txtpb, compiled in).
 inline proto::GroundParams DefaultGroundParams() {
-  proto::GroundParams params;
-  const Status status =
-      LoadParams(SourceDir() + "/stages/ground/default_params.txtpb", &params);
-  EXPECT_TRUE(status.ok()) << status.message();
-  return params;
+  return DefaultParamsWith<proto::GroundParams>(ground::DefaultParamsText());
 }
 
-// The shipped defaults with `override_text` (text format) merged in: the
-// scalars it sets replace the defaults (repeated fields would be appended).
+// The shipped defaults with `override_text` (text format) merged over them:
+// a singular field replaces the default, a repeated one is appended to.
 inline proto::GroundParams GroundParamsWith(const std::string& override_text) {
-  proto::GroundParams params = DefaultGroundParams();
-  EXPECT_TRUE(google::protobuf::TextFormat::MergeFromString(override_text, &params))
-      << override_text;
-  return params;
+  return DefaultParamsWith<proto::GroundParams>(ground::DefaultParamsText(), override_text);
 }
 
 inline Eigen::Vector3d NormalOf(const proto::GroundPlane& plane) {
