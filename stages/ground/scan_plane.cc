@@ -5,6 +5,8 @@
 
 #include <fmt/format.h>
 
+#include "common/io/eigen_proto.h"
+
 namespace tiltcal::ground {
 
 namespace {
@@ -224,7 +226,7 @@ void ApplyScanPlaneGates(const proto::ScanPlaneGateParams& gates, double height_
 
 void ApplyTiltJumpGate(const proto::TiltJumpGateParams& gate,
                        std::vector<proto::GroundPlane>* planes) {
-  const double max_tilt_jump_deg = gate.max_jump_deg();
+  const double max_jump_deg = gate.max_jump_deg();
   const int window = static_cast<int>(gate.window());
   const int n = static_cast<int>(planes->size());
   std::vector<Eigen::Vector3d> normals(n, Eigen::Vector3d::Zero());
@@ -232,8 +234,7 @@ void ApplyTiltJumpGate(const proto::TiltJumpGateParams& gate,
   for (int i = 0; i < n; ++i) {
     const proto::GroundPlane& p = (*planes)[i];
     valid[i] = p.valid();
-    normals[i] = Eigen::Vector3d(p.normal_in_lidar().x(), p.normal_in_lidar().y(),
-                                 p.normal_in_lidar().z());
+    normals[i] = ToEigen(p.normal_in_lidar());
   }
   // Decisions use the validity before this pass only.
   for (int i = 0; i < n; ++i) {
@@ -250,11 +251,11 @@ void ApplyTiltJumpGate(const proto::TiltJumpGateParams& gate,
     const double jump_deg = std::acos(cos_angle) * kRadToDeg;
     proto::GroundPlane& p = (*planes)[i];
     p.set_tilt_jump_deg(jump_deg);
-    if (max_tilt_jump_deg > 0.0 && jump_deg > max_tilt_jump_deg) {
+    if (max_jump_deg > 0.0 && jump_deg > max_jump_deg) {
       p.set_valid(false);
       p.set_reject_reason(proto::GROUND_TILT_JUMP);
       p.set_reject_detail(fmt::format("normal {:.2f} deg from its neighbours' mean > {:.2f} deg",
-                                      jump_deg, max_tilt_jump_deg));
+                                      jump_deg, max_jump_deg));
     }
   }
 }

@@ -120,10 +120,10 @@ TEST(Deskewer, PointsMatchTheFrameAtTheStamp) {
   double worst = 0.0;
   for (int i = 0; i < scan.x_size(); ++i) {
     const double dt = 1e-9 * scan.time_offset_ns(i);
+    const Eigen::Vector3d omega = c.pose.omega_lidar_radps;
     const Eigen::Matrix3d r_t =
         c.pose.g_from_lidar *
-        Eigen::AngleAxisd(c.pose.omega_lidar_radps.norm() * dt, c.pose.omega_lidar_radps.normalized())
-            .toRotationMatrix();
+        Eigen::AngleAxisd(omega.norm() * dt, omega.normalized()).toRotationMatrix();
     const Eigen::Vector3d raw(c.scan.x(i), c.scan.y(i), c.scan.z(i));
     const Eigen::Vector3d expected = still.g_from_lidar.transpose() * r_t * raw;
     const Eigen::Vector3d got(scan.x(i), scan.y(i), scan.z(i));

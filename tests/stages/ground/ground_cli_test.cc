@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "common/io/atomic_file.h"
+#include "common/io/eigen_proto.h"
 #include "common/io/provenance.h"
 #include "common/io/record_stream.h"
 #include "common/io/text_proto.h"
@@ -58,10 +59,7 @@ Dataset WriteDataset(const TempDir& dir, bool corrupt_scan, bool bad_imu_stamp) 
 
   proto::Rig rig;
   const Eigen::Quaterniond q(c_bl);
-  rig.mutable_imu_from_lidar()->mutable_rotation()->set_w(q.w());
-  rig.mutable_imu_from_lidar()->mutable_rotation()->set_x(q.x());
-  rig.mutable_imu_from_lidar()->mutable_rotation()->set_y(q.y());
-  rig.mutable_imu_from_lidar()->mutable_rotation()->set_z(q.z());
+  *rig.mutable_imu_from_lidar()->mutable_rotation() = ToProto(q);
   rig.mutable_imu_from_lidar()->mutable_translation()->set_z(0.4);
   rig.set_imu_height_m(0.5);
   EXPECT_TRUE(WriteTextProto(data.rig, rig).ok());

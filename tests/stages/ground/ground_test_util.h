@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 #include <gtest/gtest.h>
 
+#include "common/io/eigen_proto.h"
 #include "stages/ground/default_params_text.h"
 #include "tests/testing/params_text.h"
 #include "tests/testing/test_env.h"
@@ -27,8 +28,7 @@ inline proto::GroundParams GroundParamsWith(const std::string& override_text) {
 }
 
 inline Eigen::Vector3d NormalOf(const proto::GroundPlane& plane) {
-  return Eigen::Vector3d(plane.normal_in_lidar().x(), plane.normal_in_lidar().y(),
-                         plane.normal_in_lidar().z());
+  return ToEigen(plane.normal_in_lidar());
 }
 
 // Every floating-point field of the plane is finite.

@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include "common/io/eigen_proto.h"
 #include "tests/stages/ground/ground_test_util.h"
 #include "tests/stages/ground/synthetic_lidar.h"
 
@@ -112,10 +113,7 @@ TEST(ScanProcessor, UpsideDownLidarWithRigUpDirection) {
   // still point towards the sensor (here −z_l) with d > 0.
   proto::Rig rig;
   const Eigen::Quaterniond c_bl(RollPitchYaw(M_PI, 0.0, 0.3));
-  rig.mutable_imu_from_lidar()->mutable_rotation()->set_w(c_bl.w());
-  rig.mutable_imu_from_lidar()->mutable_rotation()->set_x(c_bl.x());
-  rig.mutable_imu_from_lidar()->mutable_rotation()->set_y(c_bl.y());
-  rig.mutable_imu_from_lidar()->mutable_rotation()->set_z(c_bl.z());
+  *rig.mutable_imu_from_lidar()->mutable_rotation() = ToProto(c_bl);
   rig.mutable_gravity_flat_in_imu()->set_z(-9.81);
   const GroundFrame frame = MakeGroundFrame(rig, DefaultGroundParams().frame());
   ScanProcessor processor(DefaultGroundParams(), frame, nullptr);
