@@ -62,7 +62,7 @@ class ScanPlaneFitter {
   proto::ScanPlaneFitParams plane_fit_;
   proto::ScanPlaneGateParams gates_;
   proto::PlaneCovarianceFloorParams covariance_floor_;
-  size_t num_range_bins_ = 0;            // of histogram_, for the segmenter's range
+  size_t num_range_bins_ = 0;          // of histogram_, up to the segmenter's max range
   std::vector<uint32_t> candidates_;   // binned index of each candidate
   std::vector<float> cx_, cy_, cz_;     // candidate coordinates, contiguous
   std::vector<uint32_t> histogram_;     // horizontal ranges, 5 cm bins
