@@ -1,0 +1,32 @@
+#ifndef TILTCAL_STAGES_CALIBRATE_CALIBRATE_PARAMS_VALIDATION_H_
+#define TILTCAL_STAGES_CALIBRATE_CALIBRATE_PARAMS_VALIDATION_H_
+
+// The rules on CalibrateParams that the schema bounds
+// (proto/tiltcal/proto/calibrate_params.proto, checked by common/io/params.h)
+// cannot express: strictly positive values where the bound is an inclusive 0,
+// and relations between fields. One function per message that has such
+// rules; each error names the field by its dotted path from CalibrateParams.
+// ValidateCalibrateParams runs them all; tiltcal_calibrate calls it once,
+// after loading the params.
+
+#include <string>
+
+#include "common/status.h"
+#include "tiltcal/proto/calibrate_params.pb.h"
+
+namespace tiltcal::calibrate {
+
+Status ValidateImuNoiseParams(const proto::ImuNoiseParams& params);
+Status ValidateLidarScanParams(const proto::LidarScanParams& params);
+Status ValidateLidarResidualParams(const proto::LidarResidualParams& params);
+Status ValidateInitParams(const proto::InitParams& params);
+// `path` names the message in the errors ("map", "odometry.quality_map").
+Status ValidateSurfelMapParams(const proto::SurfelMapParams& params, const std::string& path);
+Status ValidateAssociationParams(const proto::AssociationParams& params);
+Status ValidateGroundResidualsParams(const proto::GroundResidualsParams& params);
+
+Status ValidateCalibrateParams(const proto::CalibrateParams& params);
+
+}  // namespace tiltcal::calibrate
+
+#endif  // TILTCAL_STAGES_CALIBRATE_CALIBRATE_PARAMS_VALIDATION_H_
