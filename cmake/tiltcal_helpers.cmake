@@ -26,9 +26,24 @@ endfunction()
 
 # tiltcal_add_stage(NAME decode SRCS lib sources... DEPS ...)
 # Builds tiltcal_<NAME>_lib from SRCS and the executable tiltcal_<NAME> from
-# main.cc of the current directory, landing in build/bin/.
+# main.cc of the current directory, landing in build/bin/. A stage with a
+# default_params.txtpb gets it compiled in as tiltcal::<NAME>::DefaultParamsText()
+# ("stages/<NAME>/default_params_text.h"), so that the file stays the one
+# place where the defaults are written.
 function(tiltcal_add_stage)
   cmake_parse_arguments(ARG "" "NAME" "SRCS;DEPS" ${ARGN})
+  set(defaults_file ${CMAKE_CURRENT_SOURCE_DIR}/default_params.txtpb)
+  if(EXISTS ${defaults_file})
+    set_property(DIRECTORY APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS ${defaults_file})
+    file(READ ${defaults_file} TILTCAL_DEFAULT_PARAMS)
+    string(TOUPPER ${ARG_NAME} ARG_NAME_UPPER)
+    set(generated ${PROJECT_BINARY_DIR}/generated/stages/${ARG_NAME})
+    configure_file(${PROJECT_SOURCE_DIR}/cmake/default_params_text.h.in
+                   ${generated}/default_params_text.h @ONLY)
+    configure_file(${PROJECT_SOURCE_DIR}/cmake/default_params_text.cc.in
+                   ${generated}/default_params_text.cc @ONLY)
+    list(APPEND ARG_SRCS ${generated}/default_params_text.cc)
+  endif()
   tiltcal_add_library(NAME tiltcal_${ARG_NAME}_lib SRCS ${ARG_SRCS} DEPS ${ARG_DEPS})
   add_executable(tiltcal_${ARG_NAME} main.cc)
   target_link_libraries(tiltcal_${ARG_NAME} PRIVATE tiltcal_${ARG_NAME}_lib gflags)

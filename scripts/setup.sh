@@ -7,7 +7,7 @@ PACKAGES=(
   build-essential cmake ninja-build pkg-config git
   libeigen3-dev libceres-dev libgflags-dev libgoogle-glog-dev
   libpcl-dev libprotobuf-dev protobuf-compiler
-  liblz4-dev lz4 libbz2-dev
+  liblz4-dev lz4 libbz2-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   python3-rosbag python3-sensor-msgs python3-numpy python3-matplotlib
 )

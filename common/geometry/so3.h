@@ -5,7 +5,7 @@
 // rotation-matrix forms), right/left Jacobians and their inverses, and the
 // right-perturbation quaternion "box" operations.
 //
-// Conventions (DESIGN §5):
+// Conventions (docs/design.md §5):
 // - Rotation vectors phi are in radians; Exp(phi) is the rotation by |phi|
 //   about phi/|phi|.
 // - Quaternions are Hamilton, unit, and handled as Eigen::Quaternion, whose

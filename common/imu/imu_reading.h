@@ -9,7 +9,7 @@
 
 namespace tiltcal::imu {
 
-// One IMU sample in the IMU frame b (DESIGN §5):
+// One IMU sample in the IMU frame b (docs/design.md §6):
 //   ω_m = ω_b(t) + b_g + n,   f_m = C_ab(t)^T (r̈_a(t) − g_a) + b_a + n.
 // time_s: seconds relative to the sequence start, IMU clock.
 struct ImuReading {

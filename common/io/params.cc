@@ -123,4 +123,12 @@ Status LoadParams(const std::string& path, Message* params) {
   return ValidateAgainstSchema(*params).WithContext(path);
 }
 
+Status LoadParamsOrDefaults(const std::string& path, std::string_view default_text,
+                            Message* params) {
+  if (!path.empty()) return LoadParams(path, params);
+  const std::string source = "default " + params->GetDescriptor()->name();
+  TILTCAL_RETURN_IF_ERROR(ParseTextProto(std::string(default_text), source, params));
+  return ValidateAgainstSchema(*params).WithContext(source);
+}
+
 }  // namespace tiltcal

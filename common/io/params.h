@@ -2,6 +2,7 @@
 #define TILTCAL_COMMON_IO_PARAMS_H_
 
 #include <string>
+#include <string_view>
 
 #include <google/protobuf/message.h>
 
@@ -19,6 +20,12 @@ Status ValidateAgainstSchema(const google::protobuf::Message& message);
 // Reads a params file in text format and validates it. Every error names
 // the file and the field.
 Status LoadParams(const std::string& path, google::protobuf::Message* params);
+
+// The params of a stage: the file at `path`, or, when `path` is empty, the
+// stage's defaults `default_text` (its default_params.txtpb, compiled into the
+// binary as <stage>::DefaultParamsText()). Validated like LoadParams.
+Status LoadParamsOrDefaults(const std::string& path, std::string_view default_text,
+                            google::protobuf::Message* params);
 
 }  // namespace tiltcal
 

@@ -35,7 +35,7 @@ proto::Provenance MakeProvenance(const std::string& producer,
   return provenance;
 }
 
-std::string JoinCommandLine(int argc, char** argv) {
+std::string JoinCommandLine(int argc, const char* const* argv) {
   std::string line;
   for (int i = 0; i < argc; ++i) {
     if (i > 0) line += ' ';

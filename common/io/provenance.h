@@ -22,7 +22,7 @@ proto::Provenance MakeProvenance(const std::string& producer,
                                  const std::string& command_line = "");
 
 // Joins argv into one shell-like line for the provenance record.
-std::string JoinCommandLine(int argc, char** argv);
+std::string JoinCommandLine(int argc, const char* const* argv);
 
 }  // namespace tiltcal
 

@@ -14,7 +14,7 @@
 
 namespace tiltcal {
 
-// Record stream file layout (DESIGN §4):
+// Record stream file layout (docs/design.md §4):
 //   kStreamMagic (8 bytes) · varint-delimited StreamHeader · varint-delimited records
 // optionally wrapped as a whole in one LZ4 frame (`lz4 -dc` gives the plain
 // stream). Readers detect the LZ4 frame by its magic.

@@ -1,5 +1,8 @@
 #include "common/io/text_proto.h"
 
+#include <filesystem>
+#include <system_error>
+
 #include <google/protobuf/io/tokenizer.h>
 #include <google/protobuf/text_format.h>
 
@@ -41,8 +44,18 @@ Status ParseTextProto(const std::string& text, const std::string& source_name,
 }
 
 Status ReadTextProto(const std::string& path, google::protobuf::Message* message) {
+  std::error_code error;
+  const auto status = std::filesystem::status(path, error);
+  if (std::filesystem::exists(status) && !std::filesystem::is_regular_file(status)) {
+    return Status::Error(path + ": not a regular file (a " +
+                         message->GetDescriptor()->name() + " in text format is expected)");
+  }
   std::string text;
   TILTCAL_RETURN_IF_ERROR(ReadFileToString(path, &text));
+  if (text.find_first_not_of(" \t\r\n") == std::string::npos) {
+    return Status::Error(path + ": empty file (a " + message->GetDescriptor()->name() +
+                         " in text format is expected)");
+  }
   return ParseTextProto(text, path, message);
 }
 

@@ -10,7 +10,8 @@
 namespace tiltcal {
 
 // Parses a protobuf text-format file. Unknown fields are errors; the message
-// names the file, line and column.
+// names the file, line and column. A directory, another non-regular file or an
+// empty file is an error, not an empty message.
 Status ReadTextProto(const std::string& path, google::protobuf::Message* message);
 
 // Parses text format from memory; `source_name` is used in error messages.

@@ -3,7 +3,7 @@
 
 // The IMU trajectory of the calibrator: C_ab(t) as a cumulative cubic SO(3)
 // B-spline and r_a^{ba}(t) as a cubic R^3 B-spline on the same uniform knot
-// grid (split representation, DESIGN §5). Owns the knot storage that the
+// grid (split representation, docs/design.md §6). Owns the knot storage that the
 // optimiser uses as parameter blocks:
 //   rotation knot i: 4 doubles (x, y, z, w), a unit quaternion, at rotation_knot(i);
 //   position knot i: 3 doubles (m), at position_knot(i).

@@ -1,61 +1,67 @@
 // tiltcal_inspect: looks into any file of the pipeline.
-//   tiltcal_inspect info FILE
-//   tiltcal_inspect cat  FILE [--from=N] [--count=K] [--single_line]
-//   tiltcal_inspect csv  FILE [--points --record=N] [--field=NAME]
 #include <iostream>
 
-#include <gflags/gflags.h>
-
+#include "common/cli/command_line.h"
 #include "stages/inspect/ground_summary.h"
 #include "stages/inspect/inspect.h"
 #include "stages/inspect/pcd_export.h"
 
-DEFINE_int64(from, 0, "cat: first record to print");
-DEFINE_int64(count, -1, "cat: number of records to print (-1: all)");
-DEFINE_bool(single_line, false, "cat: one record per line");
-DEFINE_bool(points, false, "csv: print the points of scan --record");
-DEFINE_int64(record, 0, "csv --points / pcd: index of the scan");
-DEFINE_string(ground, "", "pcd: ground.binpb whose point masks label the points");
-DEFINE_string(out, "", "pcd: the PCD file to write");
-DEFINE_string(field, "", "csv of a text file: the repeated field to tabulate");
+namespace {
+
+using tiltcal::Status;
+using tiltcal::cli::CommandLine;
+
+Status RunCommand(const CommandLine& cli, const std::string& command, const std::string& path) {
+  namespace inspect = tiltcal::inspect;
+  int64_t from = 0, count = 0, record = 0;
+  TILTCAL_RETURN_IF_ERROR(cli.GetInt("from", &from));
+  TILTCAL_RETURN_IF_ERROR(cli.GetInt("count", &count));
+  TILTCAL_RETURN_IF_ERROR(cli.GetInt("record", &record));
+  if (command == "info") return inspect::RunInfo(path, std::cout);
+  if (command == "cat") {
+    return inspect::RunCat(path, {from, count, cli.GetSwitch("single_line")}, std::cout);
+  }
+  if (command == "csv") {
+    const bool points = cli.GetSwitch("points");
+    TILTCAL_RETURN_IF_ERROR(inspect::RunCsv(path, {points, record, cli.Get("field")}, std::cout));
+    // ground.binpb: rejected scans by reason on stderr (the table stays clean).
+    return points ? Status::Ok() : inspect::PrintGroundSummary(path, std::cerr);
+  }
+  return inspect::RunPcd(path, {record, cli.Get("ground"), cli.Get("out")}, std::cerr);
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
-  gflags::SetUsageMessage(
-      "looks into any tiltcal file\n"
-      "  tiltcal_inspect info FILE\n"
-      "  tiltcal_inspect cat FILE [--from=N] [--count=K] [--single_line]\n"
-      "  tiltcal_inspect csv FILE [--points --record=N] [--field=NAME]\n"
-      "  tiltcal_inspect pcd SCANS --record=N [--ground=ground.binpb] --out=scan.pcd");
-  gflags::ParseCommandLineFlags(&argc, &argv, /*remove_flags=*/true);
-  if (argc != 3) {
-    std::cerr << "usage: tiltcal_inspect info|cat|csv|pcd FILE (see --help)\n";
-    return 2;
+  CommandLine cli("tiltcal_inspect", "looks into any file of the pipeline");
+  cli.SetPositional("info|cat|csv|pcd FILE",
+                    "info: what the file is; cat: its records as text; csv: a table; "
+                    "pcd: one scan as a PCD file",
+                    2, 2);
+  cli.AddFlag("from", "cat: first record to print", tiltcal::cli::kOptional, "0");
+  cli.AddFlag("count", "cat: number of records to print (-1: all)", tiltcal::cli::kOptional,
+              "-1");
+  cli.AddSwitch("single_line", "cat: one record per line");
+  cli.AddSwitch("points", "csv: print the points of scan --record");
+  cli.AddFlag("record", "csv --points / pcd: index of the scan", tiltcal::cli::kOptional, "0");
+  cli.AddFlag("field", "csv of a text file: the repeated field to tabulate");
+  cli.AddFlag("ground", "pcd: ground.binpb whose point masks label the points");
+  cli.AddFlag("out", "pcd: the PCD file to write");
+  cli.AddExample("tiltcal_inspect info out/run1/scans.binpb.lz4");
+  cli.AddExample("tiltcal_inspect csv out/run1/ground.binpb > ground.csv");
+  cli.AddExample("tiltcal_inspect csv out/run1/scans.binpb.lz4 --points --record=10");
+  cli.AddExample(
+      "tiltcal_inspect pcd out/run1/scans.binpb.lz4 --record=10 --ground=out/run1/ground.binpb "
+      "--out=scan10.pcd");
+  if (const auto exit_code = cli.Parse(argc, argv)) return *exit_code;
+  const std::string& command = cli.positional()[0];
+  if (command != "info" && command != "cat" && command != "csv" && command != "pcd") {
+    std::cerr << "tiltcal_inspect: unknown command '" << command
+              << "' (info, cat, csv, pcd; see tiltcal_inspect --help)\n";
+    return tiltcal::cli::kExitUsage;
   }
-  const std::string command = argv[1];
-  const std::string path = argv[2];
   std::ios::sync_with_stdio(false);
-  tiltcal::Status status;
-  if (command == "info") {
-    status = tiltcal::inspect::RunInfo(path, std::cout);
-  } else if (command == "cat") {
-    status = tiltcal::inspect::RunCat(path, {FLAGS_from, FLAGS_count, FLAGS_single_line},
-                                      std::cout);
-  } else if (command == "csv") {
-    status = tiltcal::inspect::RunCsv(path, {FLAGS_points, FLAGS_record, FLAGS_field}, std::cout);
-    // ground.binpb: rejected scans by reason on stderr (the table stays clean).
-    if (status.ok() && !FLAGS_points) {
-      status = tiltcal::inspect::PrintGroundSummary(path, std::cerr);
-    }
-  } else if (command == "pcd") {
-    status = tiltcal::inspect::RunPcd(path, {FLAGS_record, FLAGS_ground, FLAGS_out}, std::cerr);
-  } else {
-    std::cerr << "tiltcal_inspect: unknown command '" << command << "' (info, cat, csv, pcd)\n";
-    return 2;
-  }
+  const Status status = RunCommand(cli, command, cli.positional()[1]);
   std::cout.flush();
-  if (!status.ok()) {
-    std::cerr << "tiltcal_inspect: " << status.message() << "\n";
-    return 1;
-  }
-  return 0;
+  return cli.Finish(status);
 }

@@ -29,58 +29,59 @@ void AddField(const std::string& name, uint32_t offset, uint8_t datatype,
   cloud->fields.push_back(field);
 }
 
-}  // namespace
-
-Status RunPcd(const std::string& scans_path, const PcdOptions& options, std::ostream& log) {
-  if (options.out_path.empty()) return Status::Error("pcd needs --out=FILE.pcd");
-  if (options.record < 0) return Status::Error("pcd: --record must be >= 0");
+// Scan `record` of the stream at `scans_path`, with equal point columns.
+Status ReadScan(const std::string& scans_path, int64_t record, proto::Scan* scan) {
   RecordReader reader;
   TILTCAL_RETURN_IF_ERROR(reader.Open(scans_path, proto::Scan::descriptor()->full_name()));
-  proto::Scan scan;
   for (int64_t i = 0;; ++i) {
     bool end = false;
-    TILTCAL_RETURN_IF_ERROR(reader.Read(&scan, &end));
+    TILTCAL_RETURN_IF_ERROR(reader.Read(scan, &end));
     if (end) {
       return Status::Error(scans_path + ": has " + std::to_string(i) + " scans, no record " +
-                           std::to_string(options.record));
+                           std::to_string(record));
     }
-    if (i == options.record) break;
+    if (i == record) break;
   }
-  const size_t n = static_cast<size_t>(scan.x_size());
-  if (scan.y_size() != scan.x_size() || scan.z_size() != scan.x_size()) {
-    return Status::Error(scans_path + ": record " + std::to_string(options.record) +
+  if (scan->y_size() != scan->x_size() || scan->z_size() != scan->x_size()) {
+    return Status::Error(scans_path + ": record " + std::to_string(record) +
                          ": point columns differ in length");
   }
+  return Status::Ok();
+}
 
-  proto::GroundPlane plane;
-  bool have_ground = false;
-  if (!options.ground_path.empty()) {
-    RecordReader ground;
-    TILTCAL_RETURN_IF_ERROR(
-        ground.Open(options.ground_path, proto::GroundPlane::descriptor()->full_name()));
-    for (;;) {
-      bool end = false;
-      TILTCAL_RETURN_IF_ERROR(ground.Read(&plane, &end));
-      if (end) break;
-      if (plane.scan_index() == scan.index() && plane.stamp_ns() == scan.stamp_ns()) {
-        have_ground = true;
-        break;
-      }
-    }
-    if (!have_ground) {
-      return Status::Error(options.ground_path + ": no ground record for scan index " +
+// The ground record of `scan` (same scan_index and stamp) with its point masks.
+Status ReadGroundOfScan(const std::string& ground_path, const proto::Scan& scan,
+                        proto::GroundPlane* plane) {
+  RecordReader ground;
+  TILTCAL_RETURN_IF_ERROR(ground.Open(ground_path, proto::GroundPlane::descriptor()->full_name()));
+  for (;;) {
+    bool end = false;
+    TILTCAL_RETURN_IF_ERROR(ground.Read(plane, &end));
+    if (end) {
+      return Status::Error(ground_path + ": no ground record for scan index " +
                            std::to_string(scan.index()) + " stamp " +
                            std::to_string(scan.stamp_ns()));
     }
-    if (plane.num_points() != n || (n > 0 && plane.ground_mask_size() == 0 &&
-                                    plane.reject_reason() != proto::GROUND_NO_IMU_COVERAGE)) {
-      return Status::Error(options.ground_path + ": record for scan " +
-                           std::to_string(scan.index()) +
-                           " has no point masks for this scan (params.store_point_masks)");
-    }
+    if (plane->scan_index() == scan.index() && plane->stamp_ns() == scan.stamp_ns()) break;
   }
+  const size_t n = static_cast<size_t>(scan.x_size());
+  if (plane->num_points() != n || (n > 0 && plane->ground_mask_size() == 0 &&
+                                   plane->reject_reason() != proto::GROUND_NO_IMU_COVERAGE)) {
+    return Status::Error(ground_path + ": record for scan " + std::to_string(scan.index()) +
+                         " has no point masks for this scan (params.store_point_masks)");
+  }
+  return Status::Ok();
+}
 
-  // Packed binary layout: x y z intensity ring time_offset_ns [label].
+struct LabelCounts {
+  size_t ground = 0;   // labelled 1 or 2
+  size_t inliers = 0;  // labelled 2
+};
+
+// Packed binary layout: x y z intensity ring time_offset_ns [label], the
+// label from `plane`'s masks when it is given.
+pcl::PCLPointCloud2 MakeCloud(const proto::Scan& scan, const proto::GroundPlane* plane,
+                              LabelCounts* counts) {
   pcl::PCLPointCloud2 cloud;
   AddField("x", 0, pcl::PCLPointField::FLOAT32, &cloud);
   AddField("y", 4, pcl::PCLPointField::FLOAT32, &cloud);
@@ -89,17 +90,17 @@ Status RunPcd(const std::string& scans_path, const PcdOptions& options, std::ost
   AddField("ring", 16, pcl::PCLPointField::UINT32, &cloud);
   AddField("time_offset_ns", 20, pcl::PCLPointField::INT32, &cloud);
   uint32_t step = 24;
-  if (have_ground) {
+  if (plane != nullptr) {
     AddField("label", 24, pcl::PCLPointField::UINT8, &cloud);
     step = 25;
   }
+  const size_t n = static_cast<size_t>(scan.x_size());
   cloud.height = 1;
   cloud.width = static_cast<uint32_t>(n);
   cloud.point_step = step;
   cloud.row_step = step * cloud.width;
   cloud.is_dense = true;
   cloud.data.resize(static_cast<size_t>(cloud.row_step));
-  size_t num_ground = 0, num_inliers = 0;
   for (size_t i = 0; i < n; ++i) {
     uint8_t* p = cloud.data.data() + i * step;
     const float xyz[4] = {scan.x(i), scan.y(i), scan.z(i),
@@ -111,34 +112,54 @@ Status RunPcd(const std::string& scans_path, const PcdOptions& options, std::ost
     std::memcpy(p, xyz, 16);
     std::memcpy(p + 16, &ring, 4);
     std::memcpy(p + 20, &t, 4);
-    if (have_ground) {
+    if (plane != nullptr) {
       uint8_t label = 0;
-      if (Bit(plane.inlier_mask(), i)) {
+      if (Bit(plane->inlier_mask(), i)) {
         label = 2;
-        ++num_inliers;
-        ++num_ground;
-      } else if (Bit(plane.ground_mask(), i)) {
+        ++counts->inliers;
+        ++counts->ground;
+      } else if (Bit(plane->ground_mask(), i)) {
         label = 1;
-        ++num_ground;
+        ++counts->ground;
       }
       p[24] = label;
     }
   }
+  return cloud;
+}
 
-  const std::string temp = options.out_path + ".tmp";
+// Writes `cloud` as a binary PCD to a temporary name and renames it.
+Status WritePcdAtomically(const std::string& path, const pcl::PCLPointCloud2& cloud) {
+  const std::string temp = path + ".tmp";
   pcl::PCDWriter writer;
   if (writer.writeBinary(temp, cloud) != 0) {
     std::remove(temp.c_str());
-    return Status::Error(options.out_path + ": cannot write the PCD");
+    return Status::Error(path + ": cannot write the PCD");
   }
-  if (std::rename(temp.c_str(), options.out_path.c_str()) != 0) {
+  if (std::rename(temp.c_str(), path.c_str()) != 0) {
     std::remove(temp.c_str());
-    return Status::Error(options.out_path + ": cannot rename the temporary PCD");
+    return Status::Error(path + ": cannot rename the temporary PCD");
   }
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status RunPcd(const std::string& scans_path, const PcdOptions& options, std::ostream& log) {
+  if (options.out_path.empty()) return Status::Error("pcd needs --out=FILE.pcd");
+  if (options.record < 0) return Status::Error("pcd: --record must be >= 0");
+  proto::Scan scan;
+  TILTCAL_RETURN_IF_ERROR(ReadScan(scans_path, options.record, &scan));
+  proto::GroundPlane plane;
+  const bool have_ground = !options.ground_path.empty();
+  if (have_ground) TILTCAL_RETURN_IF_ERROR(ReadGroundOfScan(options.ground_path, scan, &plane));
+  LabelCounts counts;
+  const pcl::PCLPointCloud2 cloud = MakeCloud(scan, have_ground ? &plane : nullptr, &counts);
+  TILTCAL_RETURN_IF_ERROR(WritePcdAtomically(options.out_path, cloud));
   log << "tiltcal_inspect pcd: scan " << options.record << " (index " << scan.index() << ", "
-      << n << " points";
+      << scan.x_size() << " points";
   if (have_ground) {
-    log << ", " << num_ground << " ground, " << num_inliers << " in the plane fit, plane "
+    log << ", " << counts.ground << " ground, " << counts.inliers << " in the plane fit, plane "
         << (plane.valid() ? "valid" : "rejected: " + proto::GroundRejectReason_Name(
                                                          plane.reject_reason()));
   }

@@ -1,39 +1,28 @@
 // tiltcal_report: repeatability of the calibrations of a dataset.
-//   tiltcal_report --out=out/repeatability.txt [--out_csv=out/repeatability.csv]
-//                  [--rig=DATASET/rig.txtpb] [--title=TEXT] out/seq1 out/seq2 ...
-// Each directory holds calibration.txtpb and, for simulated data, truth.txtpb.
 #include <iostream>
 
-#include <gflags/gflags.h>
-
+#include "common/cli/command_line.h"
 #include "stages/report/report.h"
 
-DEFINE_string(out, "", "output: the repeatability table (text)");
-DEFINE_string(out_csv, "", "output: the same as CSV (optional)");
-DEFINE_string(rig, "", "input: the dataset's rig.txtpb, for the measured extrinsic (optional)");
-DEFINE_string(title, "", "first line of the table");
-
 int main(int argc, char** argv) {
-  gflags::SetUsageMessage(
-      "repeatability over calibrations\n"
-      "  tiltcal_report --out=TABLE [--out_csv=CSV] [--rig=RIG] SEQUENCE_DIR...");
-  gflags::ParseCommandLineFlags(&argc, &argv, /*remove_flags=*/true);
-  if (FLAGS_out.empty() || argc < 2) {
-    std::cerr << "usage: tiltcal_report --out=TABLE [--out_csv=CSV] [--rig=RIG] SEQUENCE_DIR...\n";
-    return 2;
-  }
-  tiltcal::report::RunOptions options;
-  options.sequence_dirs.assign(argv + 1, argv + argc);
-  options.rig_path = FLAGS_rig;
-  options.out_table_path = FLAGS_out;
-  options.out_csv_path = FLAGS_out_csv;
-  options.title = FLAGS_title;
-  std::string table;
-  const tiltcal::Status status = tiltcal::report::Run(options, &table);
-  if (!status.ok()) {
-    std::cerr << "tiltcal_report: " << status.message() << "\n";
-    return 1;
-  }
-  std::cout << table;
-  return 0;
+  tiltcal::cli::CommandLine cli("tiltcal_report",
+                                "repeatability over the calibrations of a dataset (SO(3) mean, "
+                                "sigma per component, errors against a simulation truth)");
+  cli.SetPositional("SEQUENCE_DIR...",
+                    "out/<sequence> folders, each with calibration.txtpb (+ truth.txtpb)", 1, -1);
+  cli.AddFlag("out", "output: the repeatability table (text)", tiltcal::cli::kRequired);
+  cli.AddFlag("out_csv", "output: the same as CSV");
+  cli.AddFlag("rig", "input: the dataset's rig.txtpb, for the measured extrinsic row");
+  cli.AddFlag("title", "first line of the table");
+  cli.AddExample(
+      "tiltcal_report --out=out/repeatability.txt --out_csv=out/repeatability.csv "
+      "--rig=datasets/husky/rig.txtpb out/run1 out/run2");
+  if (const auto exit_code = cli.Parse(argc, argv)) return *exit_code;
+  tiltcal::report::ReportPaths paths;
+  paths.sequence_dirs = cli.positional();
+  paths.rig = cli.Get("rig");
+  paths.out = cli.Get("out");
+  paths.out_csv = cli.Get("out_csv");
+  paths.title = cli.Get("title");
+  return cli.Finish(tiltcal::report::Run(paths, &std::cout));
 }

@@ -9,6 +9,7 @@
 #include "common/geometry/so3.h"
 #include "common/io/atomic_file.h"
 #include "common/io/eigen_proto.h"
+#include "common/io/rig.h"
 #include "common/io/text_proto.h"
 
 namespace tiltcal::report {
@@ -166,12 +167,12 @@ std::string FormatCsv(const Repeatability& r) {
   return out;
 }
 
-Status Run(const RunOptions& options, std::string* table) {
-  if (options.sequence_dirs.empty()) {
+Status Run(const ReportPaths& paths, std::ostream* log) {
+  if (paths.sequence_dirs.empty()) {
     return Status::Error("no sequence directories given");
   }
   std::vector<SequenceResult> results;
-  for (const std::string& dir : options.sequence_dirs) {
+  for (const std::string& dir : paths.sequence_dirs) {
     SequenceResult result;
     result.name = std::filesystem::path(dir).lexically_normal().filename().string();
     if (result.name.empty()) {
@@ -185,14 +186,15 @@ Status Run(const RunOptions& options, std::string* table) {
     results.push_back(std::move(result));
   }
   proto::Rig rig;
-  if (!options.rig_path.empty()) TILTCAL_RETURN_IF_ERROR(ReadTextProto(options.rig_path, &rig));
+  if (!paths.rig.empty()) TILTCAL_RETURN_IF_ERROR(LoadRig(paths.rig, &rig));
   const Repeatability repeatability =
-      ComputeRepeatability(results, options.rig_path.empty() ? nullptr : &rig);
-  *table = FormatTable(repeatability, options.title);
-  TILTCAL_RETURN_IF_ERROR(WriteFileAtomically(options.out_table_path, *table));
-  if (!options.out_csv_path.empty()) {
-    TILTCAL_RETURN_IF_ERROR(WriteFileAtomically(options.out_csv_path, FormatCsv(repeatability)));
+      ComputeRepeatability(results, paths.rig.empty() ? nullptr : &rig);
+  const std::string table = FormatTable(repeatability, paths.title);
+  TILTCAL_RETURN_IF_ERROR(WriteFileAtomically(paths.out, table));
+  if (!paths.out_csv.empty()) {
+    TILTCAL_RETURN_IF_ERROR(WriteFileAtomically(paths.out_csv, FormatCsv(repeatability)));
   }
+  if (log != nullptr) *log << table;
   return Status::Ok();
 }
 

@@ -2,6 +2,7 @@
 #define TILTCAL_STAGES_REPORT_REPORT_H_
 
 #include <optional>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -52,16 +53,19 @@ Repeatability ComputeRepeatability(const std::vector<SequenceResult>& results,
 std::string FormatTable(const Repeatability& repeatability, const std::string& title);
 std::string FormatCsv(const Repeatability& repeatability);
 
-// Reads <dir>/calibration.txtpb and <dir>/truth.txtpb (if present) for each
-// directory, computes the repeatability and writes the table and the CSV.
-struct RunOptions {
-  std::vector<std::string> sequence_dirs;
-  std::string rig_path;  // optional
-  std::string out_table_path;
-  std::string out_csv_path;  // optional
-  std::string title;
+// What tiltcal_report reads and writes.
+struct ReportPaths {
+  std::vector<std::string> sequence_dirs;  // each holds calibration.txtpb [+ truth.txtpb]
+  std::string rig;                         // optional: the measured extrinsic row
+  std::string out;                         // the table (text)
+  std::string out_csv;                     // optional: the same as CSV
+  std::string title;                       // first line of the table
 };
-Status Run(const RunOptions& options, std::string* table);
+
+// Reads <dir>/calibration.txtpb and <dir>/truth.txtpb (if present) for each
+// directory, computes the repeatability, writes the table and the CSV, and
+// prints the table to `log` (nullptr: silent).
+Status Run(const ReportPaths& paths, std::ostream* log);
 
 }  // namespace tiltcal::report
 

@@ -41,7 +41,7 @@ grep -q "seq_1" "$table" && grep -q "seq_2" "$table" || fail "the report misses 
 # the defaults (flat + distance residuals on this level ground). The 20 s
 # sequences (a 10 x 5 m figure-eight at 1.2 m/s, about two thirds of a loop)
 # hold less information on the angle of C_bl about the vertical than the
-# 40-60 s ones issue 6 bounds at 0.1 deg (its sigma here: 0.11-0.27 deg), so
+# 40-60 s ones, whose rotation target is 0.1 deg (its sigma here: 0.11-0.27 deg), so
 # rotation is held to 0.25 deg; every axis to 1 cm, tau to 0.5 ms. Measured:
 # rotation 0.089 / 0.012 deg, x/y at most 0.82 cm, z 0.01 cm, tau 0.09-0.32 ms.
 awk -F, 'function abs(v) { return v < 0 ? -v : v }

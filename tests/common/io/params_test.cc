@@ -87,3 +87,23 @@ TEST(TextProto, WriteThenReadRoundTripsDoublesExactly) {
 
 }  // namespace
 }  // namespace tiltcal
+
+namespace tiltcal {
+namespace {
+
+TEST(Params, MissingPathMeansTheDefaultText) {
+  proto::DecodeParams params;
+  const Status status =
+      LoadParamsOrDefaults("", "min_range_m: 0.25\nchunk_cache_size: 4\n", &params);
+  ASSERT_TRUE(status.ok()) << status.message();
+  EXPECT_DOUBLE_EQ(params.min_range_m(), 0.25);
+  const Status bad =
+      LoadParamsOrDefaults("", "min_range_m: -1\nchunk_cache_size: 4\n", &params);
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.message().find("default DecodeParams: field min_range_m = -1"),
+            std::string::npos)
+      << bad.message();
+}
+
+}  // namespace
+}  // namespace tiltcal

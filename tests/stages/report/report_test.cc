@@ -2,8 +2,10 @@
 
 #include <cmath>
 #include <filesystem>
+#include <sstream>
 
 #include <Eigen/Geometry>
+
 #include <gtest/gtest.h>
 
 #include "common/geometry/euler_angles.h"
@@ -77,13 +79,17 @@ TEST(Repeatability, RunWritesTableAndCsvAndFailsOnMissingResult) {
     const SequenceResult s = Sequence(name, {180, 0, yaw}, {0.1, 0, 0.2}, 0.005);
     ASSERT_TRUE(WriteTextProto(dir.File(name + "/calibration.txtpb"), s.calibration).ok());
   }
-  RunOptions options;
-  options.sequence_dirs = {dir.File("seq1"), dir.File("seq2/")};
-  options.out_table_path = dir.File("repeatability.txt");
-  options.out_csv_path = dir.File("repeatability.csv");
-  std::string table;
-  const Status status = report::Run(options, &table);
+  ReportPaths paths;
+  paths.sequence_dirs = {dir.File("seq1"), dir.File("seq2/")};
+  paths.out = dir.File("repeatability.txt");
+  paths.out_csv = dir.File("repeatability.csv");
+  std::ostringstream log;
+  const Status status = report::Run(paths, &log);
   ASSERT_TRUE(status.ok()) << status.message();
+  const std::string table = log.str();
+  std::string written;
+  ASSERT_TRUE(ReadFileToString(dir.File("repeatability.txt"), &written).ok());
+  EXPECT_EQ(written, table);
   EXPECT_NE(table.find("seq1"), std::string::npos) << table;
   EXPECT_NE(table.find("seq2"), std::string::npos) << table;
   EXPECT_EQ(table.find("rot err"), std::string::npos) << "no truth, no error columns";
@@ -92,9 +98,9 @@ TEST(Repeatability, RunWritesTableAndCsvAndFailsOnMissingResult) {
   EXPECT_NE(csv.find("\nmean,10,0,20,180,"), std::string::npos) << csv;
   EXPECT_NE(csv.find(",11,"), std::string::npos) << csv;  // mean yaw 11 deg
 
-  options.sequence_dirs.push_back(dir.File("missing"));
-  options.out_table_path = dir.File("other.txt");
-  const Status missing = report::Run(options, &table);
+  paths.sequence_dirs.push_back(dir.File("missing"));
+  paths.out = dir.File("other.txt");
+  const Status missing = report::Run(paths, nullptr);
   ASSERT_FALSE(missing.ok());
   EXPECT_NE(missing.message().find("missing/calibration.txtpb"), std::string::npos);
   EXPECT_FALSE(testing::FileExists(dir.File("other.txt")));

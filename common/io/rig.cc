@@ -1,0 +1,65 @@
+#include "common/io/rig.h"
+
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "common/io/eigen_proto.h"
+#include "common/io/text_proto.h"
+
+namespace tiltcal {
+
+namespace {
+
+bool IsFinite(const proto::Vector3& v) {
+  return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z());
+}
+
+}  // namespace
+
+Status ValidateRig(proto::Rig* rig) {
+  if (!rig->has_imu_from_lidar() || !rig->imu_from_lidar().has_rotation()) {
+    return Status::Error("imu_from_lidar.rotation is missing (the measured extrinsic C_bl)");
+  }
+  proto::Quaternion* q = rig->mutable_imu_from_lidar()->mutable_rotation();
+  const double norm = std::sqrt(q->w() * q->w() + q->x() * q->x() + q->y() * q->y() +
+                                q->z() * q->z());
+  if (!std::isfinite(norm)) return Status::Error("imu_from_lidar.rotation is not finite");
+  if (std::fabs(norm - 1.0) > kRigQuaternionNormTolerance) {
+    return Status::Error(fmt::format(
+        "imu_from_lidar.rotation is not a unit quaternion (norm {:.6g}; w x y z, Hamilton)", norm));
+  }
+  *q = ToProto(ToEigen(*q));
+  const proto::Vector3& translation = rig->imu_from_lidar().translation();
+  if (!IsFinite(translation)) return Status::Error("imu_from_lidar.translation is not finite");
+  const double distance = ToEigen(translation).norm();
+  if (distance > kRigMaxTranslationM) {
+    return Status::Error(fmt::format(
+        "imu_from_lidar.translation is {:.3g} m long, more than {} m (metres, IMU frame)",
+        distance, kRigMaxTranslationM));
+  }
+  if (!std::isfinite(rig->imu_height_m()) || rig->imu_height_m() < 0 ||
+      rig->imu_height_m() > kRigMaxImuHeightM) {
+    return Status::Error(fmt::format("imu_height_m = {} is outside [0, {}] m (0 = unknown)",
+                                     rig->imu_height_m(), kRigMaxImuHeightM));
+  }
+  if (rig->has_gravity_flat_in_imu()) {
+    if (!IsFinite(rig->gravity_flat_in_imu())) {
+      return Status::Error("gravity_flat_in_imu is not finite");
+    }
+    const double g = ToEigen(rig->gravity_flat_in_imu()).norm();
+    if (g != 0.0 && (g < kRigMinGravityMps2 || g > kRigMaxGravityMps2)) {
+      return Status::Error(fmt::format(
+          "gravity_flat_in_imu has norm {:.4g}, not a gravity in m/s² (expected {} to {})", g,
+          kRigMinGravityMps2, kRigMaxGravityMps2));
+    }
+  }
+  return Status::Ok();
+}
+
+Status LoadRig(const std::string& path, proto::Rig* rig) {
+  TILTCAL_RETURN_IF_ERROR(ReadTextProto(path, rig));
+  return ValidateRig(rig).WithContext(path);
+}
+
+}  // namespace tiltcal

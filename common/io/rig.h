@@ -1,0 +1,33 @@
+#ifndef TILTCAL_COMMON_IO_RIG_H_
+#define TILTCAL_COMMON_IO_RIG_H_
+
+#include <string>
+
+#include "common/status.h"
+#include "tiltcal/proto/rig.pb.h"
+
+namespace tiltcal {
+
+// How far the norm of the rig's rotation quaternion may be from 1 (a
+// hand-written quaternion with four decimals is off by ~1e-4).
+inline constexpr double kRigQuaternionNormTolerance = 1e-3;
+// Bounds of a plausible rig: the LiDAR within 10 m of the IMU, the IMU at
+// most 10 m above the ground, g_f between 8.5 and 11 m/s² when given.
+inline constexpr double kRigMaxTranslationM = 10.0;
+inline constexpr double kRigMaxImuHeightM = 10.0;
+inline constexpr double kRigMinGravityMps2 = 8.5;
+inline constexpr double kRigMaxGravityMps2 = 11.0;
+
+// Checks a rig (the dataset's rig.txtpb): imu_from_lidar present with a unit
+// quaternion (within kRigQuaternionNormTolerance; normalised in place),
+// every value finite, the translation, imu_height_m and gravity_flat_in_imu
+// (when set) within the bounds above. The error names the field.
+Status ValidateRig(proto::Rig* rig);
+
+// Reads rig.txtpb (a regular, non-empty file) and validates it; every error
+// names the file and the field. Every stage reads the rig through this.
+Status LoadRig(const std::string& path, proto::Rig* rig);
+
+}  // namespace tiltcal
+
+#endif  // TILTCAL_COMMON_IO_RIG_H_
