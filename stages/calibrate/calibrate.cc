@@ -3,18 +3,18 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <ctime>
 #include <memory>
 
 #include <ceres/solver.h>
+#include <fmt/format.h>
 
 #include "common/io/eigen_proto.h"
 #include "common/io/imu_stream.h"
 #include "common/io/provenance.h"
 #include "common/io/record_stream.h"
+#include "common/io/rig.h"
 #include "common/io/text_proto.h"
-#include "stages/calibrate/calibrate_params_validation.h"
 #include "stages/calibrate/covariance_report.h"
 #include "stages/calibrate/ground_residuals.h"
 #include "stages/calibrate/initialisation.h"
@@ -43,22 +43,12 @@ void Log(std::ostream* log, const std::string& line) {
   if (log != nullptr) *log << "tiltcal_calibrate: " << line << "\n" << std::flush;
 }
 
-std::string Format(const char* fmt, double a = 0, double b = 0, double c = 0, double d = 0,
-                   double e = 0) {
-  char buf[512];
-  std::snprintf(buf, sizeof(buf), fmt, a, b, c, d, e);
-  return buf;
-}
-
 }  // namespace
 
 Status ReadCalibrateInputs(const CalibratePaths& paths, const proto::CalibrateParams& params,
                            CalibrateInputs* inputs) {
   *inputs = CalibrateInputs();
-  TILTCAL_RETURN_IF_ERROR(ReadTextProto(paths.rig, &inputs->rig));
-  if (!HasValidRotation(inputs->rig.imu_from_lidar())) {
-    return Status::Error(paths.rig + ": imu_from_lidar.rotation missing or zero");
-  }
+  TILTCAL_RETURN_IF_ERROR(LoadRig(paths.rig, &inputs->rig));
   TILTCAL_RETURN_IF_ERROR(
       ReadImuReadings(paths.imu, &inputs->imu, &inputs->first_imu_stamp_ns));
   TILTCAL_RETURN_IF_ERROR(
@@ -88,21 +78,22 @@ Status Initialise(const CalibrateInputs& inputs, const proto::CalibrateParams& p
   AddTiming("init_rotation_spline", init->rotation_fit_seconds, result);
   AddTiming("init_lidar_odometry", init->odometry_seconds, result);
   AddTiming("init_position_spline", init->position_fit_seconds, result);
-  Log(log, Format("init: %.0f knots, static start %.0f, gyro fit rms %.3f, odometry %.0f/%.0f "
-                  "scans registered",
-                  state->trajectory.grid().num_knots(), init->imu.from_static_start ? 1 : 0,
-                  init->gyro_fit_rms, init->odometry_registered, init->odometry_scans));
-  Log(log, Format("init: hand-eye excitation %.4f rad (%.0f pairs); position fit rms %.3f; "
-                  "%.2f s",
-                  init->hand_eye.excitation_rad, init->hand_eye.num_pairs, init->position_fit_rms,
-                  Seconds(start)) +
-               (init->rotation_from_hand_eye ? "; C_bl from hand-eye" : "; C_bl from the rig"));
-  Log(log, Format("init: rotation-axis alignment %.0f (%.3f deg), coarse tau %.2f ms",
-                  init->axis_alignment_applied ? 1 : 0, init->axis_alignment_deg,
-                  init->time_offset_init_s * 1e3));
+  Log(log, fmt::format("init: {} knots, static start {:d}, gyro fit rms {:.3f}, odometry {}/{} "
+                       "scans registered",
+                       state->trajectory.grid().num_knots(), init->imu.from_static_start ? 1 : 0,
+                       init->gyro_fit_rms, init->odometry_registered, init->odometry_scans));
+  Log(log, fmt::format("init: hand-eye excitation {:.4f} rad ({} pairs); position fit rms {:.3f}; "
+                       "{:.2f} s; C_bl from {}",
+                       init->hand_eye.excitation_rad, init->hand_eye.num_pairs,
+                       init->position_fit_rms, Seconds(start),
+                       init->rotation_from_hand_eye ? "hand-eye" : "the rig"));
+  Log(log, fmt::format("init: rotation-axis alignment {:d} ({:.3f} deg), coarse tau {:.2f} ms",
+                       init->axis_alignment_applied ? 1 : 0, init->axis_alignment_deg,
+                       init->time_offset_init_s * 1e3));
   const Eigen::Vector3d r = state->ImuFromLidarTranslation();
-  Log(log, Format("init: rotation refit rms %.3f; r_bl (%.4f, %.4f, %.4f) m from the position fit",
-                  init->rotation_refit_rms, r.x(), r.y(), r.z()));
+  Log(log, fmt::format("init: rotation refit rms {:.3f}; r_bl ({:.4f}, {:.4f}, {:.4f}) m from the "
+                       "position fit",
+                       init->rotation_refit_rms, r.x(), r.y(), r.z()));
   return Status::Ok();
 }
 
@@ -174,13 +165,13 @@ Status RunOuterRound(const OuterLoopSetup& setup, CalibrationState* state, Outer
   loop->converged = summary.termination_type == ceres::CONVERGENCE;
   loop->termination = ceres::TerminationTypeToString(summary.termination_type);
   const Eigen::Vector3d r = state->ImuFromLidarTranslation();
-  Log(log, Format("outer %.0f: %.0f surfels, %.0f lidar residuals, cost %.4g -> %.4g", round,
-                  assoc.map.num_surfels, assoc.residuals, summary.initial_cost,
-                  summary.final_cost));
-  Log(log, Format("outer %.0f: %.0f LM iterations in %.2f s; tau %.3f ms; r_bl (%.4f, ", round,
-                  static_cast<double>(summary.iterations.size()) - 1, solve_seconds,
-                  state->time_offset_s[0] * 1e3, r.x()) +
-               Format("%.4f, %.4f) m", r.y(), r.z()));
+  Log(log, fmt::format("outer {}: {} surfels, {} lidar residuals, cost {:.4g} -> {:.4g}", round,
+                       assoc.map.num_surfels, assoc.residuals, summary.initial_cost,
+                       summary.final_cost));
+  Log(log, fmt::format("outer {}: {} LM iterations in {:.2f} s; tau {:.3f} ms; r_bl ({:.4f}, "
+                       "{:.4f}, {:.4f}) m",
+                       round, static_cast<int>(summary.iterations.size()) - 1, solve_seconds,
+                       state->time_offset_s[0] * 1e3, r.x(), r.y(), r.z()));
   loop->rounds = round;
   loop->moved_deg =
       Eigen::AngleAxisd(rotation_before.conjugate() * state->ImuFromLidarRotation()).angle() *
@@ -198,9 +189,9 @@ Status RunOuterRound(const OuterLoopSetup& setup, CalibrationState* state, Outer
   *settled = round >= 2 && loop->moved_deg < stop.stop_rotation_deg() &&
              loop->moved_m < stop.stop_translation_m() &&
              loop->moved_s < stop.stop_time_offset_s();
-  Log(log, Format("outer %.0f: extrinsic moved %.4f deg, %.2f mm, tau %.3f ms", round,
-                  loop->moved_deg, loop->moved_m * 1e3, loop->moved_s * 1e3) +
-               (*settled ? ": stop" : ""));
+  Log(log, fmt::format("outer {}: extrinsic moved {:.4f} deg, {:.2f} mm, tau {:.3f} ms{}", round,
+                       loop->moved_deg, loop->moved_m * 1e3, loop->moved_s * 1e3,
+                       *settled ? ": stop" : ""));
   return Status::Ok();
 }
 
@@ -290,7 +281,6 @@ void FillEstimate(const CalibrationState& state, const std::vector<std::string>&
 Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& params,
                  proto::CalibrationResult* result, CalibrationState* final_state,
                  std::ostream* log) {
-  TILTCAL_RETURN_IF_ERROR(ValidateCalibrateParams(params));
   result->Clear();
   const auto total_start = Clock::now();
   if (inputs.imu.size() < 10) return Status::Error("too few IMU samples");
@@ -347,9 +337,9 @@ Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& pa
   AddTiming("total", Seconds(total_start), result);
   if (final_state != nullptr) *final_state = state;
   for (const proto::ObservabilityDirection& d : result->observability()) Log(log, d.description());
-  Log(log, Format("done in %.2f s, %.0f LM iterations, %.3f s per iteration",
-                  Seconds(total_start), loop.total_iterations,
-                  result->solver().seconds_per_iteration()));
+  Log(log, fmt::format("done in {:.2f} s, {} LM iterations, {:.3f} s per iteration",
+                       Seconds(total_start), loop.total_iterations,
+                       result->solver().seconds_per_iteration()));
   return Status::Ok();
 }
 

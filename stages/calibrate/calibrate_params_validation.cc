@@ -2,6 +2,9 @@
 
 #include <string>
 
+#include "common/io/params.h"
+#include "stages/calibrate/default_params_text.h"
+
 namespace tiltcal::calibrate {
 namespace {
 
@@ -60,6 +63,12 @@ Status ValidateCalibrateParams(const proto::CalibrateParams& params) {
   TILTCAL_RETURN_IF_ERROR(ValidateSurfelMapParams(params.map(), "map"));
   TILTCAL_RETURN_IF_ERROR(ValidateAssociationParams(params.association()));
   return ValidateGroundResidualsParams(params.ground());
+}
+
+Status LoadCalibrateParams(const std::string& path, proto::CalibrateParams* params) {
+  TILTCAL_RETURN_IF_ERROR(LoadParamsOrDefaults(path, DefaultParamsText(), params));
+  return ValidateCalibrateParams(*params).WithContext(path.empty() ? "default CalibrateParams"
+                                                                   : path);
 }
 
 }  // namespace tiltcal::calibrate

@@ -6,8 +6,8 @@
 // cannot express: strictly positive values where the bound is an inclusive 0,
 // and relations between fields. One function per message that has such
 // rules; each error names the field by its dotted path from CalibrateParams.
-// ValidateCalibrateParams runs them all; tiltcal_calibrate calls it once,
-// after loading the params.
+// ValidateCalibrateParams runs them all; LoadCalibrateParams runs it once,
+// after the schema bounds, when the params are loaded.
 
 #include <string>
 
@@ -26,6 +26,11 @@ Status ValidateAssociationParams(const proto::AssociationParams& params);
 Status ValidateGroundResidualsParams(const proto::GroundResidualsParams& params);
 
 Status ValidateCalibrateParams(const proto::CalibrateParams& params);
+
+// The params file at `path` (or, when `path` is empty, the stage's defaults,
+// DefaultParamsText()), checked against the schema bounds and by
+// ValidateCalibrateParams.
+Status LoadCalibrateParams(const std::string& path, proto::CalibrateParams* params);
 
 }  // namespace tiltcal::calibrate
 

@@ -11,6 +11,7 @@
 
 #include "common/io/atomic_file.h"
 #include "stages/calibrate/calibrate_params_validation.h"
+#include "stages/calibrate/default_params_text.h"
 #include "tests/stages/calibrate/calibrate_params_text.h"
 #include "tests/testing/test_env.h"
 
@@ -40,20 +41,31 @@ void CollectUnsetFields(const Descriptor* descriptor, const TextFormat::ParseInf
 }
 
 TEST(CalibrateParamsTest, DefaultParamsFileSetsEveryField) {
-  std::string text;
-  ASSERT_TRUE(
-      ReadFileToString(tiltcal::testing::SourceDir() + "/stages/calibrate/default_params.txtpb",
-                       &text)
-          .ok());
   proto::CalibrateParams params;
   TextFormat::ParseInfoTree tree;
   TextFormat::Parser parser;
   parser.WriteLocationsTo(&tree);
-  ASSERT_TRUE(parser.ParseFromString(text, &params));
+  ASSERT_TRUE(parser.ParseFromString(std::string(DefaultParamsText()), &params));
   std::string missing;
   CollectUnsetFields(proto::CalibrateParams::descriptor(), &tree, "", &missing);
   EXPECT_EQ(missing, "") << "fields the default params file does not set";
   EXPECT_TRUE(ValidateCalibrateParams(params).ok());
+}
+
+TEST(CalibrateParamsTest, LoadingChecksTheRulesAndNamesTheFile) {
+  proto::CalibrateParams params;
+  ASSERT_TRUE(LoadCalibrateParams("", &params).ok());  // the embedded defaults
+  EXPECT_DOUBLE_EQ(params.map().voxel_m(), 1.0);
+  tiltcal::testing::TempDir dir;
+  std::string text(DefaultParamsText());
+  const std::string min_range = "min_range_m: 1.0";
+  ASSERT_NE(text.find(min_range), std::string::npos);
+  text.replace(text.find(min_range), min_range.size(), "min_range_m: 90");  // > max_range_m (80)
+  ASSERT_TRUE(WriteFileAtomically(dir.File("p.txtpb"), text).ok());
+  const Status status = LoadCalibrateParams(dir.File("p.txtpb"), &params);
+  ASSERT_FALSE(status.ok());
+  EXPECT_NE(status.message().find("p.txtpb"), std::string::npos) << status.message();
+  EXPECT_NE(status.message().find("scans.max_range_m"), std::string::npos) << status.message();
 }
 
 // The error of ValidateCalibrateParams on the defaults with `override_text`.

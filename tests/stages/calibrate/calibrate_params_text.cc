@@ -1,25 +1,18 @@
 #include "tests/stages/calibrate/calibrate_params_text.h"
 
-#include <google/protobuf/text_format.h>
 #include <gtest/gtest.h>
 
-#include "common/io/params.h"
 #include "stages/calibrate/calibrate_params_validation.h"
-#include "tests/testing/test_env.h"
+#include "stages/calibrate/default_params_text.h"
+#include "tests/testing/params_text.h"
 
 namespace tiltcal::testing {
 
 proto::CalibrateParams DefaultCalibrateParamsWith(const std::string& override_text) {
-  proto::CalibrateParams params;
-  const Status loaded = LoadParams(
-      SourceDir() + "/stages/calibrate/default_params.txtpb", &params);
-  if (!loaded.ok()) ADD_FAILURE() << loaded.message();
-  if (!google::protobuf::TextFormat::MergeFromString(override_text, &params)) {
-    ADD_FAILURE() << "override text does not parse: " << override_text;
-  }
-  Status valid = ValidateAgainstSchema(params);
-  if (valid.ok()) valid = calibrate::ValidateCalibrateParams(params);
-  if (!valid.ok()) ADD_FAILURE() << valid.message();
+  const proto::CalibrateParams params =
+      DefaultParamsWith<proto::CalibrateParams>(calibrate::DefaultParamsText(), override_text);
+  const Status valid = calibrate::ValidateCalibrateParams(params);
+  EXPECT_TRUE(valid.ok()) << valid.message();
   return params;
 }
 

@@ -7,9 +7,10 @@
 
 namespace tiltcal::testing {
 
-// The program's defaults (stages/calibrate/default_params.txtpb) with the
-// fields of `override_text` (text format, CalibrateParams) merged over them;
-// the test fails (ADD_FAILURE) when either does not parse or validate.
+// The calibrator's defaults (calibrate::DefaultParamsText()) with the fields
+// of `override_text` (text format, CalibrateParams) merged over them
+// (DefaultParamsWith, tests/testing/params_text.h); the test fails when the
+// result breaks a schema bound or a rule of ValidateCalibrateParams.
 proto::CalibrateParams DefaultCalibrateParamsWith(const std::string& override_text = "");
 
 }  // namespace tiltcal::testing
