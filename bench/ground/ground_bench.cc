@@ -28,6 +28,7 @@
 #include "common/imu/gyro_integrator.h"
 #include "common/imu/imu_reading.h"
 #include "common/io/params.h"
+#include "stages/ground/default_params_text.h"
 #include "stages/ground/scan_processor.h"
 #include "tests/stages/ground/synthetic_lidar.h"
 
@@ -141,9 +142,10 @@ int main(int argc, char** argv) {
     if (arg.rfind("--fixtures=", 0) == 0) fixtures = arg.substr(11);
     if (arg.rfind("--passes=", 0) == 0) passes = std::max(1, std::atoi(arg.c_str() + 9));
   }
+  // The shipped defaults (stages/ground/default_params.txtpb, compiled in).
   tiltcal::proto::GroundParams params;
-  const tiltcal::Status status = tiltcal::LoadParams(
-      std::string(TILTCAL_SOURCE_DIR) + "/stages/ground/default_params.txtpb", &params);
+  const tiltcal::Status status = tiltcal::LoadParamsOrDefaults(
+      "", tiltcal::ground::DefaultParamsText(), &params);
   if (!status.ok()) {
     std::fprintf(stderr, "ground_bench: %s\n", status.message().c_str());
     return 1;
@@ -182,7 +184,7 @@ int main(int argc, char** argv) {
     }
     tiltcal::imu::GyroIntegrator integrator(imu, Eigen::Vector3d::Zero());
     tiltcal::ground::Deskewer deskewer(&integrator, -1000000000LL, Eigen::Matrix3d::Identity(),
-                                       0, params.deskew_node_spacing_s());
+                                       params.deskew());
     PrintRow("  + deskewing (timing only)", TimeScans(params, vlp, passes, &deskewer), 0.0);
   }
 

@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
+#include <vector>
+
+#include <fmt/format.h>
 
 #include "common/imu/gyro_integrator.h"
 #include "common/imu/imu_initialisation.h"
@@ -11,6 +13,7 @@
 #include "common/io/imu_stream.h"
 #include "common/io/provenance.h"
 #include "common/io/record_stream.h"
+#include "common/io/rig.h"
 #include "common/io/static_detection_params.h"
 #include "common/io/text_proto.h"
 
@@ -33,31 +36,20 @@ double Percentile(std::vector<double> values, double percentile) {
   return values[low] + (rank - low) * (values[high] - values[low]);
 }
 
-std::string Format(const char* format, double a, double b = 0, double c = 0) {
-  char buffer[256];
-  std::snprintf(buffer, sizeof(buffer), format, a, b, c);
-  return buffer;
-}
+// The specific force of the static windows (−g_b on level ground): summed
+// over their samples.
+struct StaticForce {
+  Eigen::Vector3d sum_mps2 = Eigen::Vector3d::Zero();
+  size_t num_samples = 0;
+};
 
-}  // namespace
-
-Status EstimateGravityReference(const GravityInputs& inputs, const proto::GravityParams& params,
-                                proto::GravityReference* out) {
-  const double g = params.gravity_norm_mps2();
-  imu::ImuInitialisationOptions init_options;
-  init_options.static_detection = ToStaticDetectionOptions(params.static_detection());
-  init_options.gravity_norm_mps2 = g;
-  init_options.fallback_window_s = params.fallback_window_s();
-  imu::ImuInitialisation init;
-  TILTCAL_RETURN_IF_ERROR(imu::InitialiseImu(inputs.imu, init_options, &init));
-  *out->mutable_gravity_in_world() = ToProto(init.gravity_in_world_mps2);
-  *out->mutable_gyro_bias_radps() = ToProto(init.gyro_bias_radps);
-
-  // Static windows: their specific force is −g_b at that time.
-  Eigen::Vector3d static_force_sum = Eigen::Vector3d::Zero();
-  size_t static_samples = 0;
-  for (const imu::StaticInterval& interval :
-       imu::DetectStaticIntervals(inputs.imu, init_options.static_detection)) {
+// Static windows of the accelerometer, added to `out`, and their specific
+// force.
+StaticForce AddStaticWindows(const GravityInputs& inputs,
+                             const imu::StaticDetectionOptions& options,
+                             proto::GravityReference* out) {
+  StaticForce force;
+  for (const imu::StaticInterval& interval : imu::DetectStaticIntervals(inputs.imu, options)) {
     proto::StaticWindow* window = out->add_static_windows();
     window->set_begin_ns(inputs.first_imu_stamp_ns + std::llround(interval.begin_s * 1e9));
     window->set_end_ns(inputs.first_imu_stamp_ns + std::llround(interval.end_s * 1e9));
@@ -65,80 +57,112 @@ Status EstimateGravityReference(const GravityInputs& inputs, const proto::Gravit
     window->set_accel_std_mps2(interval.accel_std_mps2);
     window->set_gyro_std_radps(interval.gyro_std_radps);
     const size_t n = interval.end_index - interval.begin_index;
-    static_force_sum += interval.mean_accel_mps2 * static_cast<double>(n);
-    static_samples += n;
+    force.sum_mps2 += interval.mean_accel_mps2 * static_cast<double>(n);
+    force.num_samples += n;
   }
+  return force;
+}
 
-  // Per scan: gravity-up in the IMU frame and the slope of the ground.
+// One inclination sample per ground plane: g̃_b = −C_ab(t)^T g_a / |g_a| at
+// t = t_scan + τ (returned in *ups) and, for a valid plane, the ground slope
+// ∠(g̃_b, C_bl n_l) (returned in *slopes).
+void AddInclinationSamples(const GravityInputs& inputs, const imu::ImuInitialisation& init,
+                           double time_offset_s, proto::GravityReference* out,
+                           std::vector<Eigen::Vector3d>* ups, std::vector<double>* slopes) {
   const imu::GyroIntegrator attitude(inputs.imu, init.gyro_bias_radps);
   const Eigen::Vector3d up_in_world = -init.gravity_in_world_mps2.normalized();
   const Eigen::Quaterniond imu_from_lidar = ToEigen(inputs.rig.imu_from_lidar().rotation());
-  const bool has_extrinsic = HasValidRotation(inputs.rig.imu_from_lidar());
-  std::vector<double> slopes;
-  std::vector<Eigen::Vector3d> ups;
   for (const proto::GroundPlane& plane : inputs.ground) {
     const double t = static_cast<double>(plane.stamp_ns() - inputs.first_imu_stamp_ns) * 1e-9 +
-                     params.time_offset_s();
+                     time_offset_s;
     const Eigen::Vector3d up_in_imu = attitude.Rotation(t).conjugate() * up_in_world;
     proto::InclinationSample* sample = out->add_inclination();
     sample->set_stamp_ns(plane.stamp_ns());
     *sample->mutable_up_in_imu() = ToProto(up_in_imu);
-    ups.push_back(up_in_imu);
-    if (plane.valid() && has_extrinsic) {
+    ups->push_back(up_in_imu);
+    if (plane.valid()) {
       const double slope = AngleDeg(up_in_imu, imu_from_lidar * ToEigen(plane.normal_in_lidar()));
       sample->set_ground_slope_deg(slope);
-      slopes.push_back(slope);
+      slopes->push_back(slope);
     }
   }
+}
 
-  // Verdict.
-  if (!slopes.empty()) {
-    const double statistic = Percentile(slopes, params.level_percentile());
-    out->set_level_statistic_deg(statistic);
-    out->set_is_level(statistic < params.level_threshold_deg());
-    out->set_level_statistic(Format("%.0fth percentile of the ground slope over %.0f valid "
-                                    "ground planes: %.3f deg",
-                                    params.level_percentile(),
-                                    static_cast<double>(slopes.size()), statistic) +
-                             Format(" (level below %.3f deg)", params.level_threshold_deg()));
-  } else {
+// Level when the percentile of the ground slopes is below the threshold; not
+// level when no slope is known.
+void SetLevelVerdict(const std::vector<double>& slopes, const proto::LevelVerdictParams& params,
+                     proto::GravityReference* out) {
+  if (slopes.empty()) {
     out->set_is_level(false);
-    out->set_level_statistic(has_extrinsic
-                                 ? "no valid ground plane: the ground slope is unknown, so the "
-                                   "sequence is not taken as level"
-                                 : "the rig has no imu_from_lidar: the ground slope is unknown, "
-                                   "so the sequence is not taken as level");
+    out->set_level_statistic(
+        "no valid ground plane: the ground slope is unknown, so the sequence is not taken as "
+        "level");
+    return;
   }
+  const double statistic = Percentile(slopes, params.percentile());
+  out->set_level_statistic_deg(statistic);
+  out->set_is_level(statistic < params.threshold_deg());
+  out->set_level_statistic(
+      fmt::format("{:.0f}th percentile of the ground slope over {} valid ground planes: {:.3f} "
+                  "deg (level below {:.3f} deg)",
+                  params.percentile(), slopes.size(), statistic, params.threshold_deg()));
+}
 
-  // g_f.
+// g_f: from the dataset when it names one; else on a level sequence from the
+// static windows (−|g| times the direction of their mean specific force) and
+// from a flat-ground calibration (its g_a), preferring the calibration.
+void SetFlatGravity(const GravityInputs& inputs, double gravity_norm_mps2,
+                    const StaticForce& static_force, proto::GravityReference* out) {
   if (inputs.dataset_reference.has_gravity_flat()) {
     out->set_has_gravity_flat(true);
     *out->mutable_gravity_flat_in_imu() = inputs.dataset_reference.gravity_flat_in_imu();
     out->set_gravity_flat_source(inputs.dataset_reference_source);
-  } else if (out->is_level()) {
-    const bool from_static = static_samples > 0;
-    const bool from_calibration = inputs.flat_calibration != nullptr;
-    if (from_static) {
-      *out->mutable_gravity_from_static() =
-          ToProto(Eigen::Vector3d(-g * static_force_sum.normalized()));
-    }
-    if (from_calibration) {
-      *out->mutable_gravity_from_calibration() = inputs.flat_calibration->gravity_in_world();
-    }
-    if (from_static && from_calibration) {
-      out->set_sources_disagreement_deg(AngleDeg(ToEigen(out->gravity_from_static()),
-                                                 ToEigen(out->gravity_from_calibration())));
-    }
-    if (from_static || from_calibration) {
-      out->set_has_gravity_flat(true);
-      // The calibration's g_a is optimised with the accelerometer bias; prefer it.
-      *out->mutable_gravity_flat_in_imu() =
-          from_calibration ? out->gravity_from_calibration() : out->gravity_from_static();
-      out->set_gravity_flat_source(from_static && from_calibration ? "both"
-                                   : from_calibration          ? "calibration"
-                                                               : "static_windows");
-    }
+    return;
   }
+  if (!out->is_level()) return;
+  const bool from_static = static_force.num_samples > 0;
+  const bool from_calibration = inputs.flat_calibration != nullptr;
+  if (from_static) {
+    *out->mutable_gravity_from_static() =
+        ToProto(Eigen::Vector3d(-gravity_norm_mps2 * static_force.sum_mps2.normalized()));
+  }
+  if (from_calibration) {
+    *out->mutable_gravity_from_calibration() = inputs.flat_calibration->gravity_in_world();
+  }
+  if (from_static && from_calibration) {
+    out->set_sources_disagreement_deg(AngleDeg(ToEigen(out->gravity_from_static()),
+                                               ToEigen(out->gravity_from_calibration())));
+  }
+  if (from_static || from_calibration) {
+    out->set_has_gravity_flat(true);
+    // The calibration's g_a is optimised with the accelerometer bias; prefer it.
+    *out->mutable_gravity_flat_in_imu() =
+        from_calibration ? out->gravity_from_calibration() : out->gravity_from_static();
+    out->set_gravity_flat_source(from_static && from_calibration ? "both"
+                                 : from_calibration          ? "calibration"
+                                                             : "static_windows");
+  }
+}
+
+}  // namespace
+
+Status EstimateGravityReference(const GravityInputs& inputs, const proto::GravityParams& params,
+                                proto::GravityReference* out) {
+  imu::ImuInitialisationOptions init_options;
+  init_options.static_detection = ToStaticDetectionOptions(params.static_detection());
+  init_options.gravity_norm_mps2 = params.gravity_norm_mps2();
+  init_options.fallback_window_s = params.fallback_window_s();
+  imu::ImuInitialisation init;
+  TILTCAL_RETURN_IF_ERROR(imu::InitialiseImu(inputs.imu, init_options, &init));
+  *out->mutable_gravity_in_world() = ToProto(init.gravity_in_world_mps2);
+  *out->mutable_gyro_bias_radps() = ToProto(init.gyro_bias_radps);
+  const StaticForce static_force = AddStaticWindows(inputs, init_options.static_detection, out);
+
+  std::vector<Eigen::Vector3d> ups;
+  std::vector<double> slopes;
+  AddInclinationSamples(inputs, init, params.time_offset_s(), out, &ups, &slopes);
+  SetLevelVerdict(slopes, params.level_verdict(), out);
+  SetFlatGravity(inputs, params.gravity_norm_mps2(), static_force, out);
   if (out->has_gravity_flat()) {
     const Eigen::Vector3d up_flat = -ToEigen(out->gravity_flat_in_imu()).normalized();
     for (int i = 0; i < out->inclination_size(); ++i) {
@@ -172,15 +196,36 @@ Status ReadDatasetReference(const std::string& rig_path, const proto::Rig& rig,
   return Status::Ok();
 }
 
+// The summary of a run: static windows, verdict, g_f and its source, and a
+// warning when the two sources of g_f disagree.
+void LogSummary(const proto::GravityReference& out, const proto::GravityParams& params,
+                std::ostream* log) {
+  if (log == nullptr) return;
+  *log << "tiltcal_gravity: " << out.static_windows_size() << " static windows; "
+       << (out.is_level() ? "level" : "tilted") << ": " << out.level_statistic() << "\n";
+  if (out.has_gravity_flat()) {
+    const Eigen::Vector3d g_f = ToEigen(out.gravity_flat_in_imu());
+    *log << fmt::format("tiltcal_gravity: g_f = ({:.4f}, {:.4f}, {:.4f}) m/s^2 from {}\n",
+                        g_f.x(), g_f.y(), g_f.z(), out.gravity_flat_source());
+  } else {
+    *log << "tiltcal_gravity: no g_f (tilted sequence and none in the rig)\n";
+  }
+  if (out.sources_disagreement_deg() > params.max_sources_disagreement_deg()) {
+    *log << fmt::format("tiltcal_gravity: warning: g_f from the static windows and from the "
+                        "calibration disagree by {:.3f} deg\n",
+                        out.sources_disagreement_deg());
+  }
+}
+
 }  // namespace
 
-Status Run(const RunPaths& paths, const proto::GravityParams& params) {
+Status Run(const GravityPaths& paths, const proto::GravityParams& params, std::ostream* log) {
   GravityInputs inputs;
   TILTCAL_RETURN_IF_ERROR(ReadImuReadings(paths.imu, &inputs.imu, &inputs.first_imu_stamp_ns));
   if (!paths.ground.empty()) {
     TILTCAL_RETURN_IF_ERROR(ReadAllRecords<proto::GroundPlane>(paths.ground, &inputs.ground));
   }
-  TILTCAL_RETURN_IF_ERROR(ReadTextProto(paths.rig, &inputs.rig));
+  TILTCAL_RETURN_IF_ERROR(LoadRig(paths.rig, &inputs.rig));
   TILTCAL_RETURN_IF_ERROR(ReadDatasetReference(paths.rig, inputs.rig, &inputs.dataset_reference,
                                                &inputs.dataset_reference_source));
   proto::CalibrationResult calibration;
@@ -194,26 +239,11 @@ Status Run(const RunPaths& paths, const proto::GravityParams& params) {
   std::vector<InputPath> input_paths = {{"imu", paths.imu}, {"rig", paths.rig}};
   if (!paths.ground.empty()) input_paths.push_back({"ground", paths.ground});
   if (!paths.calibration.empty()) input_paths.push_back({"calibration", paths.calibration});
+  if (!paths.params.empty()) input_paths.push_back({"params", paths.params});
   *out.mutable_provenance() =
       MakeProvenance("tiltcal_gravity", params, input_paths, paths.command_line);
   TILTCAL_RETURN_IF_ERROR(WriteTextProto(paths.out, out));
-
-  std::fprintf(stderr, "tiltcal_gravity: %d static windows; %s: %s\n",
-               out.static_windows_size(), out.is_level() ? "level" : "tilted",
-               out.level_statistic().c_str());
-  if (out.has_gravity_flat()) {
-    const Eigen::Vector3d g_f = ToEigen(out.gravity_flat_in_imu());
-    std::fprintf(stderr, "tiltcal_gravity: g_f = (%.4f, %.4f, %.4f) m/s^2 from %s\n", g_f.x(),
-                 g_f.y(), g_f.z(), out.gravity_flat_source().c_str());
-  } else {
-    std::fprintf(stderr, "tiltcal_gravity: no g_f (tilted sequence and none in the rig)\n");
-  }
-  if (out.sources_disagreement_deg() > params.max_sources_disagreement_deg()) {
-    std::fprintf(stderr,
-                 "tiltcal_gravity: warning: g_f from the static windows and from the "
-                 "calibration disagree by %.3f deg\n",
-                 out.sources_disagreement_deg());
-  }
+  LogSummary(out, params, log);
   return Status::Ok();
 }
 

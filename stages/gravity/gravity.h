@@ -1,6 +1,7 @@
 #ifndef TILTCAL_STAGES_GRAVITY_GRAVITY_H_
 #define TILTCAL_STAGES_GRAVITY_GRAVITY_H_
 
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -19,7 +20,7 @@ struct GravityInputs {
   std::vector<imu::ImuReading> imu;  // times relative to first_imu_stamp_ns
   int64_t first_imu_stamp_ns = 0;
   std::vector<proto::GroundPlane> ground;   // may be empty
-  proto::Rig rig;
+  proto::Rig rig;                           // passed ValidateRig (common/io/rig.h)
   // g_f given by the dataset: the rig's gravity_flat_in_imu or the file its
   // gravity_reference names (has_gravity_flat false otherwise).
   proto::GravityReference dataset_reference;
@@ -33,28 +34,30 @@ struct GravityInputs {
 // - static windows of the accelerometer;
 // - per scan: g̃_b = −C_ab(t)^T g_a / |g_a| at t = t_scan + τ, the ground slope
 //   ∠(g̃_b, C_bl n_l) from the scan's ground plane and, when g_f is known, the
-//   inclination φ with cos φ = g̃_b · g̃_f, g̃_f = −g_f / |g_f| (DESIGN §5);
-// - the verdict level / tilted from a percentile of the ground slope;
+//   inclination φ with cos φ = g̃_b · g̃_f, g̃_f = −g_f / |g_f|
+//   (docs/design.md §10);
+// - the verdict level / tilted from a percentile of the ground slope
+//   (params.level_verdict);
 // - g_f: from the dataset when it names one; else on a level sequence from the
 //   static windows (−|g| times the direction of the mean specific force) and
 //   from a flat-ground calibration (its g_a), with their disagreement.
 Status EstimateGravityReference(const GravityInputs& inputs, const proto::GravityParams& params,
                                 proto::GravityReference* out);
 
-// Paths of one run of the stage.
-struct RunPaths {
-  std::string imu;
-  std::string ground;       // optional
-  std::string rig;
+// Paths of one tiltcal_gravity run (the flags of the same names).
+struct GravityPaths {
+  std::string imu;          // imu.binpb
+  std::string ground;       // optional: ground.binpb
+  std::string rig;          // rig.txtpb
   std::string calibration;  // optional: a flat-ground calibration.txtpb
-  std::string params;
-  std::string out;
+  std::string params;       // the params file (provenance only; empty: the defaults)
+  std::string out;          // gravity.txtpb
   std::string command_line;
 };
 
 // Reads the inputs, estimates, writes gravity.txtpb atomically with its
-// provenance, and prints a summary on stderr.
-Status Run(const RunPaths& paths, const proto::GravityParams& params);
+// provenance, and writes a summary to `log` (nullptr: silent).
+Status Run(const GravityPaths& paths, const proto::GravityParams& params, std::ostream* log);
 
 }  // namespace tiltcal::gravity
 

@@ -1,42 +1,39 @@
 // tiltcal_gravity: inclination and flat-ground gravity reference of a sequence.
-//   tiltcal_gravity --imu=imu.binpb --ground=ground.binpb --rig=rig.txtpb
-//                   --params=P [--calibration=flat/calibration.txtpb] --out=gravity.txtpb
 #include <iostream>
 
-#include <gflags/gflags.h>
-
+#include "common/cli/command_line.h"
 #include "common/io/params.h"
-#include "common/io/provenance.h"
+#include "stages/gravity/default_params_text.h"
 #include "stages/gravity/gravity.h"
-
-DEFINE_string(imu, "", "input: imu.binpb");
-DEFINE_string(ground, "", "input: ground.binpb (optional, gives the ground slope per scan)");
-DEFINE_string(rig, "", "input: the dataset's rig.txtpb");
-DEFINE_string(calibration, "", "input: calibration.txtpb of a flat-ground run (optional)");
-DEFINE_string(params, "", "input: params (stages/gravity/default_params.txtpb)");
-DEFINE_string(out, "", "output: gravity.txtpb");
+#include "tiltcal/proto/gravity_params.pb.h"
 
 int main(int argc, char** argv) {
-  gflags::SetUsageMessage(
-      "inclination and flat-ground gravity reference\n"
-      "  tiltcal_gravity --imu=IMU --ground=GROUND --rig=RIG --params=P [--calibration=C] "
-      "--out=gravity.txtpb");
-  const std::string command_line = tiltcal::JoinCommandLine(argc, argv);
-  gflags::ParseCommandLineFlags(&argc, &argv, /*remove_flags=*/true);
-  if (FLAGS_imu.empty() || FLAGS_rig.empty() || FLAGS_params.empty() || FLAGS_out.empty()) {
-    std::cerr << "tiltcal_gravity: --imu, --rig, --params and --out are required (see --help)\n";
-    return 2;
-  }
+  using tiltcal::cli::kRequired;
+  tiltcal::cli::CommandLine cli("tiltcal_gravity",
+                                "inclination and flat-ground gravity reference of a sequence");
+  cli.AddFlag("imu", "input: imu.binpb", kRequired);
+  cli.AddFlag("ground", "input, optional: ground.binpb (gives the ground slope per scan)");
+  cli.AddFlag("rig", "input: the dataset's rig.txtpb", kRequired);
+  cli.AddFlag("calibration", "input, optional: calibration.txtpb of a flat-ground run");
+  cli.AddFlag("params",
+              "input: gravity params, text format (default: "
+              "stages/gravity/default_params.txtpb, compiled in)");
+  cli.AddFlag("out", "output: gravity.txtpb", kRequired);
+  cli.AddExample(
+      "tiltcal_gravity --imu=out/run1/imu.binpb --ground=out/run1/ground.binpb "
+      "--rig=datasets/husky/rig.txtpb --out=out/run1/gravity.txtpb");
+  if (const auto exit_code = cli.Parse(argc, argv)) return *exit_code;
+  tiltcal::gravity::GravityPaths paths;
+  paths.imu = cli.Get("imu");
+  paths.ground = cli.Get("ground");
+  paths.rig = cli.Get("rig");
+  paths.calibration = cli.Get("calibration");
+  paths.params = cli.Get("params");
+  paths.out = cli.Get("out");
+  paths.command_line = cli.command_line();
   tiltcal::proto::GravityParams params;
-  tiltcal::Status status = tiltcal::LoadParams(FLAGS_params, &params);
-  if (status.ok()) {
-    status = tiltcal::gravity::Run({FLAGS_imu, FLAGS_ground, FLAGS_rig, FLAGS_calibration,
-                                    FLAGS_params, FLAGS_out, command_line},
-                                   params);
-  }
-  if (!status.ok()) {
-    std::cerr << "tiltcal_gravity: " << status.message() << "\n";
-    return 1;
-  }
-  return 0;
+  tiltcal::Status status = tiltcal::LoadParamsOrDefaults(
+      paths.params, tiltcal::gravity::DefaultParamsText(), &params);
+  if (status.ok()) status = tiltcal::gravity::Run(paths, params, &std::cerr);
+  return cli.Finish(status);
 }

@@ -6,14 +6,14 @@
 namespace tiltcal::ground {
 
 Deskewer::Deskewer(const imu::GyroIntegrator* integrator, int64_t imu_origin_ns,
-                   const Eigen::Matrix3d& imu_from_lidar_rotation, int64_t time_offset_ns,
-                   double node_spacing_s)
+                   const Eigen::Matrix3d& imu_from_lidar_rotation,
+                   const proto::GroundDeskewParams& params)
     : integrator_(integrator),
       imu_origin_ns_(imu_origin_ns),
       c_bl_(imu_from_lidar_rotation),
-      time_offset_ns_(time_offset_ns),
-      node_spacing_ns_(
-          std::max<int64_t>(1, static_cast<int64_t>(std::llround(node_spacing_s * 1e9)))) {}
+      time_offset_ns_(std::llround(params.time_offset_s() * 1e9)),
+      node_spacing_ns_(std::max<int64_t>(
+          1, static_cast<int64_t>(std::llround(params.node_spacing_s() * 1e9)))) {}
 
 bool Deskewer::Covers(int64_t t0_ns, int64_t t1_ns) const {
   if (integrator_ == nullptr || integrator_->empty()) return false;

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <string>
 
 #include "common/geometry/plane_fit.h"
 
@@ -14,58 +13,19 @@ namespace {
 constexpr double kDegToRad = M_PI / 180.0;
 constexpr float kTwoPi = 6.28318530717958647692f;
 
-// Zone boundaries b0..b4 (m) from the params.
-void ZoneBounds(const proto::GroundParams& p, double bound[5]) {
-  const double lo = p.min_range_m(), hi = p.max_range_m();
-  bound[0] = lo;
-  bound[4] = hi;
-  if (p.zone_boundaries_m_size() == 3) {
-    for (int k = 0; k < 3; ++k) bound[k + 1] = p.zone_boundaries_m(k);
-  } else {
-    bound[1] = (7.0 * lo + hi) / 8.0;
-    bound[2] = (3.0 * lo + hi) / 4.0;
-    bound[3] = (lo + hi) / 2.0;
-  }
-}
-
 }  // namespace
 
-Status ValidateGroundParams(const proto::GroundParams& p) {
-  if (!(p.max_range_m() > p.min_range_m())) {
-    return Status::Error("field max_range_m must be greater than min_range_m");
+void ZoneBoundaries(const proto::ZoneModelParams& zone_model, double bound_m[5]) {
+  const double lo = zone_model.min_range_m(), hi = zone_model.max_range_m();
+  bound_m[0] = lo;
+  bound_m[4] = hi;
+  if (zone_model.boundaries_m_size() == 3) {
+    for (int k = 0; k < 3; ++k) bound_m[k + 1] = zone_model.boundaries_m(k);
+  } else {
+    bound_m[1] = (7.0 * lo + hi) / 8.0;
+    bound_m[2] = (3.0 * lo + hi) / 4.0;
+    bound_m[3] = (lo + hi) / 2.0;
   }
-  if (p.zone_rings_size() != 4) {
-    return Status::Error("field zone_rings must have exactly 4 values (one per zone), has " +
-                         std::to_string(p.zone_rings_size()));
-  }
-  if (p.zone_sectors_size() != 4) {
-    return Status::Error("field zone_sectors must have exactly 4 values (one per zone), has " +
-                         std::to_string(p.zone_sectors_size()));
-  }
-  if (p.zone_boundaries_m_size() != 0 && p.zone_boundaries_m_size() != 3) {
-    return Status::Error("field zone_boundaries_m must have 0 or 3 values, has " +
-                         std::to_string(p.zone_boundaries_m_size()));
-  }
-  double bound[5];
-  ZoneBounds(p, bound);
-  for (int k = 0; k < 4; ++k) {
-    if (!(bound[k + 1] > bound[k])) {
-      return Status::Error(
-          "field zone_boundaries_m must increase strictly between min_range_m and max_range_m");
-    }
-  }
-  if (p.num_rings_of_interest() > 0 && p.near_elevation_m_size() == 0) {
-    return Status::Error("field near_elevation_m needs at least one value when "
-                         "num_rings_of_interest > 0");
-  }
-  if (p.fit_radius_m() == 0.0 && !(p.fit_radius_max_m() >= p.fit_radius_min_m())) {
-    return Status::Error("field fit_radius_max_m must be >= fit_radius_min_m");
-  }
-  if (p.fit_radius_m() == 0.0 && !(p.fit_radius_max_m() > 0.0)) {
-    return Status::Error("field fit_radius_max_m must be > 0 when fit_radius_m is 0 (automatic)");
-  }
-  if (p.min_inliers() < 3) return Status::Error("field min_inliers must be >= 3");
-  return Status::Ok();
 }
 
 float Azimuth02Pi(float y, float x) {
@@ -82,13 +42,14 @@ float Azimuth02Pi(float y, float x) {
   return r >= kTwoPi ? 0.0f : r;
 }
 
-GroundSegmenter::GroundSegmenter(const proto::GroundParams& p) {
-  ZoneBounds(p, bound_);
+GroundSegmenter::GroundSegmenter(const proto::ZoneModelParams& zone_model,
+                                 const proto::RegionFitParams& region_fit) {
+  ZoneBoundaries(zone_model, bound_);
   num_rings_ = 0;
   num_bins_ = 0;
   for (int k = 0; k < 4; ++k) {
-    rings_[k] = static_cast<int>(p.zone_rings(k));
-    sectors_[k] = static_cast<int>(p.zone_sectors(k));
+    rings_[k] = static_cast<int>(zone_model.rings(k));
+    sectors_[k] = static_cast<int>(zone_model.sectors(k));
     inv_ring_width_[k] = rings_[k] / (bound_[k + 1] - bound_[k]);
     sector_scale_[k] = static_cast<float>(sectors_[k] / (2.0 * M_PI));
     first_ring_[k] = num_rings_;
@@ -99,22 +60,22 @@ GroundSegmenter::GroundSegmenter(const proto::GroundParams& p) {
     num_rings_ += rings_[k];
   }
   ring_first_bin_.push_back(num_bins_);
-  num_iterations_ = static_cast<int>(p.num_iterations());
-  num_seed_points_ = p.num_seed_points();
-  seed_margin_ = static_cast<float>(p.seed_height_margin_m());
-  plane_distance_ = static_cast<float>(p.plane_distance_m());
-  min_points_per_bin_ = std::max<uint32_t>(3, p.min_points_per_bin());
-  cos_max_tilt_ = static_cast<float>(std::cos(p.max_bin_tilt_deg() * kDegToRad));
-  max_flatness_ = static_cast<float>(p.max_flatness());
-  max_elongation_ = static_cast<float>(p.max_bin_elongation());
-  far_max_elevation_ = static_cast<float>(p.max_elevation_m());
-  num_rings_of_interest_ = static_cast<int>(p.num_rings_of_interest());
-  for (double e : p.near_elevation_m()) near_elevation_.push_back(static_cast<float>(e));
-  reject_vertical_ = p.reject_vertical();
-  vertical_seed_margin_ = static_cast<float>(p.vertical_seed_margin_m());
-  vertical_distance_ = static_cast<float>(p.vertical_distance_m());
-  seed_floor_ratio_ = p.seed_floor_height_ratio();
-  reference_window_ = p.reference_prior_window_m();
+  num_iterations_ = static_cast<int>(region_fit.num_iterations());
+  num_seed_points_ = region_fit.num_seed_points();
+  seed_margin_ = static_cast<float>(region_fit.seed_height_margin_m());
+  plane_distance_ = static_cast<float>(region_fit.plane_distance_m());
+  min_points_per_bin_ = std::max<uint32_t>(3, region_fit.min_points_per_bin());
+  cos_max_tilt_ = static_cast<float>(std::cos(region_fit.max_bin_tilt_deg() * kDegToRad));
+  max_flatness_ = static_cast<float>(region_fit.max_flatness());
+  max_elongation_ = static_cast<float>(region_fit.max_bin_elongation());
+  far_max_elevation_ = static_cast<float>(region_fit.max_elevation_m());
+  num_rings_of_interest_ = static_cast<int>(region_fit.num_rings_of_interest());
+  for (double e : region_fit.near_elevation_m()) near_elevation_.push_back(static_cast<float>(e));
+  reject_vertical_ = region_fit.reject_vertical();
+  vertical_seed_margin_ = static_cast<float>(region_fit.vertical_seed_margin_m());
+  vertical_distance_ = static_cast<float>(region_fit.vertical_distance_m());
+  seed_floor_ratio_ = region_fit.seed_floor_height_ratio();
+  reference_window_ = region_fit.reference_prior_window_m();
   min_range2_ = bound_[0] * bound_[0];
   max_range2_ = bound_[4] * bound_[4];
   bin_start_.resize(num_bins_ + 1);
@@ -201,11 +162,24 @@ SegmentationSummary GroundSegmenter::Segment(const float* x, const float* y, con
                                              size_t n, double height_prior_m) {
   SegmentationSummary summary;
   summary.num_points = static_cast<uint32_t>(n);
+  const size_t binned = AssignBins(x, y, z, n);
+  SortIntoBins(x, y, z, n, binned);
+  summary.num_binned = static_cast<uint32_t>(binned);
+  const bool have_prior = height_prior_m > 0.0;
+  const double seed_floor_z = (have_prior && seed_floor_ratio_ > 0.0)
+                                  ? -seed_floor_ratio_ * height_prior_m
+                                  : -std::numeric_limits<double>::infinity();
+  FitBins(seed_floor_z, &summary);
+  FindReferenceHeight(height_prior_m, &summary);
+  ClassifyBins(&summary);
+  return summary;
+}
+
+size_t GroundSegmenter::AssignBins(const float* x, const float* y, const float* z, size_t n) {
   bin_of_.resize(n);
   r_of_.resize(n);
   std::fill(bin_start_.begin(), bin_start_.end(), 0u);
-
-  // 1. Bin index of every point and per-bin counts.
+  // count[b] = bin_start_[b + 1], turned into start offsets by SortIntoBins.
   uint32_t* count = bin_start_.data() + 1;
   size_t binned = 0;
   const float min_r2 = static_cast<float>(min_range2_), max_r2 = static_cast<float>(max_range2_);
@@ -234,7 +208,11 @@ SegmentationSummary GroundSegmenter::Segment(const float* x, const float* y, con
     ++count[bin];
     ++binned;
   }
-  // 2. Counting sort into contiguous per-bin columns.
+  return binned;
+}
+
+void GroundSegmenter::SortIntoBins(const float* x, const float* y, const float* z, size_t n,
+                                   size_t binned) {
   for (int b = 0; b < num_bins_; ++b) bin_start_[b + 1] += bin_start_[b];
   num_binned_ = binned;
   bx_.resize(binned);
@@ -245,28 +223,22 @@ SegmentationSummary GroundSegmenter::Segment(const float* x, const float* y, con
   bground_.assign(binned, 0);
   active_.assign(binned, 1);
   seed_scratch_.assign(binned, 0);
-  {
-    // bin_start_[b] is the write cursor of bin b; restored afterwards.
-    for (size_t i = 0; i < n; ++i) {
-      const int b = bin_of_[i];
-      if (b < 0) continue;
-      const uint32_t pos = bin_start_[b]++;
-      bx_[pos] = x[i];
-      by_[pos] = y[i];
-      bz_[pos] = z[i];
-      br_[pos] = r_of_[i];
-      bsrc_[pos] = static_cast<uint32_t>(i);
-    }
-    for (int b = num_bins_; b > 0; --b) bin_start_[b] = bin_start_[b - 1];
-    bin_start_[0] = 0;
+  // bin_start_[b] is the write cursor of bin b; restored afterwards.
+  for (size_t i = 0; i < n; ++i) {
+    const int b = bin_of_[i];
+    if (b < 0) continue;
+    const uint32_t pos = bin_start_[b]++;
+    bx_[pos] = x[i];
+    by_[pos] = y[i];
+    bz_[pos] = z[i];
+    br_[pos] = r_of_[i];
+    bsrc_[pos] = static_cast<uint32_t>(i);
   }
-  summary.num_binned = static_cast<uint32_t>(binned);
+  for (int b = num_bins_; b > 0; --b) bin_start_[b] = bin_start_[b - 1];
+  bin_start_[0] = 0;
+}
 
-  // 3. Per-bin plane fits.
-  const bool have_prior = height_prior_m > 0.0;
-  const double seed_floor_z = (have_prior && seed_floor_ratio_ > 0.0)
-                                  ? -seed_floor_ratio_ * height_prior_m
-                                  : -std::numeric_limits<double>::infinity();
+void GroundSegmenter::FitBins(double seed_floor_z, SegmentationSummary* summary) {
   for (int ring = 0; ring < num_rings_; ++ring) {
     const bool zone0 = ring < rings_[0];
     for (int b = ring_first_bin_[ring]; b < ring_first_bin_[ring + 1]; ++b) {
@@ -275,12 +247,15 @@ SegmentationSummary GroundSegmenter::Segment(const float* x, const float* y, con
       const uint32_t begin = bin_start_[b], end = bin_start_[b + 1];
       if (end - begin < min_points_per_bin_) continue;
       ProcessBin(b, begin, end, zone0, seed_floor_z);
-      if (bins_[b].ok) ++summary.num_bins_fitted;
+      if (bins_[b].ok) ++summary->num_bins_fitted;
     }
   }
+}
 
-  // 4. Ground reference height: median centroid z of upright, sensor-facing,
-  //    non-elongated bins in the rings of interest (ring 0 when none).
+// Median centroid z of upright, sensor-facing, non-elongated bins in the
+// rings of interest (ring 0 when none).
+void GroundSegmenter::FindReferenceHeight(double height_prior_m, SegmentationSummary* summary) {
+  const bool have_prior = height_prior_m > 0.0;
   reference_samples_.clear();
   const int reference_rings = std::min(std::max(1, num_rings_of_interest_), num_rings_);
   for (int pass = 0; pass < 2 && reference_samples_.empty(); ++pass) {
@@ -301,12 +276,14 @@ SegmentationSummary GroundSegmenter::Segment(const float* x, const float* y, con
     const size_t mid = reference_samples_.size() / 2;
     std::nth_element(reference_samples_.begin(), reference_samples_.begin() + mid,
                      reference_samples_.end());
-    summary.has_reference = true;
-    summary.reference_z_m = reference_samples_[mid];
+    summary->has_reference = true;
+    summary->reference_z_m = reference_samples_[mid];
   }
+}
 
-  // 5. Ground likelihood per bin; clear the labels of rejected bins.
-  const float ref = static_cast<float>(summary.reference_z_m);
+// Ground likelihood per bin; clears the labels of rejected bins.
+void GroundSegmenter::ClassifyBins(SegmentationSummary* summary) {
+  const float ref = static_cast<float>(summary->reference_z_m);
   for (int b = 0; b < num_bins_; ++b) {
     Bin& bin = bins_[b];
     // Upright, sensor above the plane (rejects ceilings), and in the rings of
@@ -315,7 +292,7 @@ SegmentationSummary GroundSegmenter::Segment(const float* x, const float* y, con
     if (ground && bin.ring < num_rings_of_interest_ && bin.elongation > max_elongation_) {
       ground = false;
     }
-    if (ground && summary.has_reference) {
+    if (ground && summary->has_reference) {
       const float elevation = bin.centroid.z() - ref;
       if (bin.ring < num_rings_of_interest_) {
         const float limit =
@@ -330,11 +307,10 @@ SegmentationSummary GroundSegmenter::Segment(const float* x, const float* y, con
     if (!ground) {
       for (uint32_t i = begin; i < end; ++i) bground_[i] = 0;
     } else {
-      ++summary.num_bins_ground;
-      for (uint32_t i = begin; i < end; ++i) summary.num_ground += bground_[i];
+      ++summary->num_bins_ground;
+      for (uint32_t i = begin; i < end; ++i) summary->num_ground += bground_[i];
     }
   }
-  return summary;
 }
 
 void GroundSegmenter::GroundBinPlanes(double radius_m, std::vector<Eigen::Vector4d>* planes) const {

@@ -7,14 +7,14 @@
 
 #include <Eigen/Core>
 
-#include "common/status.h"
 #include "tiltcal/proto/ground_params.pb.h"
 
 namespace tiltcal::ground {
 
-// Checks what the schema cannot: 4 values in zone_rings / zone_sectors, 0 or
-// 3 increasing zone_boundaries_m inside (min_range_m, max_range_m), etc.
-Status ValidateGroundParams(const proto::GroundParams& params);
+// Zone boundaries b0..b4 (m): b0 = min_range_m, b4 = max_range_m, b1..b3 from
+// boundaries_m when it has 3 values, else the Patchwork++ rule
+// b1 = (7 b0 + b4)/8, b2 = (3 b0 + b4)/4, b3 = (b0 + b4)/2.
+void ZoneBoundaries(const proto::ZoneModelParams& zone_model, double bound_m[5]);
 
 // Fast atan2 in [0, 2π), max error ~1e-5 rad (for binning only).
 float Azimuth02Pi(float y, float x);
@@ -48,13 +48,19 @@ struct SegmentationSummary {
 // and the height prior. Buffers are reused between calls.
 class GroundSegmenter {
  public:
-  // `params` must have passed ValidateGroundParams.
-  explicit GroundSegmenter(const proto::GroundParams& params);
+  // The params must have passed ValidateZoneModelParams and
+  // ValidateRegionFitParams (stages/ground/ground_params.h).
+  GroundSegmenter(const proto::ZoneModelParams& zone_model,
+                  const proto::RegionFitParams& region_fit);
 
   // Segments n points (columns x, y, z, frame s, metres). height_prior_m > 0
   // enables the prior-based parts (seed floor, reference window).
   SegmentationSummary Segment(const float* x, const float* y, const float* z, size_t n,
                               double height_prior_m);
+
+  // Binned horizontal ranges: min_range_m < r <= max_range_m (m).
+  double min_range_m() const { return bound_[0]; }
+  double max_range_m() const { return bound_[4]; }
 
   // Results of the last Segment(), in binned order (grouped by bin):
   // coordinates, the source index of each point, and the ground label.
@@ -83,6 +89,15 @@ class GroundSegmenter {
     float elongation = 0.0f;   // largest / middle covariance eigenvalue
   };
 
+  // Steps of Segment(): bin index of every point and the per-bin counts
+  // (returns the number of binned points); counting sort into contiguous
+  // per-bin columns; per-bin plane fits; the scan's ground reference height;
+  // the ground likelihood of every bin.
+  size_t AssignBins(const float* x, const float* y, const float* z, size_t n);
+  void SortIntoBins(const float* x, const float* y, const float* z, size_t n, size_t binned);
+  void FitBins(double seed_floor_z, SegmentationSummary* summary);
+  void FindReferenceHeight(double height_prior_m, SegmentationSummary* summary);
+  void ClassifyBins(SegmentationSummary* summary);
   void ProcessBin(int bin, uint32_t begin, uint32_t end, bool zone0, double seed_floor_z);
 
   // Layout.

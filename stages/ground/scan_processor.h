@@ -25,14 +25,19 @@ struct GroundFrame {
   double height_prior_m = 0.0;
 };
 
-// The frame and height prior from the rig and the params (see
-// GroundParams.use_rig_up_direction and sensor_height_guess_m).
-GroundFrame MakeGroundFrame(const proto::Rig& rig, const proto::GroundParams& params);
+// The frame and height prior from the rig and the params: up is
+// C_bl^T (−g_f/|g_f|) when use_rig_up_direction and the rig has g_f, else the
+// LiDAR z axis; the height prior is sensor_height_guess_m when > 0, else
+// d_b + up_l · (C_bl^T r_b^{lb}) when the rig has d_b > 0, else none.
+GroundFrame MakeGroundFrame(const proto::Rig& rig, const proto::GroundFrameParams& params);
 
 // Deskew + segmentation + plane fit of one scan at a time; buffers are reused.
+// Hands each component its own part of the params.
 class ScanProcessor {
  public:
-  // `deskewer` may be null (no deskewing).
+  // `deskewer` may be null (no deskewing); it is used when
+  // params.deskew.enabled. The params must have passed ValidateGroundParams
+  // (stages/ground/ground_params.h).
   ScanProcessor(const proto::GroundParams& params, const GroundFrame& frame, Deskewer* deskewer);
 
   // Processes one scan. When deskewing applies, the scan's points are moved
@@ -45,10 +50,19 @@ class ScanProcessor {
   double last_fit_s() const { return fit_s_; }
 
  private:
-  proto::GroundParams params_;
+  // Steps of Process(): deskews the scan in place (false: rejected for lack
+  // of IMU coverage, `out` filled); the points in frame s (columns, valid
+  // until the next call); the fitted plane back in the LiDAR frame.
+  bool Deskew(proto::Scan* scan, proto::GroundPlane* out);
+  void ToSegmentationFrame(const proto::Scan& scan, const float** x, const float** y,
+                           const float** z);
+  void SetPlaneInLidar(const ScanPlane& plane, proto::GroundPlane* out) const;
+
   GroundFrame frame_;
   bool level_ = false;
-  Deskewer* deskewer_;
+  Deskewer* deskewer_;  // null when deskewing is off
+  bool require_imu_coverage_;
+  bool store_point_masks_;
   GroundSegmenter segmenter_;
   ScanPlaneFitter fitter_;
   std::vector<float> sx_, sy_, sz_;

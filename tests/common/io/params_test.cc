@@ -59,11 +59,12 @@ TEST(Params, RepeatedElementsAreCheckedWithTheirIndex) {
   proto::GroundParams params;
   ASSERT_TRUE(
       LoadParams(testing::SourceDir() + "/stages/ground/default_params.txtpb", &params).ok());
-  ASSERT_GE(params.zone_rings_size(), 2);
-  params.set_zone_rings(1, 0);
+  ASSERT_GE(params.zone_model().rings_size(), 2);
+  params.mutable_zone_model()->set_rings(1, 0);
   const Status status = ValidateAgainstSchema(params);
   ASSERT_FALSE(status.ok());
-  EXPECT_NE(status.message().find("zone_rings[1] = 0"), std::string::npos) << status.message();
+  EXPECT_NE(status.message().find("zone_model.rings[1] = 0"), std::string::npos)
+      << status.message();
 }
 
 TEST(Params, NanIsRejected) {

@@ -10,7 +10,9 @@
 #include "common/io/eigen_proto.h"
 #include "common/io/record_stream.h"
 #include "common/io/text_proto.h"
+#include "stages/gravity/default_params_text.h"
 #include "tests/common/imu/synthetic_imu.h"
+#include "tests/testing/params_text.h"
 #include "tests/testing/test_env.h"
 #include "tiltcal/proto/imu.pb.h"
 
@@ -20,11 +22,9 @@ namespace {
 constexpr double kDeg = M_PI / 180.0;
 const Eigen::Vector3d kGravityWorld(0, 0, -9.81);
 
+// The shipped defaults (stages/gravity/default_params.txtpb, compiled in).
 proto::GravityParams DefaultParams() {
-  proto::GravityParams params;
-  EXPECT_TRUE(ReadTextProto(testing::SourceDir() + "/stages/gravity/default_params.txtpb", &params)
-                  .ok());
-  return params;
+  return testing::DefaultParamsWith<proto::GravityParams>(DefaultParamsText());
 }
 
 // A vehicle on a plane tilted by `tilt_deg` about x: still for 2 s, then
@@ -152,14 +152,14 @@ TEST(Gravity, RunWritesTheReferenceAndFailsCleanlyOnBadInputs) {
   proto::Rig rig = scenario.inputs.rig;
   rig.set_gravity_reference("flat/gravity.txtpb");
   ASSERT_TRUE(WriteTextProto(dir.File("rig.txtpb"), rig).ok());
-  RunPaths paths;
+  GravityPaths paths;
   paths.imu = dir.File("imu.binpb");
   paths.ground = dir.File("ground.binpb");
   paths.rig = dir.File("rig.txtpb");
   paths.out = dir.File("gravity.txtpb");
 
   // The reference named by the rig does not exist yet.
-  Status status = gravity::Run(paths, DefaultParams());
+  Status status = gravity::Run(paths, DefaultParams(), nullptr);
   ASSERT_FALSE(status.ok());
   EXPECT_NE(status.message().find("flat/gravity.txtpb"), std::string::npos) << status.message();
   EXPECT_FALSE(testing::FileExists(paths.out));
@@ -169,7 +169,7 @@ TEST(Gravity, RunWritesTheReferenceAndFailsCleanlyOnBadInputs) {
   flat.set_has_gravity_flat(true);
   *flat.mutable_gravity_flat_in_imu() = ToProto(scenario.FlatGravityInImu());
   ASSERT_TRUE(WriteTextProto(dir.File("flat/gravity.txtpb"), flat).ok());
-  status = gravity::Run(paths, DefaultParams());
+  status = gravity::Run(paths, DefaultParams(), nullptr);
   ASSERT_TRUE(status.ok()) << status.message();
   proto::GravityReference out;
   ASSERT_TRUE(ReadTextProto(paths.out, &out).ok());
@@ -177,8 +177,17 @@ TEST(Gravity, RunWritesTheReferenceAndFailsCleanlyOnBadInputs) {
   EXPECT_EQ(out.provenance().producer(), "tiltcal_gravity");
   EXPECT_NEAR(out.inclination(50).inclination_deg(), 8.0, 0.3);
 
+  // A rig without the measured extrinsic is an error naming the field.
+  proto::Rig no_extrinsic = rig;
+  no_extrinsic.mutable_imu_from_lidar()->clear_rotation();
+  ASSERT_TRUE(WriteTextProto(dir.File("rig.txtpb"), no_extrinsic).ok());
+  status = gravity::Run(paths, DefaultParams(), nullptr);
+  ASSERT_FALSE(status.ok());
+  EXPECT_NE(status.message().find("imu_from_lidar.rotation"), std::string::npos)
+      << status.message();
+
   paths.imu = dir.File("missing.binpb");
-  status = gravity::Run(paths, DefaultParams());
+  status = gravity::Run(paths, DefaultParams(), nullptr);
   ASSERT_FALSE(status.ok());
   EXPECT_NE(status.message().find("missing.binpb"), std::string::npos);
 }

@@ -21,6 +21,7 @@ namespace {
 using testing::AngleDeg;
 using testing::CastScan;
 using testing::DefaultGroundParams;
+using testing::GroundParamsWith;
 using testing::NormalOf;
 using testing::RollPitchYaw;
 using testing::StreetScene;
@@ -61,7 +62,7 @@ DeskewCase MakeCase() {
   c.pose.g_from_lidar = RollPitchYaw(0.03, 0.05, 0.2);
   c.pose.omega_lidar_radps = Eigen::Vector3d(0.8, -0.6, 1.2);  // fast rocking + turning
   c.scan = CastScan(StreetScene(11), SyntheticLidar::Vlp16(), c.pose, kStampNs, 11);
-  c.tau_ns = 7000000;  // IMU clock = LiDAR clock + 7 ms
+  c.tau_ns = 7000000;  // IMU clock = LiDAR clock + 7 ms (deskew.time_offset_s below)
   const Eigen::Vector3d omega_b = c.c_bl * c.pose.omega_lidar_radps;
   c.imu_origin_ns = kStampNs + c.tau_ns - 1000000000LL;
   c.imu = ConstantRateImu(c.imu_origin_ns, kStampNs + c.tau_ns + 1000000000LL, omega_b,
@@ -69,17 +70,21 @@ DeskewCase MakeCase() {
   return c;
 }
 
+// The defaults with τ = 7 ms, as in MakeCase.
+proto::GroundParams ParamsOfTheCase() {
+  return GroundParamsWith("deskew { time_offset_s: 0.007 }");
+}
+
 TEST(Deskewer, DeskewedPlaneMatchesTheTruthAtTheStamp) {
   DeskewCase c = MakeCase();
-  const proto::GroundParams params = DefaultGroundParams();
+  const proto::GroundParams params = ParamsOfTheCase();
   // Raw (skewed) scan.
   ScanProcessor raw(params, GroundFrame(), nullptr);
   proto::Scan raw_scan = c.scan;
   const proto::GroundPlane raw_plane = raw.Process(&raw_scan);
   // Deskewed.
   imu::GyroIntegrator integrator(c.imu, Eigen::Vector3d::Zero());
-  Deskewer deskewer(&integrator, c.imu_origin_ns, c.c_bl, c.tau_ns,
-                    params.deskew_node_spacing_s());
+  Deskewer deskewer(&integrator, c.imu_origin_ns, c.c_bl, params.deskew());
   ScanProcessor processor(params, GroundFrame(), &deskewer);
   proto::Scan scan = c.scan;
   const proto::GroundPlane plane = processor.Process(&scan);
@@ -104,7 +109,10 @@ TEST(Deskewer, PointsMatchTheFrameAtTheStamp) {
   SyntheticPose still = c.pose;
   c.scan = CastScan(StreetScene(11), lidar, c.pose, kStampNs, 1);
   imu::GyroIntegrator integrator(c.imu, Eigen::Vector3d::Zero());
-  Deskewer deskewer(&integrator, c.imu_origin_ns, c.c_bl, c.tau_ns, 0.001);
+  // 1 ms rotation nodes: the bound below depends on them.
+  const proto::GroundParams params =
+      GroundParamsWith("deskew { time_offset_s: 0.007 node_spacing_s: 0.001 }");
+  Deskewer deskewer(&integrator, c.imu_origin_ns, c.c_bl, params.deskew());
   proto::Scan scan = c.scan;
   ASSERT_TRUE(deskewer.Deskew(scan.stamp_ns(), scan.time_offset_ns().data(),
                               static_cast<size_t>(scan.x_size()), scan.mutable_x()->mutable_data(),
@@ -112,10 +120,10 @@ TEST(Deskewer, PointsMatchTheFrameAtTheStamp) {
   double worst = 0.0;
   for (int i = 0; i < scan.x_size(); ++i) {
     const double dt = 1e-9 * scan.time_offset_ns(i);
+    const Eigen::Vector3d omega = c.pose.omega_lidar_radps;
     const Eigen::Matrix3d r_t =
         c.pose.g_from_lidar *
-        Eigen::AngleAxisd(c.pose.omega_lidar_radps.norm() * dt, c.pose.omega_lidar_radps.normalized())
-            .toRotationMatrix();
+        Eigen::AngleAxisd(omega.norm() * dt, omega.normalized()).toRotationMatrix();
     const Eigen::Vector3d raw(c.scan.x(i), c.scan.y(i), c.scan.z(i));
     const Eigen::Vector3d expected = still.g_from_lidar.transpose() * r_t * raw;
     const Eigen::Vector3d got(scan.x(i), scan.y(i), scan.z(i));
@@ -129,8 +137,9 @@ TEST(Deskewer, NoImuCoverageIsARejectionNotANan) {
   // The readings start 25 ms after the stamp.
   std::vector<imu::ImuReading> late(c.imu.begin() + 410, c.imu.end());
   imu::GyroIntegrator integrator(late, Eigen::Vector3d::Zero());
-  Deskewer deskewer(&integrator, c.imu_origin_ns, c.c_bl, c.tau_ns, 0.001);
-  ScanProcessor processor(DefaultGroundParams(), GroundFrame(), &deskewer);
+  const proto::GroundParams params = ParamsOfTheCase();
+  Deskewer deskewer(&integrator, c.imu_origin_ns, c.c_bl, params.deskew());
+  ScanProcessor processor(params, GroundFrame(), &deskewer);
   proto::Scan scan = c.scan;
   const proto::GroundPlane plane = processor.Process(&scan);
   EXPECT_FALSE(plane.valid());

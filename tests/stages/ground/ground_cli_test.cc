@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "common/io/atomic_file.h"
+#include "common/io/eigen_proto.h"
 #include "common/io/provenance.h"
 #include "common/io/record_stream.h"
 #include "common/io/text_proto.h"
@@ -58,10 +59,7 @@ Dataset WriteDataset(const TempDir& dir, bool corrupt_scan, bool bad_imu_stamp) 
 
   proto::Rig rig;
   const Eigen::Quaterniond q(c_bl);
-  rig.mutable_imu_from_lidar()->mutable_rotation()->set_w(q.w());
-  rig.mutable_imu_from_lidar()->mutable_rotation()->set_x(q.x());
-  rig.mutable_imu_from_lidar()->mutable_rotation()->set_y(q.y());
-  rig.mutable_imu_from_lidar()->mutable_rotation()->set_z(q.z());
+  *rig.mutable_imu_from_lidar()->mutable_rotation() = ToProto(q);
   rig.mutable_imu_from_lidar()->mutable_translation()->set_z(0.4);
   rig.set_imu_height_m(0.5);
   EXPECT_TRUE(WriteTextProto(data.rig, rig).ok());
@@ -101,9 +99,11 @@ Dataset WriteDataset(const TempDir& dir, bool corrupt_scan, bool bad_imu_stamp) 
   return data;
 }
 
+// The command line of tiltcal_ground on `data`; without --params when
+// `params` is empty.
 std::string Command(const Dataset& data, const TempDir& dir, const std::string& params) {
   return testing::ToolPath("tiltcal_ground") + " --imu=" + data.imu + " --scans=" + data.scans +
-         " --rig=" + data.rig + " --params=" + params + " --out_ground=" +
+         " --rig=" + data.rig + (params.empty() ? "" : " --params=" + params) + " --out_ground=" +
          dir.File("ground.binpb") + " --out_scans=" + dir.File("deskewed.binpb.lz4");
 }
 
@@ -121,7 +121,7 @@ TEST(GroundCli, PlanesMatchTheTruthAndDeskewedScansAreWritten) {
       ReadAllRecords<proto::GroundPlane>(dir.File("ground.binpb"), &planes, &header);
   ASSERT_TRUE(status.ok()) << status.message();
   EXPECT_EQ(header.provenance().producer(), "tiltcal_ground");
-  EXPECT_NE(header.provenance().params_txtpb().find("fit_radius_first_ring_ratio"),
+  EXPECT_NE(header.provenance().params_txtpb().find("radius_first_ring_ratio"),
             std::string::npos);
   ASSERT_EQ(planes.size(), static_cast<size_t>(kNumScans));
   for (int k = 0; k < kNumScans; ++k) {
@@ -161,7 +161,8 @@ TEST(GroundCli, InspectCsvAndPcdShowThePlanesAndLabels) {
   ASSERT_TRUE(ReadAllRecords<proto::GroundPlane>(dir.File("ground.binpb"), &planes).ok());
   const std::string inspect = testing::ToolPath("tiltcal_inspect");
 
-  // CSV: dotted names of DESIGN §8, one row per plane, values as written.
+  // CSV: a header of dotted field paths (normal_in_lidar.z), one row per
+  // plane, values as written.
   std::string csv;
   ASSERT_EQ(testing::RunCommand("(" + inspect + " csv " + dir.File("ground.binpb") +
                                     " 2>/dev/null)", &csv), 0) << csv;
@@ -259,17 +260,50 @@ TEST(GroundCli, NonMonotonicImuIsAnError) {
   EXPECT_FALSE(testing::FileExists(dir.File("ground.binpb")));
 }
 
+TEST(GroundCli, WithoutParamsTheDefaultsAreUsed) {
+  TempDir dir;
+  const Dataset data = WriteDataset(dir, false, false);
+  std::string output;
+  ASSERT_EQ(testing::RunCommand(Command(data, dir, data.params), &output), 0) << output;
+  std::vector<proto::GroundPlane> with_file;
+  ASSERT_TRUE(ReadAllRecords<proto::GroundPlane>(dir.File("ground.binpb"), &with_file).ok());
+  ASSERT_EQ(testing::RunCommand(Command(data, dir, ""), &output), 0) << output;
+  std::vector<proto::GroundPlane> without;
+  proto::StreamHeader header;
+  ASSERT_TRUE(
+      ReadAllRecords<proto::GroundPlane>(dir.File("ground.binpb"), &without, &header).ok());
+  ASSERT_EQ(without.size(), with_file.size());
+  for (size_t k = 0; k < without.size(); ++k) {
+    EXPECT_EQ(without[k].SerializeAsString(), with_file[k].SerializeAsString()) << k;
+  }
+  EXPECT_NE(header.provenance().params_txtpb().find("radius_first_ring_ratio"),
+            std::string::npos);
+}
+
+TEST(GroundCli, MissingRequiredFlagIsAUsageError) {
+  TempDir dir;
+  std::string output;
+  EXPECT_EQ(testing::RunCommand(testing::ToolPath("tiltcal_ground") + " --imu=a --scans=b " +
+                                    "--out_ground=" + dir.File("ground.binpb"),
+                                &output),
+            2);
+  EXPECT_NE(output.find("--rig"), std::string::npos) << output;
+  EXPECT_EQ(std::count(output.begin(), output.end(), '\n'), 1) << output;
+  EXPECT_FALSE(testing::FileExists(dir.File("ground.binpb")));
+}
+
 TEST(GroundCli, BadParamsNameTheField) {
   TempDir dir;
   const Dataset data = WriteDataset(dir, false, false);
+  // A fifth zone ring count: within the schema bounds, but 4 zones.
   const std::string params = dir.File("params.txtpb");
-  ASSERT_TRUE(WriteTextProto(params, testing::DefaultGroundParams()).ok());
-  std::string text;
-  ASSERT_TRUE(ReadFileToString(params, &text).ok());
-  ASSERT_TRUE(WriteFileAtomically(params, text + "zone_rings: 5\n").ok());
+  proto::GroundParams five_zones = testing::DefaultGroundParams();
+  five_zones.mutable_zone_model()->add_rings(5);
+  ASSERT_TRUE(WriteTextProto(params, five_zones).ok());
   std::string output;
   EXPECT_EQ(testing::RunCommand(Command(data, dir, params), &output), 1);
-  EXPECT_NE(output.find("zone_rings"), std::string::npos) << output;
+  EXPECT_NE(output.find("zone_model.rings must have exactly 4 values"), std::string::npos)
+      << output;
   EXPECT_FALSE(testing::FileExists(dir.File("ground.binpb")));
 }
 

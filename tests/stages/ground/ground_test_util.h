@@ -7,25 +7,28 @@
 #include <Eigen/Core>
 #include <gtest/gtest.h>
 
-#include "common/io/params.h"
+#include "common/io/eigen_proto.h"
+#include "stages/ground/default_params_text.h"
+#include "tests/testing/params_text.h"
 #include "tests/testing/test_env.h"
 #include "tiltcal/proto/ground.pb.h"
 #include "tiltcal/proto/ground_params.pb.h"
 
 namespace tiltcal::testing {
 
-// The shipped defaults (stages/ground/default_params.txtpb).
+// The shipped defaults (stages/ground/default_params.txtpb, compiled in).
 inline proto::GroundParams DefaultGroundParams() {
-  proto::GroundParams params;
-  const Status status =
-      LoadParams(SourceDir() + "/stages/ground/default_params.txtpb", &params);
-  EXPECT_TRUE(status.ok()) << status.message();
-  return params;
+  return DefaultParamsWith<proto::GroundParams>(ground::DefaultParamsText());
+}
+
+// The shipped defaults with `override_text` (text format) merged over them:
+// a singular field replaces the default, a repeated one is appended to.
+inline proto::GroundParams GroundParamsWith(const std::string& override_text) {
+  return DefaultParamsWith<proto::GroundParams>(ground::DefaultParamsText(), override_text);
 }
 
 inline Eigen::Vector3d NormalOf(const proto::GroundPlane& plane) {
-  return Eigen::Vector3d(plane.normal_in_lidar().x(), plane.normal_in_lidar().y(),
-                         plane.normal_in_lidar().z());
+  return ToEigen(plane.normal_in_lidar());
 }
 
 // Every floating-point field of the plane is finite.

@@ -100,8 +100,7 @@ TEST(KittiGroundCli, ExecutableFitsTheReferencePlane) {
   proto::Rig rig;
   rig.mutable_imu_from_lidar()->mutable_rotation()->set_w(1.0);
   ASSERT_TRUE(WriteTextProto(dir.File("rig.txtpb"), rig).ok());
-  proto::GroundParams params = testing::DefaultGroundParams();
-  params.set_deskew(false);
+  const proto::GroundParams params = testing::GroundParamsWith("deskew { enabled: false }");
   ASSERT_TRUE(WriteTextProto(dir.File("params.txtpb"), params).ok());
   std::string output;
   ASSERT_EQ(testing::RunCommand(testing::ToolPath("tiltcal_ground") + " --imu=" +

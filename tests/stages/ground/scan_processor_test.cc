@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include "common/io/eigen_proto.h"
 #include "tests/stages/ground/ground_test_util.h"
 #include "tests/stages/ground/synthetic_lidar.h"
 
@@ -64,8 +65,7 @@ SequenceErrors RunSequence(double roll_deg, double pitch_deg, double height_m, i
     planes.push_back(processor.Process(&scan));
     poses.push_back(pose);
   }
-  ApplyTiltJumpGate(params.max_tilt_jump_deg(), static_cast<int>(params.tilt_jump_window()),
-                    &planes);
+  ApplyTiltJumpGate(params.tilt_jump_gate(), &planes);
   SequenceErrors errors;
   for (int k = 0; k < num_scans; ++k) {
     const proto::GroundPlane& plane = planes[k];
@@ -113,12 +113,9 @@ TEST(ScanProcessor, UpsideDownLidarWithRigUpDirection) {
   // still point towards the sensor (here −z_l) with d > 0.
   proto::Rig rig;
   const Eigen::Quaterniond c_bl(RollPitchYaw(M_PI, 0.0, 0.3));
-  rig.mutable_imu_from_lidar()->mutable_rotation()->set_w(c_bl.w());
-  rig.mutable_imu_from_lidar()->mutable_rotation()->set_x(c_bl.x());
-  rig.mutable_imu_from_lidar()->mutable_rotation()->set_y(c_bl.y());
-  rig.mutable_imu_from_lidar()->mutable_rotation()->set_z(c_bl.z());
+  *rig.mutable_imu_from_lidar()->mutable_rotation() = ToProto(c_bl);
   rig.mutable_gravity_flat_in_imu()->set_z(-9.81);
-  const GroundFrame frame = MakeGroundFrame(rig, DefaultGroundParams());
+  const GroundFrame frame = MakeGroundFrame(rig, DefaultGroundParams().frame());
   ScanProcessor processor(DefaultGroundParams(), frame, nullptr);
   SyntheticPose pose;
   pose.position_g = Eigen::Vector3d(0, 0, 1.2);
@@ -149,8 +146,8 @@ TEST(ScanProcessor, CovarianceIsPositiveAndMasksMatchCounts) {
   const Eigen::Vector3d n = NormalOf(plane);
   EXPECT_NEAR(n.dot(cov.topLeftCorner<3, 3>() * n), 0.0, 1e-12);
   const proto::GroundParams params = DefaultGroundParams();
-  EXPECT_GE(plane.normal_std_deg(), params.covariance_normal_floor_deg());
-  EXPECT_GE(plane.height_std_m(), params.covariance_height_floor_m());
+  EXPECT_GE(plane.normal_std_deg(), params.covariance_floor().normal_deg());
+  EXPECT_GE(plane.height_std_m(), params.covariance_floor().height_m());
   int ground = 0, inliers = 0;
   for (uint64_t w : plane.ground_mask()) ground += __builtin_popcountll(w);
   for (uint64_t w : plane.inlier_mask()) inliers += __builtin_popcountll(w);
@@ -313,7 +310,9 @@ TEST(TiltJumpGate, RejectsTheOutlierOnly) {
     planes[i].mutable_normal_in_lidar()->set_y(std::sin(tilt));
     planes[i].mutable_normal_in_lidar()->set_z(std::cos(tilt));
   }
-  ApplyTiltJumpGate(3.0, 3, &planes);
+  ApplyTiltJumpGate(
+      testing::GroundParamsWith("tilt_jump_gate { max_jump_deg: 3.0 window: 3 }").tilt_jump_gate(),
+      &planes);
   for (int i = 0; i < 9; ++i) {
     EXPECT_EQ(planes[i].valid(), i != 4) << i;
   }
