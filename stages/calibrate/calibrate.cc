@@ -66,6 +66,49 @@ Status ReadCalibrateInputs(const CalibratePaths& paths, const proto::CalibratePa
 
 namespace {
 
+// The wide-window tau of the initialisation and the scans it leaves out.
+void LogCoarseTimeOffset(const InitialisationReport& init, std::ostream* log) {
+  const imu::AngularSpeedAlignment& a = init.coarse.alignment;
+  Log(log, fmt::format("init: wide-window tau {:.4f} s (r {:.3f}, second peak {:.3f}, gyro/LiDAR "
+                       "rate scale {:.3f}){}",
+                       a.time_offset_s, a.correlation, a.second_peak_correlation, a.scale,
+                       init.odometry_rerun ? "; odometry rerun at that tau" : ""));
+  if (!init.coarse.trusted) {
+    Log(log, "init: wide-window tau not trusted, the search starts from 0: " +
+                 init.coarse.distrust_reason);
+  }
+  if (init.dropped_scans_outside_imu > 0) {
+    Log(log, fmt::format("init: {} scans lie outside the IMU time span at tau {:.4f} s and are "
+                         "not used",
+                         init.dropped_scans_outside_imu, init.time_offset_center_s));
+  }
+}
+
+// What the initialisation's checks of the rig rotation found.
+void LogRigChecks(const InitialisationReport& init, std::ostream* log) {
+  const AccelerationCheck& check = init.acceleration_check;
+  Log(log, fmt::format("init: rig rotation axis off by {:.2f} deg; starting C_bl {:.2f} deg from "
+                       "the rig's; acceleration yaw check {:.2f} deg ({}, RMS {:.2f} m/s^2)",
+                       init.rig_axis_disagreement_deg, init.rig_rotation_correction_deg,
+                       check.yaw_error_deg, check.decided ? "decided" : "not decided",
+                       check.rms_horizontal_acceleration_mps2));
+}
+
+// The initialisation's findings for the verdict (CalibrationResult 80-89).
+void FillInitialisationFacts(const InitialisationReport& init, proto::CalibrationResult* result) {
+  result->set_coarse_time_offset_s(init.coarse.alignment.time_offset_s);
+  result->set_coarse_time_offset_correlation(init.coarse.alignment.correlation);
+  result->set_coarse_time_offset_second_peak_correlation(
+      init.coarse.alignment.second_peak_correlation);
+  result->set_coarse_time_offset_trusted(init.coarse.trusted);
+  result->set_gyro_to_lidar_rate_scale(init.coarse.alignment.scale);
+  result->set_rig_rotation_correction_deg(init.rig_rotation_correction_deg);
+  result->set_dropped_scans_outside_imu(init.dropped_scans_outside_imu);
+  result->set_rig_rotation_axis_disagreement_deg(init.rig_axis_disagreement_deg);
+  result->set_rig_yaw_error_from_accelerations_deg(init.acceleration_check.yaw_error_deg);
+  result->set_acceleration_check_decided(init.acceleration_check.decided);
+}
+
 // Initialisation (initialisation.h) with its timings and log lines.
 Status Initialise(const CalibrateInputs& inputs, const proto::CalibrateParams& params,
                   CalibrationState* state, InitialisationReport* init,
@@ -87,9 +130,11 @@ Status Initialise(const CalibrateInputs& inputs, const proto::CalibrateParams& p
                        init->hand_eye.excitation_rad, init->hand_eye.num_pairs,
                        init->position_fit_rms, Seconds(start),
                        init->rotation_from_hand_eye ? "hand-eye" : "the rig"));
+  LogCoarseTimeOffset(*init, log);
   Log(log, fmt::format("init: rotation-axis alignment {:d} ({:.3f} deg), coarse tau {:.2f} ms",
                        init->axis_alignment_applied ? 1 : 0, init->axis_alignment_deg,
                        init->time_offset_init_s * 1e3));
+  LogRigChecks(*init, log);
   const Eigen::Vector3d r = state->ImuFromLidarTranslation();
   Log(log, fmt::format("init: rotation refit rms {:.3f}; r_bl ({:.4f}, {:.4f}, {:.4f}) m from the "
                        "position fit",
@@ -317,6 +362,7 @@ Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& pa
                            ground_used.end()};
   ProblemOptions& problem_options = setup.problem_options;
   problem_options.time_offset_bound_s = params.time_offset_bound_s();
+  problem_options.time_offset_center_s = init.time_offset_center_s;
   problem_options.time_offset_step_bound_s = params.outer_loop().time_offset_step_bound_s();
   problem_options.fix_first_knots = false;  // the fixed map planes pin the gauge
   problem_options.translation_prior_m = ToEigen(inputs.rig.imu_from_lidar()).translation;
@@ -334,6 +380,7 @@ Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& pa
 
   ReexpressInFirstImuFrame(&state);
   FillEstimate(state, ground_used, ground_reason, result);
+  FillInitialisationFacts(init, result);
   AddTiming("total", Seconds(total_start), result);
   if (final_state != nullptr) *final_state = state;
   for (const proto::ObservabilityDirection& d : result->observability()) Log(log, d.description());
