@@ -70,9 +70,11 @@ namespace {
 void LogCoarseTimeOffset(const InitialisationReport& init, std::ostream* log) {
   const imu::AngularSpeedAlignment& a = init.coarse.alignment;
   Log(log, fmt::format("init: wide-window tau {:.4f} s (r {:.3f}, second peak {:.3f}, gyro/LiDAR "
-                       "rate scale {:.3f}){}",
+                       "rate scale {:.3f}){}{}",
                        a.time_offset_s, a.correlation, a.second_peak_correlation, a.scale,
-                       init.odometry_rerun ? "; odometry rerun at that tau" : ""));
+                       init.odometry_rerun ? "; odometry rerun at that tau" : "",
+                       init.odometry_without_gyro ? " (measured on the odometry without the gyro)"
+                                                  : ""));
   if (!init.coarse.trusted) {
     Log(log, "init: wide-window tau not trusted, the search starts from 0: " +
                  init.coarse.distrust_reason);

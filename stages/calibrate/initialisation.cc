@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <optional>
 
 #include <ceres/sized_cost_function.h>
 
@@ -322,9 +323,12 @@ bool DeskewScan(const CalibrationState& state, const LidarScan& scan, double nod
 
 // Odometry on scans deskewed with the rotation spline at the state's tau
 // (positions are still zero, so only rotation and the lever arm move the
-// points); scans whose stamp + tau is outside the spline are left out.
+// points) and a rotation prior from it; scans whose stamp + tau is outside
+// the spline are left out. Without gyro_aided: raw scans, no prior (the
+// gyro's speeds are then only compared with the LiDAR's, not trusted).
 OdometryRun RunOdometry(const std::vector<LidarScan>& scans, const CalibrationState& state,
-                        const proto::CalibrateParams& params, InitialisationReport* report) {
+                        const proto::CalibrateParams& params, bool gyro_aided,
+                        InitialisationReport* report) {
   report->odometry_scans = 0;
   report->odometry_registered = 0;
   report->odometry_mean_fitness_m = 0.0;
@@ -343,7 +347,10 @@ OdometryRun RunOdometry(const std::vector<LidarScan>& scans, const CalibrationSt
     if (scan.points.empty()) continue;
     spline::So3SplineSample rot;
     if (!traj.Evaluate(scan.stamp_s + tau, spline::kSo3Rotation, &rot, nullptr)) continue;
-    if (!DeskewScan(state, scan, params.init().deskew_node_spacing_s(), &table, &deskewed)) {
+    if (!gyro_aided) {
+      deskewed = scan.points;
+    } else if (!DeskewScan(state, scan, params.init().deskew_node_spacing_s(), &table,
+                           &deskewed)) {
       continue;
     }
     const Eigen::Quaterniond c_ab_k(rot.rotation);
@@ -351,7 +358,9 @@ OdometryRun RunOdometry(const std::vector<LidarScan>& scans, const CalibrationSt
       c_ab_first = c_ab_k;
       have_first = true;
     }
-    odometry.AddScan(scan.stamp_s, deskewed, LidarRotationPriorFromImu(c_ab_first, c_ab_k, c_bl));
+    std::optional<Eigen::Quaterniond> prior;
+    if (gyro_aided) prior = LidarRotationPriorFromImu(c_ab_first, c_ab_k, c_bl);
+    odometry.AddScan(scan.stamp_s, deskewed, prior);
     run.scan_of_pose.push_back(static_cast<int>(k));
     run.imu_rotations.push_back(c_ab_k);
   }
@@ -474,7 +483,6 @@ Status EstimateCoarseTau(const OdometryRun& run, const std::vector<LidarScan>& s
     return Status::Ok();
   }
   if (!coarse.trusted) return Status::Ok();
-  TILTCAL_RETURN_IF_ERROR(CheckGyroToLidarRateScale(coarse.alignment.scale, init));
   const double step = init.time_offset_search_step_s();
   const double tau = coarse.alignment.time_offset_s;
   report->time_offset_center_s = step > 0.0 ? std::round(tau / step) * step : tau;
@@ -531,17 +539,35 @@ Status OdometryAndCoarseTau(const std::vector<LidarScan>& scans,
                             const proto::CalibrateParams& params, CalibrationState* state,
                             InitialisationReport* report, OdometryRun* run) {
   auto start = std::chrono::steady_clock::now();
-  *run = RunOdometry(scans, *state, params, report);
+  *run = RunOdometry(scans, *state, params, /*gyro_aided=*/true, report);
   report->odometry_seconds = Seconds(start);
   if (run->poses.size() < 2) {
     return Status::Error("too few scans inside the IMU time range for the LiDAR odometry (" +
                          std::to_string(run->poses.size()) + ")");
   }
   TILTCAL_RETURN_IF_ERROR(EstimateCoarseTau(*run, scans, imu_samples, params, *state, report));
-  if (std::abs(report->time_offset_center_s) > params.time_offset_bound_s()) {
+  const proto::InitParams& init = params.init();
+  const double scale = report->coarse.alignment.scale;
+  if (init.coarse_time_offset_window_s() > 0.0 &&
+      (!report->coarse.trusted || scale < init.min_gyro_to_lidar_rate_scale() ||
+       scale > init.max_gyro_to_lidar_rate_scale())) {
+    // The gyro may have misled the odometry (deskew and prior from a gyro in
+    // another unit, or from instants far off): the LiDAR alone decides.
+    start = std::chrono::steady_clock::now();
+    const OdometryRun lidar_only = RunOdometry(scans, *state, params, false, report);
+    report->odometry_without_gyro = true;
+    report->odometry_seconds += Seconds(start);
+    TILTCAL_RETURN_IF_ERROR(
+        EstimateCoarseTau(lidar_only, scans, imu_samples, params, *state, report));
+    if (report->coarse.trusted) {
+      TILTCAL_RETURN_IF_ERROR(CheckGyroToLidarRateScale(report->coarse.alignment.scale, init));
+    }
+  }
+  if (std::abs(report->time_offset_center_s) > params.time_offset_bound_s() ||
+      report->odometry_without_gyro) {
     start = std::chrono::steady_clock::now();
     state->time_offset_s[0] = report->time_offset_center_s;
-    *run = RunOdometry(scans, *state, params, report);
+    *run = RunOdometry(scans, *state, params, /*gyro_aided=*/true, report);
     report->odometry_rerun = true;
     report->odometry_seconds += Seconds(start);
     if (run->poses.size() < 2) {

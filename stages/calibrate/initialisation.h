@@ -14,7 +14,10 @@
 //     angular speeds of gyro and odometry (coarse_time_offset.h), with the
 //     gyro/LiDAR rate scale checked (a gyro in deg/s is an error); an
 //     untrusted peak leaves tau at 0 (InitialisationReport::coarse says
-//     why). A coarse tau beyond time_offset_bound_s reruns the odometry at
+//     why). No trusted peak or a scale out of bounds: the same on an
+//     odometry without the gyro (a gyro in another unit misleads the
+//     deskew and the prior), then the scale check. A coarse tau beyond
+//     time_offset_bound_s (or the gyro-free case) reruns the odometry at
 //     that tau. Scans whose sweep at t_l + tau is outside the IMU span are
 //     counted (dropped_scans_outside_imu) and take no further part;
 //  4. extrinsic: the rig's measured (C_bl, r_b^{lb}) (the paper's protocol);
@@ -82,6 +85,10 @@ struct InitialisationReport {
   CoarseTimeOffset coarse;
   double time_offset_center_s = 0.0;
   bool odometry_rerun = false;  // the odometry was run again at the coarse tau
+  // The gyro-aided odometry gave no trusted peak or a rate scale out of
+  // bounds, so tau and the scale were measured on an odometry without the
+  // gyro (raw scans, no rotation prior).
+  bool odometry_without_gyro = false;
   int dropped_scans_outside_imu = 0;
   // Steps 4 and 4d: the rig's C_bl against the motion, and how far the
   // starting C_bl is from the rig's, deg.

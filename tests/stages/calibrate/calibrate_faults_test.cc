@@ -27,6 +27,7 @@ TEST_F(CalibrateFaultsTest, GyroInDegreesPerSecondIsAnErrorNamingTheRatioAndTheR
   std::string log;
   const Status status = Run(&result, &log);
   ASSERT_FALSE(status.ok()) << log;
+  std::printf("%s\n", status.message().c_str());
   EXPECT_NE(status.message().find("deg/s"), std::string::npos) << status.message();
   EXPECT_NE(status.message().find("imu_gyro_unit: DEGPS"), std::string::npos) << status.message();
   // The ratio, printed with one decimal, is within 10 % of 57.3.
@@ -42,6 +43,7 @@ TEST_F(CalibrateFaultsTest, RigYawOffBy90DegreesIsRefusedWithTheAngle) {
   std::string log;
   const Status status = Run(&result, &log);
   ASSERT_FALSE(status.ok()) << log;
+  std::printf("%s\n", status.message().c_str());
   const std::string& m = status.message();
   EXPECT_NE(m.find("about the motion's rotation axis"), std::string::npos) << m;
   EXPECT_NE(m.find("fix it in the rig"), std::string::npos) << m;
@@ -56,6 +58,7 @@ TEST_F(CalibrateFaultsTest, UndeclaredUpsideDownImuIsRefusedWithTheAxisAngle) {
   std::string log;
   const Status status = Run(&result, &log);
   ASSERT_FALSE(status.ok()) << log;
+  std::printf("%s\n", status.message().c_str());
   const std::string& m = status.message();
   EXPECT_NE(m.find("rotation axis"), std::string::npos) << m;
   EXPECT_NE(m.find("fix imu_from_lidar.rotation in the rig"), std::string::npos) << m;
