@@ -9,6 +9,7 @@ namespace {
 
 void AddImuNotes(const proto::CheckParams& params, CheckFindings* f) {
   const ImuFindings& imu = f->imu;
+  if (imu.stamps.count < 2) return;
   auto& notes = f->notes;
   if (imu.accel.unit == imu::AccelUnit::kStandardGravity) {
     notes.push_back("IMU accelerometer in g: it will be converted to m/s² (× 9.80665)");
