@@ -23,7 +23,7 @@ void AddImuNotes(const proto::CheckParams& params, CheckFindings* f) {
   if (!imu.static_start.found) {
     notes.push_back(
         "no static start: the gyro bias starts at zero and gravity comes from the mean of the "
-        "first seconds (calibrate params: init_fallback_window_s); start the recording with "
+        "first seconds (calibrate params: init.fallback_window_s); start the recording with "
         "the vehicle still for a few seconds if you can");
   }
   if (imu.stamps.num_gaps > 0) {

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <functional>
 #include <map>
 #include <sstream>
@@ -388,6 +389,19 @@ TEST_F(CheckCommandLine, ExitCodes) {
   testing::TempDir dir;
   EXPECT_EQ(Run("check --bag=" + dir.File("missing.bag") + " >/dev/null", &output), 1);
   EXPECT_TRUE(Contains(output, "missing.bag")) << output;
+  EXPECT_EQ(std::count(output.begin(), output.end(), '\n'), 1) << output;
+
+  // A params value out of its bounds: one line naming the file and the field.
+  {
+    std::ofstream params(dir.File("check.txtpb"));
+    params << "imu { gap_factor: 0.5 }\n";
+  }
+  EXPECT_EQ(Run("check --bag=" + sim.bag() + " --params=" + dir.File("check.txtpb") +
+                    " >/dev/null",
+                &output),
+            1);
+  EXPECT_TRUE(Contains(output, "check.txtpb")) << output;
+  EXPECT_TRUE(Contains(output, "imu.gap_factor")) << output;
   EXPECT_EQ(std::count(output.begin(), output.end(), '\n'), 1) << output;
 
   BagEdits edits;
