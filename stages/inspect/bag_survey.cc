@@ -21,18 +21,17 @@ std::string ChooseTopic(const ros1::BagReader& reader, const std::string& type,
   if (!requested.empty()) {
     const std::string actual = reader.TopicType(requested);
     if (actual == type) return requested;
-    *problem = actual.empty()
-                   ? fmt::format("no topic '{}' (named in the rig); {} topics: {}", requested,
-                                 type, Join(candidates))
-                   : fmt::format("topic '{}' (named in the rig) is {}, not {}", requested, actual,
-                                 type);
+    *problem = actual.empty() ? fmt::format("no topic '{}' (named in the rig); {} topics: {}",
+                                            requested, type, Join(candidates))
+                              : fmt::format("topic '{}' (named in the rig) is {}, not {}",
+                                            requested, actual, type);
     return "";
   }
   if (candidates.size() == 1) return candidates[0];
-  *problem = candidates.empty()
-                 ? fmt::format("no {} topic in the bag (topics: {})", type, Join(reader.Topics()))
-                 : fmt::format("several {} topics ({}): name one in the rig", type,
-                               Join(candidates));
+  *problem =
+      candidates.empty()
+          ? fmt::format("no {} topic in the bag (topics: {})", type, Join(reader.Topics()))
+          : fmt::format("several {} topics ({}): name one in the rig", type, Join(candidates));
   return "";
 }
 
@@ -102,8 +101,7 @@ Status SurveyBag(const std::string& path, const BagSurveyOptions& options, BagSu
   survey->file_size = reader.file_size();
   survey->indexed = reader.indexed();
   survey->topics = reader.Topics();
-  survey->imu_topic =
-      ChooseTopic(reader, ros1::kImuType, options.imu_topic, &survey->imu_problem);
+  survey->imu_topic = ChooseTopic(reader, ros1::kImuType, options.imu_topic, &survey->imu_problem);
   survey->lidar_topic =
       ChooseTopic(reader, ros1::kPointCloud2Type, options.lidar_topic, &survey->lidar_problem);
   ros1::ReadOptions read;

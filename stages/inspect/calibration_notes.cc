@@ -27,19 +27,22 @@ void AddImuNotes(const proto::CheckParams& params, CheckFindings* f) {
         "the vehicle still for a few seconds if you can");
   }
   if (imu.stamps.num_gaps > 0) {
-    notes.push_back(fmt::format("{} gap(s) in the IMU stamps (longest {:.3f} s): the "
-                                "trajectory has no IMU data there",
-                                imu.stamps.num_gaps, imu.stamps.longest_gap_s));
+    notes.push_back(
+        fmt::format("{} gap(s) in the IMU stamps (longest {:.3f} s): the "
+                    "trajectory has no IMU data there",
+                    imu.stamps.num_gaps, imu.stamps.longest_gap_s));
   }
   if (imu.stamps.num_duplicates > 0) {
-    notes.push_back(fmt::format("{} repeated IMU stamp(s): tiltcal_decode keeps the first "
-                                "sample of each stamp",
-                                imu.stamps.num_duplicates));
+    notes.push_back(
+        fmt::format("{} repeated IMU stamp(s): tiltcal_decode keeps the first "
+                    "sample of each stamp",
+                    imu.stamps.num_duplicates));
   }
   if (imu.stamps.num_backwards > 0) {
-    notes.push_back(fmt::format("{} IMU stamp(s) earlier than the one before: tiltcal_decode "
-                                "sorts the samples by stamp",
-                                imu.stamps.num_backwards));
+    notes.push_back(
+        fmt::format("{} IMU stamp(s) earlier than the one before: tiltcal_decode "
+                    "sorts the samples by stamp",
+                    imu.stamps.num_backwards));
   }
   const ImuExcitation& e = imu.excitation;
   if (imu.stamps.count >= 2 && imu.accel.unit &&
@@ -51,10 +54,10 @@ void AddImuNotes(const proto::CheckParams& params, CheckFindings* f) {
   } else if (imu.stamps.count >= 2 && imu.accel.unit &&
              e.yaw_rate_sign_changes <
                  static_cast<int>(params.excitation().min_yaw_rate_sign_changes())) {
-    notes.push_back(fmt::format(
-        "only {} yaw-rate sign change(s): turns mostly one way; the rotation about the "
-        "vertical and τ are weakly determined (drive both left and right turns)",
-        e.yaw_rate_sign_changes));
+    notes.push_back(
+        fmt::format("only {} yaw-rate sign change(s): turns mostly one way; the rotation about the "
+                    "vertical and τ are weakly determined (drive both left and right turns)",
+                    e.yaw_rate_sign_changes));
   }
 }
 
@@ -63,34 +66,38 @@ void AddLidarNotes(const proto::CheckParams& params, CheckFindings* f) {
   auto& notes = f->notes;
   if (lidar.stamps.count == 0) return;
   if (lidar.layout.time_field.empty()) {
-    notes.push_back("no per-point time field: scans are not deskewed, motion within a sweep "
-                    "becomes error (slow down, or use a driver that publishes point times)");
+    notes.push_back(
+        "no per-point time field: scans are not deskewed, motion within a sweep "
+        "becomes error (slow down, or use a driver that publishes point times)");
   }
   if (lidar.stamps.num_gaps > 0) {
-    notes.push_back(fmt::format("{} gap(s) between scans (longest {:.3f} s)",
-                                lidar.stamps.num_gaps, lidar.stamps.longest_gap_s));
+    notes.push_back(fmt::format("{} gap(s) between scans (longest {:.3f} s)", lidar.stamps.num_gaps,
+                                lidar.stamps.longest_gap_s));
   }
   if (lidar.stamps.num_duplicates + lidar.stamps.num_backwards > 0) {
-    notes.push_back(fmt::format("{} scan stamp(s) not after the one before: tiltcal_decode drops "
-                                "them (drop_non_monotonic)",
-                                lidar.stamps.num_duplicates + lidar.stamps.num_backwards));
+    notes.push_back(
+        fmt::format("{} scan stamp(s) not after the one before: tiltcal_decode drops "
+                    "them (drop_non_monotonic)",
+                    lidar.stamps.num_duplicates + lidar.stamps.num_backwards));
   }
   if (lidar.sampled_scans > 0) {
     const double share = static_cast<double>(lidar.scans_with_ground) / lidar.sampled_scans;
     if (share < params.excitation().min_ground_scan_share()) {
-      notes.push_back(fmt::format(
-          "ground in only {:.0f} % of the scans: few ground residuals; the vertical "
-          "translation and the roll/pitch of the extrinsic rest on the motion alone",
-          100.0 * share));
+      notes.push_back(
+          fmt::format("ground in only {:.0f} % of the scans: few ground residuals; the vertical "
+                      "translation and the roll/pitch of the extrinsic rest on the motion alone",
+                      100.0 * share));
     }
   }
   if (!f->have_rig) {
-    notes.push_back("no --rig: topics found by type, and up taken as the LiDAR z axis for the "
-                    "ground statistics");
+    notes.push_back(
+        "no --rig: topics found by type, and up taken as the LiDAR z axis for the "
+        "ground statistics");
   } else if (f->rig_imu_height_m <= 0.0) {
-    notes.push_back("translation along the vertical will come from the rig (no imu_height_m: "
-                    "the ground distance residual is off, and planar motion does not "
-                    "determine it)");
+    notes.push_back(
+        "translation along the vertical will come from the rig (no imu_height_m: "
+        "the ground distance residual is off, and planar motion does not "
+        "determine it)");
   }
 }
 

@@ -15,17 +15,17 @@ Status CheckParamsAreValid(const proto::CheckParams& params) {
   const proto::StaticDetectionParams& s = params.static_detection();
   if (s.hop_s() > s.window_s()) {
     return Status::Error(fmt::format(
-        "static_detection.hop_s ({:g}) must not exceed static_detection.window_s ({:g})",
-        s.hop_s(), s.window_s()));
+        "static_detection.hop_s ({:g}) must not exceed static_detection.window_s ({:g})", s.hop_s(),
+        s.window_s()));
   }
   const proto::LidarCheckParams& l = params.lidar();
   if (l.ground_inlier_distance_m() > l.ground_min_depth_m() + l.ground_max_range_m()) {
     return Status::Error("lidar.ground_inlier_distance_m is larger than the ground region");
   }
   if (params.imu().min_rotation_radps() >= params.imu().max_vehicle_rate_radps()) {
-    return Status::Error(fmt::format(
-        "imu.min_rotation_radps ({:g}) must be below imu.max_vehicle_rate_radps ({:g})",
-        params.imu().min_rotation_radps(), params.imu().max_vehicle_rate_radps()));
+    return Status::Error(
+        fmt::format("imu.min_rotation_radps ({:g}) must be below imu.max_vehicle_rate_radps ({:g})",
+                    params.imu().min_rotation_radps(), params.imu().max_vehicle_rate_radps()));
   }
   return Status::Ok();
 }
@@ -41,12 +41,11 @@ Status RunCheck(const CheckPaths& paths, const proto::CheckParams& params, std::
   options.point_stride = params.lidar().point_stride();
   BagSurvey survey;
   TILTCAL_RETURN_IF_ERROR(SurveyBag(paths.bag, options, &survey));
-  const CheckFindings findings =
-      AnalyseSurvey(survey, paths.rig.empty() ? nullptr : &rig, params);
+  const CheckFindings findings = AnalyseSurvey(survey, paths.rig.empty() ? nullptr : &rig, params);
   WriteCheckReport(findings, out);
   if (findings.problems.empty()) return Status::Ok();
-  return Status::Error(fmt::format("{}: cannot be calibrated: {}", paths.bag,
-                                   fmt::join(findings.problems, "; ")));
+  return Status::Error(
+      fmt::format("{}: cannot be calibrated: {}", paths.bag, fmt::join(findings.problems, "; ")));
 }
 
 }  // namespace tiltcal::inspect

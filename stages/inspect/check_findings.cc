@@ -57,8 +57,8 @@ void AnalyseImu(const BagSurvey& survey, const proto::CheckParams& params, Check
   imu.stamp_minus_record_s = MedianDifferenceS(survey.imu_stamp_ns, survey.imu_record_ns);
   std::vector<imu::ImuReading> readings = ReadingsInStampOrder(survey);
   if (readings.size() < 2) {
-    f->problems.push_back(fmt::format("IMU: {} usable sample(s) on '{}'", readings.size(),
-                                      f->imu_topic));
+    f->problems.push_back(
+        fmt::format("IMU: {} usable sample(s) on '{}'", readings.size(), f->imu_topic));
     return;
   }
   std::vector<double> speed;
@@ -70,10 +70,10 @@ void AnalyseImu(const BagSurvey& survey, const proto::CheckParams& params, Check
                       : imu::GyroUnit::kRadiansPerSecond;
   imu.accel = imu::DetectAccelUnit(readings, {});
   if (!imu.accel.unit) {
-    f->problems.push_back(fmt::format(
-        "IMU: median |specific force| {:.3f} is neither m/s² (≈9.81) nor g (≈1): the "
-        "accelerometer's unit or scale is unknown",
-        imu.accel.median_norm));
+    f->problems.push_back(
+        fmt::format("IMU: median |specific force| {:.3f} is neither m/s² (≈9.81) nor g (≈1): "
+                    "the accelerometer's unit or scale is unknown",
+                    imu.accel.median_norm));
     return;
   }
   const std::vector<imu::ImuReading> published = readings;
@@ -86,7 +86,9 @@ void AnalyseImu(const BagSurvey& survey, const proto::CheckParams& params, Check
     gyro_bias = imu.static_start.mean_gyro_radps;
     imu.specific_force_at_rest_mps2 = imu.static_start.mean_accel_mps2;
   } else {
-    for (const imu::ImuReading& r : readings) imu.specific_force_at_rest_mps2 += r.linear_acceleration_mps2;
+    for (const imu::ImuReading& r : readings) {
+      imu.specific_force_at_rest_mps2 += r.linear_acceleration_mps2;
+    }
     imu.specific_force_at_rest_mps2 /= static_cast<double>(readings.size());
   }
   ExcitationOptions excitation;
@@ -109,8 +111,8 @@ ScanGeometryOptions ToScanGeometryOptions(const proto::LidarCheckParams& p) {
   return o;
 }
 
-void AnalyseLidar(const BagSurvey& survey, const proto::Rig* rig,
-                  const proto::CheckParams& params, CheckFindings* f) {
+void AnalyseLidar(const BagSurvey& survey, const proto::Rig* rig, const proto::CheckParams& params,
+                  CheckFindings* f) {
   LidarFindings& lidar = f->lidar;
   lidar.stamps = ComputeStampStatistics(survey.scan_stamp_ns, params.lidar().gap_factor());
   lidar.stamp_minus_record_s = MedianDifferenceS(survey.scan_stamp_ns, survey.scan_record_ns);
@@ -150,8 +152,8 @@ void AnalyseLidar(const BagSurvey& survey, const proto::Rig* rig,
   if (survey.scan_stamp_ns.empty()) {
     f->problems.push_back(fmt::format("LiDAR: no message on '{}'", f->lidar_topic));
   } else if (!survey.layout.has_xyz) {
-    f->problems.push_back(fmt::format("LiDAR: the clouds on '{}' have no x, y, z fields",
-                                      f->lidar_topic));
+    f->problems.push_back(
+        fmt::format("LiDAR: the clouds on '{}' have no x, y, z fields", f->lidar_topic));
   }
 }
 

@@ -23,7 +23,7 @@ struct ImuFindings {
   // Gyro unit from the rates alone: deg/s when the 95th percentile of |ω|
   // (published unit) exceeds ImuCheckParams.max_vehicle_rate_radps.
   imu::GyroUnit gyro_unit = imu::GyroUnit::kRadiansPerSecond;
-  double gyro_speed_p95 = 0.0;  // published unit
+  double gyro_speed_p95 = 0.0;       // published unit
   imu::StaticInterval static_start;  // SI; times from the first IMU stamp
   Eigen::Vector3d specific_force_at_rest_mps2 = Eigen::Vector3d::Zero();
   ImuExcitation excitation;
@@ -40,13 +40,13 @@ struct LidarFindings {
   int scans_with_ground = 0;
   double structure_fraction = 0.0;  // mean over the sampled scans
   double structure_max_range_m = 0.0;
-  bool up_from_rig = false;          // up = C_bl^T f_rest/|f_rest|, else the LiDAR z
+  bool up_from_rig = false;  // up = C_bl^T f_rest/|f_rest|, else the LiDAR z
   double stamp_minus_record_s = 0.0;
 };
 
 struct ClockFindings {
-  bool both = false;          // both streams have stamps
-  double overlap_s = 0.0;     // negative: the spans are apart by −overlap_s
+  bool both = false;       // both streams have stamps
+  double overlap_s = 0.0;  // negative: the spans are apart by −overlap_s
   // median(LiDAR stamp − record) − median(IMU stamp − record): with both
   // streams received promptly, τ ≈ −this (a LiDAR stamp t_l happened at IMU
   // time t_l + τ).

@@ -24,12 +24,13 @@ std::string Gaps(const StampStatistics& s) {
 void WriteStampLines(const StampStatistics& s, const char* count_label, std::ostream& out) {
   Line(out, count_label, fmt::format("{}", s.count));
   if (s.count < 2) return;
-  Line(out, "rate", fmt::format("{:.2f} Hz (median interval {:.3f} ms)", s.rate_hz,
-                                1e3 * s.nominal_interval_s));
-  Line(out, "stamp jitter", fmt::format("{:.3f} ms (σ of the intervals)", 1e3 * s.interval_stddev_s));
+  Line(out, "rate",
+       fmt::format("{:.2f} Hz (median interval {:.3f} ms)", s.rate_hz, 1e3 * s.nominal_interval_s));
+  Line(out, "stamp jitter",
+       fmt::format("{:.3f} ms (σ of the intervals)", 1e3 * s.interval_stddev_s));
   Line(out, "gaps", Gaps(s));
-  Line(out, "non-increasing", fmt::format("{} repeated, {} backwards", s.num_duplicates,
-                                          s.num_backwards));
+  Line(out, "non-increasing",
+       fmt::format("{} repeated, {} backwards", s.num_duplicates, s.num_backwards));
 }
 
 void WriteImu(const CheckFindings& f, std::ostream& out) {
@@ -43,13 +44,14 @@ void WriteImu(const CheckFindings& f, std::ostream& out) {
                    imu.accel.unit ? imu::UnitName(*imu.accel.unit) : std::string("unknown"),
                    imu.accel.median_norm,
                    imu.accel.from_static_samples ? ", static start" : ", all samples"));
-  Line(out, "gyro", fmt::format("{} (95th percentile |ω| {:.3f} as published)",
-                                imu::UnitName(imu.gyro_unit), imu.gyro_speed_p95));
+  Line(out, "gyro",
+       fmt::format("{} (95th percentile |ω| {:.3f} as published)", imu::UnitName(imu.gyro_unit),
+                   imu.gyro_speed_p95));
   const imu::StaticInterval& st = imu.static_start;
   Line(out, "static start",
        st.found ? fmt::format("yes, {:.2f} s (gyro bias {:.4f} {:.4f} {:.4f} rad/s)",
-                              st.end_s - st.begin_s, st.mean_gyro_radps.x(),
-                              st.mean_gyro_radps.y(), st.mean_gyro_radps.z())
+                              st.end_s - st.begin_s, st.mean_gyro_radps.x(), st.mean_gyro_radps.y(),
+                              st.mean_gyro_radps.z())
                 : std::string("no"));
 }
 
@@ -61,24 +63,23 @@ void WriteLidar(const CheckFindings& f, std::ostream& out) {
   Line(out, "points per scan",
        fmt::format("{} (median; {} .. {})", l.median_points, l.min_points, l.max_points));
   Line(out, "point time",
-       l.layout.time_field.empty()
-           ? std::string("none")
-           : fmt::format("{} {} ({})", l.layout.time_field, l.layout.time_type,
-                         l.layout.time_meaning));
+       l.layout.time_field.empty() ? std::string("none")
+                                   : fmt::format("{} {} ({})", l.layout.time_field,
+                                                 l.layout.time_type, l.layout.time_meaning));
   if (l.has_time_offsets) {
     const char* where = l.max_time_offset_s <= 0.0   ? "stamps at the end of the sweep"
                         : l.min_time_offset_s >= 0.0 ? "stamps at the start of the sweep"
                                                      : "stamps inside the sweep";
     // Offsets below 50 µs print as 0 (float32 times are not exact).
     auto offset = [](double s) { return std::abs(s) < 5e-5 ? 0.0 : s; };
-    Line(out, "sweep", fmt::format("{:+.4f} .. {:+.4f} s from the stamp ({:.1f} ms, {})",
-                                   offset(l.min_time_offset_s), offset(l.max_time_offset_s),
-                                   1e3 * (l.max_time_offset_s - l.min_time_offset_s), where));
+    Line(out, "sweep",
+         fmt::format("{:+.4f} .. {:+.4f} s from the stamp ({:.1f} ms, {})",
+                     offset(l.min_time_offset_s), offset(l.max_time_offset_s),
+                     1e3 * (l.max_time_offset_s - l.min_time_offset_s), where));
   }
   Line(out, "ring",
        l.layout.ring_field.empty() ? std::string("none")
-                                   : fmt::format("{} {}", l.layout.ring_field,
-                                                 l.layout.ring_type));
+                                   : fmt::format("{} {}", l.layout.ring_field, l.layout.ring_type));
 }
 
 void WriteClock(const CheckFindings& f, std::ostream& out) {
@@ -86,10 +87,10 @@ void WriteClock(const CheckFindings& f, std::ostream& out) {
   const StampStatistics& i = f.imu.stamps;
   const StampStatistics& l = f.lidar.stamps;
   out << "clock    header stamps, s\n";
-  Line(out, "IMU", fmt::format("{} .. {} ({:.3f} s)", Seconds(i.first_ns), Seconds(i.last_ns),
-                               i.span_s()));
-  Line(out, "LiDAR", fmt::format("{} .. {} ({:.3f} s)", Seconds(l.first_ns), Seconds(l.last_ns),
-                                 l.span_s()));
+  Line(out, "IMU",
+       fmt::format("{} .. {} ({:.3f} s)", Seconds(i.first_ns), Seconds(i.last_ns), i.span_s()));
+  Line(out, "LiDAR",
+       fmt::format("{} .. {} ({:.3f} s)", Seconds(l.first_ns), Seconds(l.last_ns), l.span_s()));
   Line(out, "overlap",
        f.clock.overlap_s >= 0.0
            ? fmt::format("{:.3f} s", f.clock.overlap_s)
@@ -106,7 +107,8 @@ void WriteExcitation(const CheckFindings& f, std::ostream& out) {
   out << "excitation\n";
   if (imu) {
     const ImuExcitation& e = f.imu.excitation;
-    Line(out, "rotation", fmt::format("95th percentile |ω| {:.3f} rad/s", e.rotation_speed_p95_radps));
+    Line(out, "rotation",
+         fmt::format("95th percentile |ω| {:.3f} rad/s", e.rotation_speed_p95_radps));
     Line(out, "yaw-rate sign changes",
          fmt::format("{} (peak |yaw rate| {:.3f} rad/s)", e.yaw_rate_sign_changes,
                      e.max_abs_yaw_rate_radps));
@@ -129,7 +131,8 @@ void WriteExcitation(const CheckFindings& f, std::ostream& out) {
 }  // namespace
 
 void WriteCheckReport(const CheckFindings& f, std::ostream& out) {
-  out << fmt::format("bag      {} ({:.1f} MB, {})\n", f.bag, 1e-6 * static_cast<double>(f.file_size),
+  out << fmt::format("bag      {} ({:.1f} MB, {})\n", f.bag,
+                     1e-6 * static_cast<double>(f.file_size),
                      f.indexed ? "indexed" : "no index: read record by record");
   WriteImu(f, out);
   WriteLidar(f, out);

@@ -63,7 +63,8 @@ ImuExcitation MeasureImuExcitation(const std::vector<imu::ImuReading>& samples,
   for (const imu::ImuReading& s : samples) {
     const Eigen::Vector3d w = s.angular_velocity_radps - gyro_bias_radps;
     yaw_rate.push_back(w.dot(up));
-    lateral_accel.push_back((s.linear_acceleration_mps2 - specific_force_at_rest_mps2).dot(lateral));
+    lateral_accel.push_back(
+        (s.linear_acceleration_mps2 - specific_force_at_rest_mps2).dot(lateral));
     speed.push_back(w.norm());
   }
   const double span_s = samples.back().time_s - samples.front().time_s;

@@ -33,9 +33,9 @@ struct ExcitationOptions {
 struct ImuExcitation {
   int yaw_rate_sign_changes = 0;
   int lateral_accel_reversals = 0;
-  double max_abs_yaw_rate_radps = 0.0;       // of the smoothed yaw rate
-  double max_abs_lateral_accel_mps2 = 0.0;   // of the smoothed lateral acceleration
-  double rotation_speed_p95_radps = 0.0;     // 95th percentile of |ω_m − b_g|
+  double max_abs_yaw_rate_radps = 0.0;      // of the smoothed yaw rate
+  double max_abs_lateral_accel_mps2 = 0.0;  // of the smoothed lateral acceleration
+  double rotation_speed_p95_radps = 0.0;    // 95th percentile of |ω_m − b_g|
   bool lateral_axis_is_x = false;
 };
 ImuExcitation MeasureImuExcitation(const std::vector<imu::ImuReading>& samples,

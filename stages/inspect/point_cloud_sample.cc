@@ -20,21 +20,29 @@ const PointField* FindField(const PointCloud2View& cloud, const char* name) {
   return nullptr;
 }
 
-// One value of `datatype` at `p` as a double (byte-swapped for big-endian).
+template <typename T>
+double As(const uint8_t* bytes) {
+  T v;
+  std::memcpy(&v, bytes, sizeof(T));
+  return static_cast<double>(v);
+}
+
+// One value of `datatype` at `p` as a double (byte-swapped for big-endian);
+// NaN for an unknown datatype.
 double ReadValue(const uint8_t* p, uint8_t datatype, bool big_endian) {
   uint8_t bytes[8];
   const size_t size = ros1::PointFieldTypeSize(datatype);
   std::memcpy(bytes, p, size);
   if (big_endian) std::reverse(bytes, bytes + size);
   switch (datatype) {
-    case ros1::kInt8: { int8_t v; std::memcpy(&v, bytes, 1); return v; }
-    case ros1::kUint8: return bytes[0];
-    case ros1::kInt16: { int16_t v; std::memcpy(&v, bytes, 2); return v; }
-    case ros1::kUint16: { uint16_t v; std::memcpy(&v, bytes, 2); return v; }
-    case ros1::kInt32: { int32_t v; std::memcpy(&v, bytes, 4); return v; }
-    case ros1::kUint32: { uint32_t v; std::memcpy(&v, bytes, 4); return v; }
-    case ros1::kFloat32: { float v; std::memcpy(&v, bytes, 4); return v; }
-    case ros1::kFloat64: { double v; std::memcpy(&v, bytes, 8); return v; }
+    case ros1::kInt8: return As<int8_t>(bytes);
+    case ros1::kUint8: return As<uint8_t>(bytes);
+    case ros1::kInt16: return As<int16_t>(bytes);
+    case ros1::kUint16: return As<uint16_t>(bytes);
+    case ros1::kInt32: return As<int32_t>(bytes);
+    case ros1::kUint32: return As<uint32_t>(bytes);
+    case ros1::kFloat32: return As<float>(bytes);
+    case ros1::kFloat64: return As<double>(bytes);
     default: return std::numeric_limits<double>::quiet_NaN();
   }
 }
@@ -90,7 +98,10 @@ double TimeOffsetS(const uint8_t* point, const TimeFields& t, bool big_endian, i
   switch (t.kind) {
     case TimeKind::kSecNsec: {
       const double nsec = ReadValue(point + t.nsec->offset, t.nsec->datatype, big_endian);
-      return (v - std::floor(1e-9 * stamp_ns)) + 1e-9 * (nsec - stamp_ns % 1000000000);
+      // Whole seconds and nanoseconds apart (a double of the ns stamp would
+      // lose the nanoseconds).
+      return (v - static_cast<double>(stamp_ns / 1000000000)) +
+             1e-9 * (nsec - static_cast<double>(stamp_ns % 1000000000));
     }
     case TimeKind::kAbsoluteSeconds:
       // Values beyond 1e12 are absolute ns (Livox driver 2).
@@ -116,11 +127,20 @@ CloudLayout DescribeCloudLayout(const PointCloud2View& cloud) {
     layout.time_field = t.kind == TimeKind::kSecNsec ? "time_sec+time_nsec" : t.field->name;
     layout.time_type = ros1::PointFieldTypeName(t.field->datatype);
     switch (t.kind) {
-      case TimeKind::kSecNsec: layout.time_meaning = "absolute s + ns"; break;
-      case TimeKind::kAbsoluteSeconds: layout.time_meaning = "absolute"; break;
-      case TimeKind::kRelativeNs: layout.time_meaning = "ns after the stamp"; break;
-      case TimeKind::kRelativeSeconds: layout.time_meaning = "s after the stamp"; break;
-      case TimeKind::kNone: break;
+      case TimeKind::kSecNsec:
+        layout.time_meaning = "absolute s + ns";
+        break;
+      case TimeKind::kAbsoluteSeconds:
+        layout.time_meaning = "absolute";
+        break;
+      case TimeKind::kRelativeNs:
+        layout.time_meaning = "ns after the stamp";
+        break;
+      case TimeKind::kRelativeSeconds:
+        layout.time_meaning = "s after the stamp";
+        break;
+      case TimeKind::kNone:
+        break;
     }
   }
   if (const PointField* ring = FindRingField(cloud)) {
@@ -144,9 +164,9 @@ Status SampleCloud(const PointCloud2View& cloud, uint32_t stride, CloudSample* s
     if (f) TILTCAL_RETURN_IF_ERROR(CheckFieldInsidePoint(cloud, *f));
   }
   const uint64_t row_bytes = static_cast<uint64_t>(cloud.width) * cloud.point_step;
-  if (cloud.height > 0 && (cloud.row_step < row_bytes ||
-                           static_cast<uint64_t>(cloud.row_step) * (cloud.height - 1) + row_bytes >
-                               cloud.data_size)) {
+  if (cloud.height > 0 &&
+      (cloud.row_step < row_bytes ||
+       static_cast<uint64_t>(cloud.row_step) * (cloud.height - 1) + row_bytes > cloud.data_size)) {
     return Status::Error("point data shorter than its " + std::to_string(cloud.height) +
                          " rows of " + std::to_string(cloud.width) + " points");
   }
@@ -155,8 +175,8 @@ Status SampleCloud(const PointCloud2View& cloud, uint32_t stride, CloudSample* s
   double min_t = std::numeric_limits<double>::infinity(), max_t = -min_t;
   const uint64_t n = static_cast<uint64_t>(cloud.width) * cloud.height;
   for (uint64_t i = 0; i < n; i += stride) {
-    const uint8_t* p = cloud.data + (i / cloud.width) * cloud.row_step +
-                       (i % cloud.width) * cloud.point_step;
+    const uint8_t* p =
+        cloud.data + (i / cloud.width) * cloud.row_step + (i % cloud.width) * cloud.point_step;
     const double x = ReadValue(p + fx->offset, fx->datatype, be);
     const double y = ReadValue(p + fy->offset, fy->datatype, be);
     const double z = ReadValue(p + fz->offset, fz->datatype, be);

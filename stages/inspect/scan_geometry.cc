@@ -21,7 +21,8 @@ ScanGeometry MeasureScanGeometry(const std::vector<float>& x, const std::vector<
           .cast<float>();
   std::vector<float> gx, gy, gz;
   size_t num_structure = 0;
-  const float ground_range2 = static_cast<float>(options.ground_max_range_m * options.ground_max_range_m);
+  const float ground_range2 =
+      static_cast<float>(options.ground_max_range_m * options.ground_max_range_m);
   const float structure_range2 =
       static_cast<float>(options.structure_max_range_m * options.structure_max_range_m);
   for (size_t i = 0; i < x.size(); ++i) {

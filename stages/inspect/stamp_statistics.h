@@ -15,12 +15,12 @@ struct StampStatistics {
   int64_t first_ns = 0;  // smallest stamp
   int64_t last_ns = 0;   // largest stamp
   double nominal_interval_s = 0.0;
-  double rate_hz = 0.0;              // 1 / nominal_interval_s (0 with < 2 stamps)
-  double interval_stddev_s = 0.0;    // jitter: σ of the positive intervals that are no gap
-  int64_t num_gaps = 0;              // intervals > gap_factor · nominal
-  double longest_gap_s = 0.0;        // longest such interval (0 without gaps)
-  int64_t num_duplicates = 0;        // interval == 0
-  int64_t num_backwards = 0;         // interval < 0
+  double rate_hz = 0.0;            // 1 / nominal_interval_s (0 with < 2 stamps)
+  double interval_stddev_s = 0.0;  // jitter: σ of the positive intervals that are no gap
+  int64_t num_gaps = 0;            // intervals > gap_factor · nominal
+  double longest_gap_s = 0.0;      // longest such interval (0 without gaps)
+  int64_t num_duplicates = 0;      // interval == 0
+  int64_t num_backwards = 0;       // interval < 0
   double span_s() const { return 1e-9 * static_cast<double>(last_ns - first_ns); }
 };
 

@@ -19,8 +19,8 @@
 #include "bag/ros1/bag_writer.h"
 #include "bag/ros1/message_encoding.h"
 #include "bag/ros1/messages.h"
-#include "common/io/text_proto.h"
 #include "common/imu/imu_units.h"
+#include "common/io/text_proto.h"
 #include "stages/inspect/bag_survey.h"
 #include "stages/inspect/check.h"
 #include "stages/inspect/check_findings.h"
@@ -82,7 +82,7 @@ struct BagEdits {
   std::function<bool(size_t index, ros1::ImuMessage* imu)> imu;
   size_t repeat_imu_index = SIZE_MAX;  // written twice
   bool drop_lidar = false;
-  int64_t lidar_stamp_shift_ns = 0;    // header stamps only; record times kept
+  int64_t lidar_stamp_shift_ns = 0;  // header stamps only; record times kept
 };
 
 void RewriteBag(const std::string& in, const std::string& out, const BagEdits& edits) {
@@ -108,8 +108,7 @@ void RewriteBag(const std::string& in, const std::string& out, const BagEdits& e
       const size_t index = imu_index++;
       if (edits.imu && !edits.imu(index, &imu)) return Status::Ok();
       message.clear();
-      ros1::SerializeImu(imu.header.seq, ros1::RosTimeToNs(imu.header.stamp),
-                         imu.header.frame_id,
+      ros1::SerializeImu(imu.header.seq, ros1::RosTimeToNs(imu.header.stamp), imu.header.frame_id,
                          Eigen::Vector3d(imu.angular_velocity[0], imu.angular_velocity[1],
                                          imu.angular_velocity[2]),
                          Eigen::Vector3d(imu.linear_acceleration[0], imu.linear_acceleration[1],
@@ -274,8 +273,9 @@ TEST(CheckBag, ImuHoleRepeatedAndBackwardStampsAreCounted) {
   EXPECT_TRUE(AnyContains(run.findings.notes, "1 gap(s) in the IMU stamps (longest 0.055 s)"));
   EXPECT_TRUE(AnyContains(run.findings.notes, "1 repeated IMU stamp(s)"));
   EXPECT_TRUE(AnyContains(run.findings.notes, "1 IMU stamp(s) earlier than the one before"));
-  EXPECT_TRUE(Contains(run.report, "  gaps                     1 (> 3 nominal intervals), "
-                                   "longest 0.055 s"))
+  EXPECT_TRUE(Contains(run.report,
+                       "  gaps                     1 (> 3 nominal intervals), "
+                       "longest 0.055 s"))
       << run.report;
 }
 
@@ -305,11 +305,12 @@ TEST(CheckBag, NoRotationCannotBeCalibrated) {
   RewriteBag(sim.bag(), dir.File("still.bag"), edits);
   const CheckRun run = Check(dir.File("still.bag"), sim.rig());
   ASSERT_FALSE(run.status.ok());
-  EXPECT_TRUE(Contains(run.status.message(), dir.File("still.bag") +
-                                                 ": cannot be calibrated: no rotation"))
+  EXPECT_TRUE(
+      Contains(run.status.message(), dir.File("still.bag") + ": cannot be calibrated: no rotation"))
       << run.status.message();
-  EXPECT_TRUE(Contains(run.report, "\nverdict: cannot be calibrated\n  - no rotation: 95th "
-                                   "percentile of |ω| is 0.0000 rad/s"))
+  EXPECT_TRUE(Contains(run.report,
+                       "\nverdict: cannot be calibrated\n  - no rotation: 95th "
+                       "percentile of |ω| is 0.0000 rad/s"))
       << run.report;
 }
 
@@ -337,12 +338,13 @@ TEST(CheckBag, LidarStampsOnAnotherClockHaveNoOverlap) {
   RewriteBag(sim.bag(), dir.File("clock.bag"), edits);
   const CheckRun run = Check(dir.File("clock.bag"), sim.rig());
   ASSERT_FALSE(run.status.ok());
-  const double apart_s = 600.0 - 1e-9 * (kStartNs + 10'000'000'000LL -
-                                         sim.truth().scans(0).stamp_ns());
+  const double apart_s =
+      600.0 - 1e-9 * (kStartNs + 10'000'000'000LL - sim.truth().scans(0).stamp_ns());
   EXPECT_NEAR(run.findings.clock.overlap_s, -apart_s, 1e-6);
-  EXPECT_TRUE(Contains(run.status.message(), "cannot be calibrated: clock: the IMU stamps "
-                                             "(1700000000.000 .. 1700000010.000 s) and the "
-                                             "LiDAR stamps (1700000600."))
+  EXPECT_TRUE(Contains(run.status.message(),
+                       "cannot be calibrated: clock: the IMU stamps "
+                       "(1700000000.000 .. 1700000010.000 s) and the "
+                       "LiDAR stamps (1700000600."))
       << run.status.message();
   EXPECT_TRUE(Contains(run.status.message(), "do not overlap (apart by"));
   EXPECT_TRUE(Contains(run.status.message(), "time_offset_bound_s"));
@@ -396,8 +398,7 @@ TEST_F(CheckCommandLine, ExitCodes) {
     std::ofstream params(dir.File("check.txtpb"));
     params << "imu { gap_factor: 0.5 }\n";
   }
-  EXPECT_EQ(Run("check --bag=" + sim.bag() + " --params=" + dir.File("check.txtpb") +
-                    " >/dev/null",
+  EXPECT_EQ(Run("check --bag=" + sim.bag() + " --params=" + dir.File("check.txtpb") + " >/dev/null",
                 &output),
             1);
   EXPECT_TRUE(Contains(output, "check.txtpb")) << output;
@@ -429,8 +430,7 @@ TEST(CheckBag, FixtureBagsRunWithoutError) {
       EXPECT_EQ(status.ok(), Contains(out.str(), "verdict: can be calibrated")) << out.str();
     }
     if (!status.ok()) {
-      EXPECT_EQ(status.message().rfind(entry.path().string() + ": ", 0), 0u)
-          << status.message();
+      EXPECT_EQ(status.message().rfind(entry.path().string() + ": ", 0), 0u) << status.message();
     }
     std::printf("%s: %s\n", entry.path().filename().c_str(),
                 status.ok() ? "can be calibrated" : status.message().c_str());

@@ -1,13 +1,18 @@
 // The I/O-free parts of `tiltcal_inspect check`: stamp statistics, sign
 // changes, excitation, scan geometry and the params rules.
 #include <cmath>
+#include <cstring>
+#include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
 
+#include "bag/ros1/message_encoding.h"
+#include "bag/ros1/messages.h"
 #include "stages/inspect/check.h"
 #include "stages/inspect/default_params_text.h"
 #include "stages/inspect/excitation.h"
+#include "stages/inspect/point_cloud_sample.h"
 #include "stages/inspect/scan_geometry.h"
 #include "stages/inspect/stamp_statistics.h"
 #include "tests/testing/params_text.h"
@@ -20,8 +25,8 @@ TEST(StampStatistics, RateJitterGapsDuplicatesAndBackwards) {
   std::vector<int64_t> stamps;
   for (int i = 0; i <= 100; ++i) stamps.push_back(10'000'000LL * i);
   for (int i = 105; i <= 200; ++i) stamps.push_back(10'000'000LL * i);
-  stamps.push_back(stamps.back());                 // repeated
-  stamps.push_back(stamps.back() - 5'000'000);     // backwards
+  stamps.push_back(stamps.back());              // repeated
+  stamps.push_back(stamps.back() - 5'000'000);  // backwards
   stamps.push_back(10'000'000LL * 201);
   const StampStatistics s = ComputeStampStatistics(stamps, 3.0);
   EXPECT_EQ(s.count, static_cast<int64_t>(stamps.size()));
@@ -132,6 +137,99 @@ TEST(ScanGeometry, EmptyScanHasNothing) {
   EXPECT_EQ(g.num_points, 0u);
 }
 
+// A cloud of 4 points (x, y, z FLOAT32, then the time fields, then a UINT16
+// ring) stamped 1 ns before a whole second: point k at stamp − 0.03 k s.
+struct TestCloud {
+  std::string message;
+  ros1::PointCloud2View view;
+};
+
+void AppendBytes(std::string* data, const void* value, size_t size) {
+  data->append(static_cast<const char*>(value), size);
+}
+
+void MakeCloud(bool sec_nsec, TestCloud* cloud) {
+  const int64_t stamp_ns = 1700000000999999999LL;
+  std::vector<ros1::PointField> fields = {{"x", 0, ros1::kFloat32, 1},
+                                          {"y", 4, ros1::kFloat32, 1},
+                                          {"z", 8, ros1::kFloat32, 1}};
+  uint32_t step = 12;
+  if (sec_nsec) {
+    fields.push_back({"time_sec", 12, ros1::kUint32, 1});
+    fields.push_back({"time_nsec", 16, ros1::kUint32, 1});
+    step = 20;
+  } else {
+    fields.push_back({"t", 12, ros1::kUint32, 1});  // Ouster: ns after the stamp
+    step = 16;
+  }
+  fields.push_back({"ring", step, ros1::kUint16, 1});
+  step += 2;
+  std::string data;
+  for (int k = 0; k < 4; ++k) {
+    const float xyz[3] = {1.0f + k, 2.0f, -1.5f};
+    AppendBytes(&data, xyz, sizeof(xyz));
+    if (sec_nsec) {
+      const int64_t t_ns = stamp_ns - 30'000'000LL * k;
+      const uint32_t sec = static_cast<uint32_t>(t_ns / 1000000000);
+      const uint32_t nsec = static_cast<uint32_t>(t_ns % 1000000000);
+      AppendBytes(&data, &sec, 4);
+      AppendBytes(&data, &nsec, 4);
+    } else {
+      const uint32_t t = 30'000'000u * k;
+      AppendBytes(&data, &t, 4);
+    }
+    const uint16_t ring = static_cast<uint16_t>(k);
+    AppendBytes(&data, &ring, 2);
+  }
+  ASSERT_TRUE(ros1::SerializePointCloud2(0, stamp_ns, "lidar", 1, 4, fields, step, data, true,
+                                         &cloud->message));
+  ASSERT_TRUE(ros1::DecodePointCloud2(reinterpret_cast<const uint8_t*>(cloud->message.data()),
+                                      cloud->message.size(), &cloud->view)
+                  .ok());
+}
+
+TEST(PointCloudSample, AbsoluteSecondsAndNanosecondsNearASecondBoundary) {
+  TestCloud cloud;
+  MakeCloud(/*sec_nsec=*/true, &cloud);
+  const CloudLayout layout = DescribeCloudLayout(cloud.view);
+  EXPECT_TRUE(layout.has_xyz);
+  EXPECT_EQ(layout.time_field, "time_sec+time_nsec");
+  EXPECT_EQ(layout.time_type, "UINT32");
+  EXPECT_EQ(layout.ring_field, "ring");
+  EXPECT_EQ(layout.ring_type, "UINT16");
+  CloudSample sample;
+  ASSERT_TRUE(SampleCloud(cloud.view, 1, &sample).ok());
+  ASSERT_EQ(sample.x.size(), 4u);
+  EXPECT_FLOAT_EQ(sample.x[3], 4.0f);
+  ASSERT_TRUE(sample.has_time);
+  EXPECT_NEAR(sample.min_time_offset_s, -0.09, 1e-9);
+  EXPECT_NEAR(sample.max_time_offset_s, 0.0, 1e-9);
+  // Every 2nd point: points 0 and 2.
+  ASSERT_TRUE(SampleCloud(cloud.view, 2, &sample).ok());
+  EXPECT_EQ(sample.x.size(), 2u);
+  EXPECT_NEAR(sample.min_time_offset_s, -0.06, 1e-9);
+}
+
+TEST(PointCloudSample, OusterNanosecondsAfterTheStamp) {
+  TestCloud cloud;
+  MakeCloud(/*sec_nsec=*/false, &cloud);
+  EXPECT_EQ(DescribeCloudLayout(cloud.view).time_meaning, "ns after the stamp");
+  CloudSample sample;
+  ASSERT_TRUE(SampleCloud(cloud.view, 1, &sample).ok());
+  EXPECT_NEAR(sample.min_time_offset_s, 0.0, 1e-12);
+  EXPECT_NEAR(sample.max_time_offset_s, 0.09, 1e-12);
+}
+
+TEST(PointCloudSample, FieldOutsideThePointIsAnError) {
+  TestCloud cloud;
+  MakeCloud(/*sec_nsec=*/false, &cloud);
+  cloud.view.fields[2].offset = 100;  // z
+  CloudSample sample;
+  const Status status = SampleCloud(cloud.view, 1, &sample);
+  ASSERT_FALSE(status.ok());
+  EXPECT_EQ(status.message(), "field 'z' lies outside the point (offset 100, point_step 18)");
+}
+
 TEST(CheckParams, DefaultsAreValidAndRulesNameTheField) {
   const auto defaults = testing::DefaultParamsWith<proto::CheckParams>(DefaultParamsText());
   EXPECT_TRUE(CheckParamsAreValid(defaults).ok());
@@ -139,12 +237,10 @@ TEST(CheckParams, DefaultsAreValidAndRulesNameTheField) {
       DefaultParamsText(), "static_detection { hop_s: 1.0 window_s: 0.5 }");
   const Status status = CheckParamsAreValid(hop);
   ASSERT_FALSE(status.ok());
-  EXPECT_NE(status.message().find("static_detection.hop_s"), std::string::npos)
-      << status.message();
+  EXPECT_NE(status.message().find("static_detection.hop_s"), std::string::npos) << status.message();
   const auto rates = testing::DefaultParamsWith<proto::CheckParams>(
       DefaultParamsText(), "imu { min_rotation_radps: 0.9 max_vehicle_rate_radps: 0.5 }");
-  EXPECT_NE(CheckParamsAreValid(rates).message().find("imu.min_rotation_radps"),
-            std::string::npos);
+  EXPECT_NE(CheckParamsAreValid(rates).message().find("imu.min_rotation_radps"), std::string::npos);
 }
 
 }  // namespace
