@@ -531,6 +531,19 @@ Status CheckRigYaw(const OdometryRun& run, const std::vector<LidarScan>& scans,
       axis_b.y(), axis_b.z(), check.rms_horizontal_acceleration_mps2, check.samples, max_deg));
 }
 
+// 99th percentile of |omega_m - b_g|, in the file's unit.
+double GyroSpeedPercentile99(const std::vector<imu::ImuReading>& imu_samples,
+                             const Eigen::Vector3d& gyro_bias) {
+  std::vector<double> speeds;
+  for (const imu::TimedValue& v : GyroAngularSpeeds(imu_samples, gyro_bias)) {
+    speeds.push_back(v.value);
+  }
+  if (speeds.empty()) return 0.0;
+  const size_t k = std::min(speeds.size() - 1, static_cast<size_t>(0.99 * speeds.size()));
+  std::nth_element(speeds.begin(), speeds.begin() + k, speeds.end());
+  return speeds[k];
+}
+
 // Step 3 with 3b: the odometry at tau = 0, the coarse tau and, when it is
 // beyond time_offset_bound_s, the odometry again at the coarse tau (its
 // deskew and gyro prior then come from the right instants).
@@ -550,7 +563,9 @@ Status OdometryAndCoarseTau(const std::vector<LidarScan>& scans,
   const double scale = report->coarse.alignment.scale;
   if (init.coarse_time_offset_window_s() > 0.0 &&
       (!report->coarse.trusted || scale < init.min_gyro_to_lidar_rate_scale() ||
-       scale > init.max_gyro_to_lidar_rate_scale())) {
+       scale > init.max_gyro_to_lidar_rate_scale() ||
+       GyroSpeedPercentile99(imu_samples, state->GyroBias()) >
+           init.max_plausible_gyro_speed_radps())) {
     // The gyro may have misled the odometry (deskew and prior from a gyro in
     // another unit, or from instants far off): the LiDAR alone decides.
     start = std::chrono::steady_clock::now();

@@ -14,7 +14,8 @@
 //     angular speeds of gyro and odometry (coarse_time_offset.h), with the
 //     gyro/LiDAR rate scale checked (a gyro in deg/s is an error); an
 //     untrusted peak leaves tau at 0 (InitialisationReport::coarse says
-//     why). No trusted peak or a scale out of bounds: the same on an
+//     why). No trusted peak, a scale out of bounds or gyro speeds above
+//     max_plausible_gyro_speed_radps (99th percentile): the same on an
 //     odometry without the gyro (a gyro in another unit misleads the
 //     deskew and the prior), then the scale check. A coarse tau beyond
 //     time_offset_bound_s (or the gyro-free case) reruns the odometry at
