@@ -19,7 +19,10 @@
 #include "stages/calibrate/ground_residuals.h"
 #include "stages/calibrate/initialisation.h"
 #include "stages/calibrate/lidar_association.h"
+#include "stages/calibrate/map_sharpness.h"
 #include "stages/calibrate/problem_builder.h"
+#include "stages/calibrate/residual_statistics.h"
+#include "stages/calibrate/verdict.h"
 
 namespace tiltcal::calibrate {
 namespace {
@@ -323,6 +326,59 @@ void FillEstimate(const CalibrationState& state, const std::vector<std::string>&
   result->set_ground_residuals_reason(ground_reason);
 }
 
+// A solve that failed outright (ceres FAILURE) or ended on a non-finite
+// cost leaves no usable estimate: an error, not a result.
+Status CheckSolveUsable(const OuterLoop& loop) {
+  if (loop.summary.termination_type == ceres::FAILURE) {
+    return Status::Error("the solve failed: " + loop.summary.message);
+  }
+  if (!std::isfinite(loop.summary.final_cost)) {
+    return Status::Error("the solve ended on a non-finite cost");
+  }
+  return Status::Ok();
+}
+
+// What the verdict is decided from besides the estimate and the covariance:
+// residual statistics and tau bounds of the last problem, the map sharpness
+// with the estimate and with the rig's extrinsic (same trajectory and tau),
+// the move from the rig, hand-eye and static start.
+void FillVerdictFacts(const CalibrateInputs& inputs, const proto::CalibrateParams& params,
+                      const InitialisationReport& init, CalibrationProblem* problem,
+                      const CalibrationState& state, proto::CalibrationResult* result) {
+  const auto start = Clock::now();
+  result->clear_residual_statistics();
+  for (proto::ResidualStatistics& s : ComputeResidualStatistics(problem->problem())) {
+    *result->add_residual_statistics() = std::move(s);
+  }
+  result->set_time_offset_lower_bound_s(problem->time_offset_lower_s());
+  result->set_time_offset_upper_bound_s(problem->time_offset_upper_s());
+
+  const Rigid3d rig = ToEigen(inputs.rig.imu_from_lidar());
+  const double spacing_s = params.association().deskew_node_spacing_s();
+  *result->mutable_map_sharpness_estimate() =
+      MeasureMapSharpness(state, inputs.scans, params.map(), spacing_s);
+  CalibrationState with_rig = state;
+  with_rig.SetImuFromLidarRotation(rig.rotation);
+  with_rig.SetImuFromLidarTranslation(rig.translation);
+  *result->mutable_map_sharpness_rig() =
+      MeasureMapSharpness(with_rig, inputs.scans, params.map(), spacing_s);
+
+  const Eigen::Quaterniond c_bl = state.ImuFromLidarRotation();
+  *result->mutable_rig_imu_from_lidar() = ToProto(rig);
+  result->set_rotation_from_rig_deg(
+      Eigen::AngleAxisd(rig.rotation.conjugate() * c_bl).angle() * 180.0 / M_PI);
+  result->set_translation_from_rig_m((state.ImuFromLidarTranslation() - rig.translation).norm());
+  result->set_hand_eye_used(init.rotation_from_hand_eye);
+  if (init.rotation_from_hand_eye) {
+    result->set_hand_eye_disagreement_deg(
+        Eigen::AngleAxisd(init.hand_eye.imu_from_lidar_rotation.conjugate() * c_bl).angle() *
+        180.0 / M_PI);
+  }
+  result->set_static_start(init.imu.from_static_start);
+  result->set_static_samples(init.imu.num_samples_averaged);
+  AddTiming("verdict_facts", Seconds(start), result);
+}
+
 }  // namespace
 
 Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& params,
@@ -376,8 +432,10 @@ Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& pa
   while (loop.rounds < max_rounds && !settled) {
     TILTCAL_RETURN_IF_ERROR(RunOuterRound(setup, &state, &loop, &settled, log));
   }
+  TILTCAL_RETURN_IF_ERROR(CheckSolveUsable(loop));
   FillSolverReport(loop, result);
   FillCovariance(inputs, params, loop.problem.get(), &state, result);
+  FillVerdictFacts(inputs, params, init, loop.problem.get(), state, result);
   loop.problem.reset();
 
   ReexpressInFirstImuFrame(&state);
@@ -385,6 +443,7 @@ Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& pa
   FillInitialisationFacts(init, result);
   AddTiming("total", Seconds(total_start), result);
   if (final_state != nullptr) *final_state = state;
+  DecideVerdict(params.verdict(), result);
   for (const proto::ObservabilityDirection& d : result->observability()) Log(log, d.description());
   Log(log, fmt::format("done in {:.2f} s, {} LM iterations, {:.3f} s per iteration",
                        Seconds(total_start), loop.total_iterations,
@@ -392,7 +451,8 @@ Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& pa
   return Status::Ok();
 }
 
-Status Run(const CalibratePaths& paths, const proto::CalibrateParams& params, std::ostream* log) {
+Status Run(const CalibratePaths& paths, const proto::CalibrateParams& params, std::ostream* log,
+           proto::CalibrationResult* written) {
   const auto start = Clock::now();
   CalibrateInputs inputs;
   TILTCAL_RETURN_IF_ERROR(ReadCalibrateInputs(paths, params, &inputs));
@@ -408,7 +468,9 @@ Status Run(const CalibratePaths& paths, const proto::CalibrateParams& params, st
   if (!paths.gravity.empty()) input_paths.push_back({"gravity", paths.gravity});
   *result.mutable_provenance() =
       MakeProvenance("tiltcal_calibrate", params, input_paths, paths.command_line);
-  return WriteTextProto(paths.out, result);
+  TILTCAL_RETURN_IF_ERROR(WriteTextProto(paths.out, result));
+  if (written != nullptr) *written = std::move(result);
+  return Status::Ok();
 }
 
 }  // namespace tiltcal::calibrate
