@@ -476,6 +476,11 @@ TEST(CalibratePipelineTest, TimeOffsetBeyondItsBoundIsSuspectWithExitCode3) {
   const std::string search = "time_offset_search_step_s: 0.001";
   ASSERT_NE(params_text.find(search), std::string::npos);
   params_text.replace(params_text.find(search), search.size(), "time_offset_search_step_s: 0");
+  // Without the wide-window search (which would find the 80 ms) tau ends at
+  // the +-50 ms bound around 0.
+  const std::string wide = "coarse_time_offset_window_s: 5.0";
+  ASSERT_NE(params_text.find(wide), std::string::npos);
+  params_text.replace(params_text.find(wide), wide.size(), "coarse_time_offset_window_s: 0");
   ASSERT_TRUE(WriteFileAtomically(dir.File("params.txtpb"), params_text).ok());
   const CalibratePaths paths = SequencePaths(dir, /*gravity=*/false);
   std::string output;
