@@ -569,7 +569,8 @@ Status Run(const SimulatePaths& paths, const proto::SimulateParams& params, std:
     return Status::Error("--out_bag and --out_truth are required");
   }
   Scenario scenario;
-  TILTCAL_RETURN_IF_ERROR(BuildScenario(params, &scenario));
+  const Status built = BuildScenario(params, &scenario);
+  if (!built.ok()) return paths.params.empty() ? built : built.WithContext(paths.params);
   unsigned threads = params.num_threads();
   if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
   ros1::BagWriter writer;

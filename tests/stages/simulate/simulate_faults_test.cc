@@ -508,6 +508,21 @@ TEST(SimulateFaultsTest, BadGapsAreAClearError) {
     EXPECT_FALSE(tiltcal::testing::FileExists(paths.out_bag));
     EXPECT_FALSE(tiltcal::testing::FileExists(paths.out_truth));
   }
+  // The command line: one line naming the scenario file and the field, exit 1.
+  const std::string tool = tiltcal::testing::ToolPath("tiltcal_simulate");
+  if (!tiltcal::testing::FileExists(tool)) GTEST_SKIP() << "build the tiltcal_simulate target";
+  const std::string scenario = dir.File("bad_gap.txtpb");
+  ASSERT_TRUE(
+      WriteTextProto(scenario, ShortScenarioWith("faults { imu_gaps { start_s: 2 } }")).ok());
+  std::string output;
+  EXPECT_EQ(tiltcal::testing::RunCommand(tool + " --params=" + scenario + " --out_bag=" +
+                                             paths.out_bag + " --out_truth=" + paths.out_truth,
+                                         &output),
+            1);
+  EXPECT_EQ(output, "tiltcal_simulate: " + scenario +
+                        ": field faults.imu_gaps[0].duration_s = 0 must be > 0\n");
+  EXPECT_FALSE(tiltcal::testing::FileExists(paths.out_bag));
+  EXPECT_FALSE(tiltcal::testing::FileExists(paths.out_truth));
 }
 
 }  // namespace
