@@ -8,6 +8,14 @@ namespace tiltcal::simulate {
 // A small, portable random generator (xoshiro256** seeded through
 // splitmix64) with its own normal sampler, so a seed gives the same numbers
 // with every compiler and standard library (std:: distributions do not).
+// The random streams of one scenario, one per use, so that switching one
+// use on or off leaves every other stream's numbers unchanged.
+inline constexpr uint64_t kImuNoiseStream = 0;       // IMU white noise and bias walk
+inline constexpr uint64_t kWorldStream = 1;          // random boxes and pillars
+inline constexpr uint64_t kImuStampJitterStream = 2;  // SimFaultParams.imu_stamp_jitter_s
+inline constexpr uint64_t kImuDropStream = 3;         // SimFaultParams.imu_drop_fraction
+inline constexpr uint64_t kSweepStreamBase = 1000;    // + k: range noise of sweep k
+
 class Rng {
  public:
   // Streams with different `stream` values are independent for one seed

@@ -11,8 +11,6 @@ namespace tiltcal::simulate {
 namespace {
 
 constexpr double kTwoPi = 2.0 * M_PI;
-// Random stream of sweep k (stream 0 is the IMU's, 1 the world's).
-constexpr uint64_t kSweepStreamBase = 1000;
 
 int VelodyneSequences(const ScanConfig& config) {
   return static_cast<int>(std::floor(1.0 / (config.scan_rate_hz * config.model.sequence_period_s)));

@@ -15,9 +15,11 @@
 #include "bag/ros1/bag_writer.h"
 #include "bag/ros1/message_encoding.h"
 #include "common/geometry/euler_angles.h"
+#include "common/imu/imu_units.h"
 #include "common/io/eigen_proto.h"
 #include "common/io/provenance.h"
 #include "common/io/text_proto.h"
+#include "stages/simulate/imu_schedule.h"
 #include "stages/simulate/point_cloud_layout.h"
 #include "stages/simulate/random.h"
 #include "tiltcal/proto/rig.pb.h"
@@ -28,9 +30,6 @@ namespace {
 
 constexpr double kDegToRad = M_PI / 180.0;
 constexpr double kRadToDeg = 180.0 / M_PI;
-// Random stream of the IMU noise and of the random obstacles.
-constexpr uint64_t kImuStream = 0;
-constexpr uint64_t kWorldStream = 1;
 // Largest stamp a ROS time can hold.
 constexpr int64_t kMaxRosTimeNs = 4294967295LL * 1000000000LL;
 
@@ -206,8 +205,9 @@ Status CheckLidarAboveGround(const PlanarTrajectory& trajectory, const ScanConfi
   return Status::Ok();
 }
 
-// Sample and sweep counts of the duration; every stamp must be a valid ROS
-// time (LiDAR stamps are true − τ).
+// Sample and sweep counts of the duration and the two clocks; every stamp
+// must be a valid ROS time. LiDAR stamps are IMU clock − τ: when the first
+// would be negative, the IMU clock starts at start_stamp_ns + τ instead.
 Status SetTiming(const proto::SimulateParams& params, Scenario* scenario) {
   const ScanConfig& sc = scenario->scan;
   const int64_t duration_ns = std::llround(params.duration_s() * 1e9);
@@ -221,12 +221,16 @@ Status SetTiming(const proto::SimulateParams& params, Scenario* scenario) {
                          " is too short for one LiDAR sweep after lidar.first_scan_time_s");
   }
   scenario->num_scans = scans;
-  scenario->time_offset_ns = std::llround(params.rig().time_offset_s() * 1e9);
+  const int64_t tau_ns = std::llround(params.rig().time_offset_s() * 1e9);
   const int64_t start = params.start_stamp_ns();
-  if (start + SweepStartNs(sc, 0) - scenario->time_offset_ns < 0 ||
-      start + duration_ns + std::abs(scenario->time_offset_ns) > kMaxRosTimeNs) {
+  scenario->time_offset_ns = tau_ns;
+  scenario->imu_clock_shift_ns = start + SweepStartNs(sc, 0) - tau_ns < 0 ? tau_ns : 0;
+  scenario->imu_start_stamp_ns = start + scenario->imu_clock_shift_ns;
+  // The latest stamp: the last IMU sample, or a LiDAR stamp |τ| later for τ < 0.
+  if (scenario->imu_start_stamp_ns + duration_ns + std::max<int64_t>(0, -tau_ns) >
+      kMaxRosTimeNs) {
     return Status::Error("field start_stamp_ns = " + std::to_string(start) +
-                         " gives stamps outside the ROS time range with this duration and "
+                         " gives stamps beyond the ROS time range with this duration and "
                          "rig.time_offset_s");
   }
   return Status::Ok();
@@ -247,6 +251,7 @@ Status BuildScenario(const proto::SimulateParams& params, Scenario* scenario) {
   TILTCAL_RETURN_IF_ERROR(CheckLidarAboveGround(trajectory, scenario->scan));
   scenario->world = MakeWorld(params, trajectory);
   scenario->gravity_w = Eigen::Vector3d(0.0, 0.0, -params.gravity_norm_mps2());
+  TILTCAL_RETURN_IF_ERROR(SimFaultParamsAreValid(params.faults(), params.duration_s()));
   return SetTiming(params, scenario);
 }
 
@@ -269,40 +274,54 @@ bool IsTerminal(const std::ostream* log) {
   return (log == &std::cerr || log == &std::clog) && ::isatty(STDERR_FILENO);
 }
 
-// The IMU: samples at rate_hz from the start stamp, with
+// The units the IMU messages are published in (SimFaultParams).
+imu::AccelUnit PublishedAccelUnit(const proto::SimFaultParams& faults) {
+  return faults.imu_accel_unit() == proto::SimFaultParams::G ? imu::AccelUnit::kStandardGravity
+                                                             : imu::AccelUnit::kMetresPerSecond2;
+}
+imu::GyroUnit PublishedGyroUnit(const proto::SimFaultParams& faults) {
+  return faults.imu_gyro_unit() == proto::SimFaultParams::DEGPS
+             ? imu::GyroUnit::kDegreesPerSecond
+             : imu::GyroUnit::kRadiansPerSecond;
+}
+
+// The IMU: samples at rate_hz from the IMU clock's start, with
 //   ω_m = ω_b + b_g + n_g,   f_m = C_wb^T (r̈_w − g_w) + b_a + n_a,
 // white noise σ = density · sqrt(rate), bias random walk σ = density / sqrt(rate),
-// from its own random stream.
+// from its own random stream. Every sample is simulated at its nominal time;
+// the schedule (imu_schedule.h) gives its header stamp and whether it is
+// written; the values are written in the units of params.faults (SI / factor).
 class ImuSimulator {
  public:
   ImuSimulator(const proto::SimulateParams& params, const Scenario& scenario)
       : params_(params.imu()),
         scenario_(scenario),
-        start_ns_(params.start_stamp_ns()),
-        rng_(params.seed(), kImuStream),
+        schedule_(MakeImuSchedule(scenario.num_imu_samples, params_.rate_hz(),
+                                  scenario.imu_start_stamp_ns, params.faults(), params.seed())),
+        rng_(params.seed(), kImuNoiseStream),
         rate_(params_.rate_hz()),
         gyro_sigma_(params_.gyro_noise_density_radps_sqrthz() * std::sqrt(rate_)),
         accel_sigma_(params_.accel_noise_density_mps2_sqrthz() * std::sqrt(rate_)),
         gyro_walk_(params_.gyro_bias_random_walk_radps2_sqrthz() / std::sqrt(rate_)),
         accel_walk_(params_.accel_bias_random_walk_mps3_sqrthz() / std::sqrt(rate_)),
+        gyro_published_per_si_(1.0 / imu::ToSiFactor(PublishedGyroUnit(params.faults()))),
+        accel_published_per_si_(1.0 / imu::ToSiFactor(PublishedAccelUnit(params.faults()))),
         gyro_bias_(ToEigen(params_.gyro_bias_radps())),
         accel_bias_(ToEigen(params_.accel_bias_mps2())),
         last_gyro_bias_(gyro_bias_),
         last_accel_bias_(accel_bias_) {}
 
-  int64_t StampNs(int i) const {
-    return start_ns_ + std::llround(static_cast<double>(i) * 1e9 / rate_);
-  }
-
-  // Writes the samples up to `stamp_ns` (all of them for INT64_MAX) not yet written.
+  // Simulates the samples stamped up to `stamp_ns` (all of them for
+  // INT64_MAX) not yet simulated, and writes those the schedule keeps.
   Status WriteUpTo(int64_t stamp_ns, uint32_t connection, ros1::BagWriter* writer) {
-    while (next_ < scenario_.num_imu_samples && StampNs(next_) <= stamp_ns) {
-      TILTCAL_RETURN_IF_ERROR(WriteSample(next_++, connection, writer));
+    while (next_ < scenario_.num_imu_samples && schedule_.stamp_ns[next_] <= stamp_ns) {
+      TILTCAL_RETURN_IF_ERROR(SimulateSample(next_++, connection, writer));
     }
     return Status::Ok();
   }
 
   double max_yaw_rate() const { return max_yaw_rate_; }
+  int num_dropped() const { return schedule_.num_dropped; }
   // The biases of the last sample.
   const Eigen::Vector3d& last_gyro_bias() const { return last_gyro_bias_; }
   const Eigen::Vector3d& last_accel_bias() const { return last_accel_bias_; }
@@ -313,8 +332,8 @@ class ImuSimulator {
     return Eigen::Vector3d(x, y, z);
   }
 
-  Status WriteSample(int i, uint32_t connection, ros1::BagWriter* writer) {
-    const int64_t rel_ns = StampNs(i) - start_ns_;
+  Status SimulateSample(int i, uint32_t connection, ros1::BagWriter* writer) {
+    const int64_t rel_ns = NominalImuStampNs(0, rate_, i);
     const ImuState s = scenario_.trajectory->Evaluate(rel_ns * 1e-9);
     max_yaw_rate_ = std::max(max_yaw_rate_, std::abs(s.yaw_rate_radps));
     const Eigen::Vector3d omega = s.angular_velocity_b + gyro_bias_ + gyro_sigma_ * Gaussian3();
@@ -325,20 +344,26 @@ class ImuSimulator {
     last_accel_bias_ = accel_bias_;
     gyro_bias_ += gyro_walk_ * Gaussian3();
     accel_bias_ += accel_walk_ * Gaussian3();
-    if (!ros1::SerializeImu(static_cast<uint32_t>(i), StampNs(i), params_.frame_id(), omega,
-                            force, gyro_sigma_ * gyro_sigma_, accel_sigma_ * accel_sigma_,
-                            &message_)) {
+    if (!schedule_.kept[i]) return Status::Ok();
+    const int64_t stamp_ns = schedule_.stamp_ns[i];
+    const double gyro_sigma = gyro_sigma_ * gyro_published_per_si_;
+    const double accel_sigma = accel_sigma_ * accel_published_per_si_;
+    if (!ros1::SerializeImu(static_cast<uint32_t>(i), stamp_ns, params_.frame_id(),
+                            omega * gyro_published_per_si_, force * accel_published_per_si_,
+                            gyro_sigma * gyro_sigma, accel_sigma * accel_sigma, &message_)) {
       return Status::Error("IMU stamp of sample " + std::to_string(i) + " is not a ROS time");
     }
-    return writer->Write(connection, StampNs(i), message_);
+    return writer->Write(connection, stamp_ns, message_);
   }
 
   const proto::SimImuParams& params_;
   const Scenario& scenario_;
-  const int64_t start_ns_;
+  const ImuSchedule schedule_;
   Rng rng_;
   const double rate_;
   const double gyro_sigma_, accel_sigma_, gyro_walk_, accel_walk_;
+  // Published value = SI value × this (1 in SI units).
+  const double gyro_published_per_si_, accel_published_per_si_;
   Eigen::Vector3d gyro_bias_, accel_bias_;
   Eigen::Vector3d last_gyro_bias_, last_accel_bias_;
   int next_ = 0;
@@ -407,11 +432,11 @@ void FillSequenceTruth(const proto::SimulateParams& params, const Scenario& scen
   *truth->mutable_ground_normal_in_world() = ToProto(f.n_w);
   truth->set_ground_roll_deg(params.ground_roll_deg());
   truth->set_ground_pitch_deg(params.ground_pitch_deg());
-  truth->set_start_stamp_ns(params.start_stamp_ns());
+  truth->set_start_stamp_ns(scenario.imu_start_stamp_ns);
   *truth->mutable_ground_normal_in_world_a() = ToProto(Eigen::Vector3d(f.c_aw * f.n_w));
   truth->set_ground_offset_in_world_m(params.rig().imu_height_m());
   truth->set_lidar_model(sc.model.name);
-  truth->set_num_imu_samples(static_cast<uint32_t>(scenario.num_imu_samples));
+  truth->set_num_imu_samples(static_cast<uint32_t>(scenario.num_imu_samples - imu.num_dropped()));
   truth->set_max_yaw_rate_radps(imu.max_yaw_rate());
   truth->set_mean_speed_mps(params.trajectory().speed_mps());
   truth->set_range_noise_m(params.lidar().range_noise_m());
@@ -419,17 +444,22 @@ void FillSequenceTruth(const proto::SimulateParams& params, const Scenario& scen
   truth->set_accel_noise_density_mps2_sqrthz(ip.accel_noise_density_mps2_sqrthz());
   *truth->mutable_world_from_sim_world() = RigidToProto(f.c_aw, -f.c_aw * f.r_wb0);
   truth->set_inclination_deg(AngleDeg(f.n_w, f.up_w));
+  truth->set_time_offset_ns(scenario.time_offset_ns);
+  truth->set_imu_clock_shift_ns(scenario.imu_clock_shift_ns);
+  if (params.has_faults()) *truth->mutable_faults() = params.faults();
+  truth->set_num_imu_samples_dropped(static_cast<uint32_t>(imu.num_dropped()));
 }
 
 // The rig a user would have measured: the true extrinsic with the errors of
-// params.rig_file.
+// params.rig_file, C_meas = C(rotation_error_in_imu_deg) C_bl C(rotation_error_deg).
 proto::Rig MakeRig(const proto::SimulateParams& params, const Scenario& scenario,
                    const TruthFrames& f) {
   const auto& rf = params.rig_file();
   const ScanConfig& sc = scenario.scan;
   proto::Rig rig;
   *rig.mutable_imu_from_lidar() = RigidToProto(
-      sc.imu_from_lidar_rotation *
+      geometry::RotationFromEuler123Deg(ToEigen(rf.rotation_error_in_imu_deg())) *
+          sc.imu_from_lidar_rotation *
           geometry::RotationFromEuler123Deg(ToEigen(rf.rotation_error_deg())),
       sc.imu_from_lidar_translation + ToEigen(rf.translation_error_m()));
   rig.set_imu_height_m(params.rig().imu_height_m());
@@ -472,7 +502,7 @@ class ScanWriter {
         TILTCAL_RETURN_IF_ERROR(imu->WriteUpTo(stamp, imu_conn, writer));
         TILTCAL_RETURN_IF_ERROR(writer->Write(lidar_conn, stamp, messages_[j]));
         summary->num_points += scans_[j].num_valid;
-        FillTruthScan(scenario_, frames, scans_[j], params_.start_stamp_ns(), stamp,
+        FillTruthScan(scenario_, frames, scans_[j], scenario_.imu_start_stamp_ns, stamp,
                       truth->add_scans());
         if (progress != nullptr) {
           *progress << fmt::format("\rtiltcal_simulate: scan {} / {}{}", k + 1, num_scans,
@@ -485,9 +515,9 @@ class ScanWriter {
   }
 
  private:
-  // The bag stamp of a sweep (LiDAR clock: true − τ).
+  // The bag stamp of a sweep (LiDAR clock = IMU clock − τ).
   int64_t StampNs(const SimulatedScan& scan) const {
-    return params_.start_stamp_ns() + scan.stamp_true_ns - scenario_.time_offset_ns;
+    return scenario_.imu_start_stamp_ns + scan.stamp_true_ns - scenario_.time_offset_ns;
   }
 
   // Simulates and serializes sweeps first .. first + count - 1.
@@ -539,7 +569,8 @@ Status Run(const SimulatePaths& paths, const proto::SimulateParams& params, std:
     return Status::Error("--out_bag and --out_truth are required");
   }
   Scenario scenario;
-  TILTCAL_RETURN_IF_ERROR(BuildScenario(params, &scenario));
+  const Status built = BuildScenario(params, &scenario);
+  if (!built.ok()) return paths.params.empty() ? built : built.WithContext(paths.params);
   unsigned threads = params.num_threads();
   if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
   ros1::BagWriter writer;

@@ -43,9 +43,14 @@ struct Scenario {
   int num_imu_samples = 0;
   int num_scans = 0;
   int64_t time_offset_ns = 0;       // τ in ns
+  // IMU clock at the first IMU sample: start_stamp_ns, plus τ when the
+  // LiDAR clock (IMU clock − τ) would otherwise be negative at a sweep.
+  int64_t imu_start_stamp_ns = 0;
+  int64_t imu_clock_shift_ns = 0;   // imu_start_stamp_ns − start_stamp_ns (0 or τ)
 };
 // Checks the params beyond their schema bounds (ranges, room size, sensor
-// above the ground, stamps representable) and builds the scenario.
+// above the ground, stamps representable, the faults' gaps) and builds the
+// scenario.
 Status BuildScenario(const proto::SimulateParams& params, Scenario* scenario);
 
 }  // namespace tiltcal::simulate
