@@ -34,7 +34,7 @@ StaticDetectionOptions StaticOptions() {
 TEST(DetectAccelUnit, MetresPerSecondSquared) {
   const std::vector<ImuReading> readings = Readings();
   const AccelUnitEvidence evidence =
-      DetectAccelUnit(readings, DetectStaticIntervals(readings, StaticOptions()));
+      DetectAccelUnit(readings, DetectStaticIntervals(readings, StaticOptions()), UnitBand());
   EXPECT_TRUE(evidence.from_static_samples);
   EXPECT_NEAR(evidence.median_norm, 9.81, 0.02);
   ASSERT_TRUE(evidence.unit.has_value());
@@ -44,7 +44,7 @@ TEST(DetectAccelUnit, MetresPerSecondSquared) {
 TEST(DetectAccelUnit, StandardGravityWithAndWithoutStaticSamples) {
   std::vector<ImuReading> readings = Readings();
   for (ImuReading& r : readings) r.linear_acceleration_mps2 /= kStandardGravityMps2;
-  const AccelUnitEvidence evidence = DetectAccelUnit(readings, {});
+  const AccelUnitEvidence evidence = DetectAccelUnit(readings, {}, UnitBand());
   EXPECT_FALSE(evidence.from_static_samples);
   EXPECT_NEAR(evidence.median_norm, 9.81 / kStandardGravityMps2, 0.01);
   ASSERT_TRUE(evidence.unit.has_value());
@@ -54,8 +54,8 @@ TEST(DetectAccelUnit, StandardGravityWithAndWithoutStaticSamples) {
 TEST(DetectAccelUnit, ImplausibleScaleHasNoUnit) {
   std::vector<ImuReading> readings = Readings();
   for (ImuReading& r : readings) r.linear_acceleration_mps2 *= 100.0;  // cm/s² or a broken driver
-  EXPECT_FALSE(DetectAccelUnit(readings, {}).unit.has_value());
-  EXPECT_FALSE(DetectAccelUnit({}, {}).unit.has_value());
+  EXPECT_FALSE(DetectAccelUnit(readings, {}, UnitBand()).unit.has_value());
+  EXPECT_FALSE(DetectAccelUnit({}, {}, UnitBand()).unit.has_value());
 }
 
 TEST(GyroUnitFromScale, RadiansDegreesAndNeither) {
