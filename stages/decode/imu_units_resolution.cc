@@ -93,15 +93,20 @@ Status ResolveGyroUnit(const std::vector<imu::ImuReading>& published, const prot
   return Status::Ok();
 }
 
-// The accelerometer's unit from the rig's statement and the specific force.
-Status ResolveAccelUnit(const std::vector<imu::ImuReading>& readings,
-                        const std::vector<imu::StaticInterval>& static_intervals,
-                        const proto::Rig& rig, const ImuUnitsSources& sources,
-                        const proto::ImuUnitsParams& params, ImuUnitsResolution* resolution) {
+imu::UnitBand AccelBand(const proto::ImuUnitsParams& params) {
   imu::UnitBand band;
   band.min_ratio = params.accel_norm_ratio_min();
   band.max_ratio = params.accel_norm_ratio_max();
-  const imu::AccelUnitEvidence evidence = imu::DetectAccelUnit(readings, static_intervals, band);
+  return band;
+}
+
+// The accelerometer's unit from the rig's statement and the specific force.
+Status ResolveAccelUnit(const std::vector<imu::ImuReading>& published,
+                        const std::vector<imu::StaticInterval>& static_intervals,
+                        const proto::Rig& rig, const ImuUnitsSources& sources,
+                        const proto::ImuUnitsParams& params, ImuUnitsResolution* resolution) {
+  const imu::UnitBand band = AccelBand(params);
+  const imu::AccelUnitEvidence evidence = imu::DetectAccelUnit(published, static_intervals, band);
   const std::string evidence_text = AccelEvidenceText(evidence);
   if (!evidence.unit) {
     return Status::Error(fmt::format(
@@ -141,7 +146,7 @@ double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
 // imu_from_lidar (an assumption, as a LiDAR may be mounted upside down, and
 // the rig's rotation may be what is wrong: a warning). An IMU's own +z says
 // nothing: drivers publish in z-up (FLU) and z-down (FRD) frames alike.
-Status CheckForceSign(const std::vector<imu::ImuReading>& readings,
+Status CheckForceSign(const std::vector<imu::ImuReading>& published,
                       const std::vector<imu::StaticInterval>& static_intervals,
                       const proto::Rig& rig, const ImuUnitsSources& sources,
                       const proto::ImuUnitsParams& params, ImuUnitsResolution* resolution) {
@@ -151,7 +156,7 @@ Status CheckForceSign(const std::vector<imu::ImuReading>& readings,
         "frame");
     return Status::Ok();
   }
-  const imu::RestForce rest = imu::MeanRestForce(readings, static_intervals);
+  const imu::RestForce rest = imu::MeanRestForce(published, static_intervals);
   const Eigen::Vector3d mean_mps2 = rest.mean * resolution->accel_to_si;
   const std::string samples = SamplesText(rest.num_samples, rest.from_static_samples);
   const double min_norm_mps2 = params.accel_norm_ratio_min() * imu::kStandardGravityMps2;
@@ -212,16 +217,22 @@ Status ResolveImuUnits(const std::vector<imu::ImuReading>& published, const prot
                        ImuUnitsResolution* resolution) {
   *resolution = ImuUnitsResolution();
   TILTCAL_RETURN_IF_ERROR(ResolveGyroUnit(published, rig, sources, params, resolution));
-  // Still intervals with the gyro in rad/s (the bounds of the static
-  // detection are in rad/s); the accelerometer is still as published, which
-  // in g only loosens its bound.
-  std::vector<imu::ImuReading> readings = published;
-  for (imu::ImuReading& r : readings) r.angular_velocity_radps *= resolution->gyro_to_si;
-  const std::vector<imu::StaticInterval> static_intervals = imu::DetectStaticIntervals(
-      readings, ToStaticDetectionOptions(params.static_detection()));
+  // Still intervals on the readings in SI (the bounds of the static detection
+  // are in rad/s and m/s²): the gyro as resolved, the accelerometer in the
+  // unit its median norm over all samples points to, so that the same motion
+  // in other units gives the same intervals.
+  const imu::AccelUnitEvidence overall = imu::DetectAccelUnit(published, {}, AccelBand(params));
+  const double accel_guess_to_si = overall.unit ? imu::ToSiFactor(*overall.unit) : 1.0;
+  std::vector<imu::ImuReading> si = published;
+  for (imu::ImuReading& r : si) {
+    r.angular_velocity_radps *= resolution->gyro_to_si;
+    r.linear_acceleration_mps2 *= accel_guess_to_si;
+  }
+  const std::vector<imu::StaticInterval> static_intervals =
+      imu::DetectStaticIntervals(si, ToStaticDetectionOptions(params.static_detection()));
   TILTCAL_RETURN_IF_ERROR(
-      ResolveAccelUnit(readings, static_intervals, rig, sources, params, resolution));
-  return CheckForceSign(readings, static_intervals, rig, sources, params, resolution);
+      ResolveAccelUnit(published, static_intervals, rig, sources, params, resolution));
+  return CheckForceSign(published, static_intervals, rig, sources, params, resolution);
 }
 
 }  // namespace tiltcal::decode
