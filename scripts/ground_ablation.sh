@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Ground-residual ablation (issue 6 item 4): simulates a level and a tilted
+# Ground-residual ablation (docs/design.md §8): simulates a level and a tilted
 # (8 deg pitch, 3 deg roll) sequence with the Husky-like rig, runs decode,
 # ground and gravity once per sequence, then tiltcal_calibrate once per
 # ground-residual set (params overrides: each residual forced ON or OFF), and
@@ -117,12 +117,12 @@ write_params() {  # set out_file
   for r in flat dist incl up; do
     local mode=OFF
     [[ "+$set+" == *"+$r+"* || "+$set+" == *"+${r}L2+"* ]] && mode=ON
-    script+=(-e "s/^$r \\{ mode: [A-Z]+/$r { mode: $mode/")
-    [[ "+$set+" == *"+${r}L2+"* ]] && script+=(-e "/^$r \\{/s/cauchy_scale: [0-9.eE+-]+/cauchy_scale: 0/")
+    script+=(-e "s/^( *)$r \\{ mode: [A-Z]+/\\1$r { mode: $mode/")
+    [[ "+$set+" == *"+${r}L2+"* ]] && script+=(-e "/^ *$r \\{/s/cauchy_scale: [0-9.eE+-]+/cauchy_scale: 0/")
   done
   sed -E "${script[@]}" "$WORK/base_calibrate_params.txtpb" > "$out"
   for r in flat dist incl up; do
-    grep -q "^$r { mode: " "$out" || { log "no '$r { mode: ...' line in the default params"; exit 1; }
+    grep -Eq "^ *$r \\{ mode: " "$out" || { log "no '$r { mode: ...' line in the default params"; exit 1; }
   done
 }
 

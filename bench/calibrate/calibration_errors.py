@@ -118,7 +118,7 @@ def main():
     rot = angle_deg(quat(cal, 'imu_from_lidar.rotation'), quat(truth, 'imu_from_lidar.rotation'))
     rig_rot = angle_deg(quat(rig, 'imu_from_lidar.rotation'), quat(truth, 'imu_from_lidar.rotation'))
     tau = (get(cal, 'time_offset_s') - get(truth, 'time_offset_s')) * 1e3
-    print('errors vs truth (issue 5 bounds: rotation <= 0.1 deg, planar translation <= 1 cm, '
+    print('errors vs truth (targets: rotation <= 0.1 deg, planar translation <= 1 cm, '
           'tau <= 0.5 ms):')
     print('  rotation            %.4f deg   (rig: %.3f deg)' % (rot, rig_rot))
     print('  translation b-x/y/z %.3f / %.3f / %.3f cm   (rig: %.1f / %.1f / %.1f cm)' % (

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# tiltcal_calibrate benchmark (issue 5 item 8, DESIGN §6): simulates a
+# tiltcal_calibrate benchmark (docs/design.md §13): simulates a
 # sequence (default: the 60 s, 200 Hz, VLP-16 flat-ground Husky sequence
 # stages/simulate/scenarios/flat_vlp16.txtpb), runs decode -> ground ->
 # gravity -> calibrate, and prints
@@ -9,7 +9,7 @@
 #   - the errors against the simulator's truth: rotation (deg), translation
 #     per axis of b and in the plane of motion (cm), tau (ms).
 # Anchor measured in the same run: the sequence length (x_realtime =
-# duration_s / calibrate wall). Targets of issue 5: whole stage <= 60 s wall on 2 cores,
+# duration_s / calibrate wall). Targets: whole stage <= 60 s wall on 2 cores,
 # <= 0.25 s per LM iteration.
 #
 # Usage: bench/calibrate/run_calibrate_bench.sh [options]
@@ -20,8 +20,8 @@
 #   --seed N           override the simulator seed (noise and world)
 #   --params FILE      calibrate params (default stages/calibrate/default_params.txtpb)
 #   --threads N        num_threads of the calibrator (default 2)
-#   --ground MODE      off (default: LiDAR + IMU only, the accuracy setting of
-#                      issue 5) or auto (ground residuals as the params say;
+#   --ground MODE      off (default: LiDAR + IMU only, the setting the accuracy
+#                      targets are stated for) or auto (ground residuals as the params say;
 #                      g_f comes with the rig, from the simulator, so tilted
 #                      scenarios need no flat reference run)
 set -euo pipefail

@@ -1,7 +1,7 @@
 #ifndef TILTCAL_STAGES_CALIBRATE_ACCEL_COST_FUNCTION_H_
 #define TILTCAL_STAGES_CALIBRATE_ACCEL_COST_FUNCTION_H_
 
-// Accelerometer residual of one IMU sample at IMU time t (DESIGN §5):
+// Accelerometer residual of one IMU sample at IMU time t (docs/design.md §6):
 //   r = (C_ab(t)^T (r''_a(t) - g_a) + b_a - f_m) / sigma_a     (3, dimensionless)
 // C_ab(t): SO(3) spline (IMU b -> world a); r''_a(t): second time derivative
 // of the R^3 position spline r_a^{ba}(t), m/s^2.

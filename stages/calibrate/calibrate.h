@@ -1,13 +1,14 @@
 #ifndef TILTCAL_STAGES_CALIBRATE_CALIBRATE_H_
 #define TILTCAL_STAGES_CALIBRATE_CALIBRATE_H_
 
-// tiltcal_calibrate: the continuous-time LiDAR-IMU calibration (issue 5).
+// tiltcal_calibrate: the continuous-time LiDAR-IMU calibration
+// (docs/design.md §3, §6-§11).
 //
 // Pipeline (Calibrate):
 //   initialisation (initialisation.h): IMU bias / gravity, gyro rotation
 //     spline, LiDAR odometry on deskewed scans, extrinsic from the rig (or
 //     hand-eye when excited), position spline;
-//   outer iterations (outer_iterations): surfel map + association with the
+//   outer iterations (OuterLoopParams): surfel map + association with the
 //     current state (lidar_association.h), problem build
 //     (problem_builder.h: gyro, accel, point-to-plane, ground when available),
 //     LM solve (SPARSE_NORMAL_CHOLESKY);

@@ -1,8 +1,8 @@
 #ifndef TILTCAL_STAGES_CALIBRATE_CALIBRATION_STATE_H_
 #define TILTCAL_STAGES_CALIBRATE_CALIBRATION_STATE_H_
 
-// The estimated quantities of the calibrator (DESIGN §5), stored as the
-// parameter blocks of the ceres::Problem. Every pointer handed to Ceres points
+// The estimated quantities of the calibrator (docs/design.md §5, §6), stored
+// as the parameter blocks of the ceres::Problem. Every pointer handed to Ceres points
 // into this struct (or into the SplineTrajectory it owns), so the struct must
 // not move while a Problem refers to it.
 //
@@ -32,7 +32,7 @@
 //                                b_g the rotation spline away from the
 //                                LiDAR's; one segment for the whole sequence
 //                                when the segment length is 0.
-// Gauge (DESIGN §5: C_ab(t0) = 1, r_a^{ba}(t0) = 0): the builder holds the
+// Gauge (C_ab(t0) = 1, r_a^{ba}(t0) = 0; docs/design.md §6): the builder holds the
 // first knots constant (see problem_builder.h).
 //
 // Residuals that use the time offset pick their knot window from the CURRENT
@@ -41,10 +41,10 @@
 // point_to_plane_cost_function.h). The problem is rebuilt, and the windows
 // re-chosen, at every outer iteration.
 //
-// Code that adds more residuals (e.g. the ground residuals of issue 6) only
-// calls problem->AddResidualBlock with these pointers; it must not add the
-// blocks itself, change their manifolds or bounds, or hold the pointers
-// beyond the life of the Problem.
+// Code that adds more residuals (e.g. the ground residuals,
+// ground_residuals.h) only calls problem->AddResidualBlock with these
+// pointers; it must not add the blocks itself, change their manifolds or
+// bounds, or hold the pointers beyond the life of the Problem.
 
 #include <array>
 #include <vector>

@@ -98,7 +98,7 @@ void AddGroup(const Eigen::Matrix3d& cov_block, const Eigen::Matrix3d& to_b, int
 }  // namespace
 
 void FillCovarianceReport(const Matrix7d& covariance, const Eigen::Matrix3d& c_bl,
-                          const MotionAxis& motion, const ObservabilityThresholds& thresholds,
+                          const MotionAxis& motion, const proto::ObservabilityParams& params,
                           proto::CalibrationResult* result) {
   result->clear_covariance();
   for (int i = 0; i < 7; ++i) {
@@ -117,18 +117,18 @@ void FillCovarianceReport(const Matrix7d& covariance, const Eigen::Matrix3d& c_b
 
   result->clear_observability();
   // Marginal covariance of each group is the corresponding block.
-  AddGroup(covariance.block<3, 3>(0, 0), c_bl, 0, rad_to_deg, thresholds.rotation_sigma_deg,
+  AddGroup(covariance.block<3, 3>(0, 0), c_bl, 0, rad_to_deg, params.weak_rotation_sigma_deg(),
            "rotation", "deg", motion, result);
   AddGroup(covariance.block<3, 3>(3, 3), Eigen::Matrix3d::Identity(), 3, 1.0,
-           thresholds.translation_sigma_m, "translation", "m", motion, result);
+           params.weak_translation_sigma_m(), "translation", "m", motion, result);
   const double tau_sigma = std::sqrt(std::max(0.0, covariance(6, 6)));
   proto::ObservabilityDirection* d = result->add_observability();
   for (int j = 0; j < 7; ++j) d->add_direction(j == 6 ? 1.0 : 0.0);
   d->set_sigma(tau_sigma);
-  d->set_weak(tau_sigma > thresholds.time_offset_sigma_s);
+  d->set_weak(tau_sigma > params.weak_time_offset_sigma_s());
   char buf[128];
   std::snprintf(buf, sizeof(buf), "time offset: sigma %.4g s%s", tau_sigma,
-                tau_sigma > thresholds.time_offset_sigma_s ? " -- WEAK" : "");
+                tau_sigma > params.weak_time_offset_sigma_s() ? " -- WEAK" : "");
   d->set_description(buf);
 }
 

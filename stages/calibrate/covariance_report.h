@@ -2,7 +2,7 @@
 #define TILTCAL_STAGES_CALIBRATE_COVARIANCE_REPORT_H_
 
 // Covariance of the calibration (C_bl, r_b^{lb}, tau) from the final
-// Jacobian, and the observability report (DESIGN §5).
+// Jacobian, and the observability report (docs/design.md §11).
 //
 // Covariance: ceres::Covariance (SPARSE_QR, robust loss applied) of the
 // blocks C_bl, r_b^{lb}, tau in the TANGENT space, 7x7 in the order
@@ -32,6 +32,7 @@
 #include "common/imu/imu_reading.h"
 #include "common/status.h"
 #include "stages/calibrate/calibration_state.h"
+#include "tiltcal/proto/calibrate_params.pb.h"
 #include "tiltcal/proto/calibration.pb.h"
 
 namespace tiltcal::calibrate {
@@ -54,17 +55,13 @@ MotionAxis PrincipalRotationAxis(const std::vector<imu::ImuReading>& samples,
 Status ComputeExtrinsicCovariance(ceres::Problem* problem, CalibrationState* state,
                                   int num_threads, Matrix7d* covariance);
 
-struct ObservabilityThresholds {
-  double rotation_sigma_deg = 0.1;
-  double translation_sigma_m = 0.01;
-  double time_offset_sigma_s = 0.001;
-};
-
 // Writes covariance, rotation_sigma_deg, translation_sigma_m,
-// time_offset_sigma_s and the observability directions into *result.
+// time_offset_sigma_s and the observability directions into *result; a
+// direction is weak when its sigma exceeds params.weak_rotation_sigma_deg,
+// weak_translation_sigma_m or weak_time_offset_sigma_s.
 // c_bl: the estimated C_bl (to express rotation directions in b).
 void FillCovarianceReport(const Matrix7d& covariance, const Eigen::Matrix3d& c_bl,
-                          const MotionAxis& motion, const ObservabilityThresholds& thresholds,
+                          const MotionAxis& motion, const proto::ObservabilityParams& params,
                           proto::CalibrationResult* result);
 
 // "x", "y", "z" of the dominant component and the direction, e.g.

@@ -1,7 +1,7 @@
 #ifndef TILTCAL_STAGES_CALIBRATE_GROUND_COST_FUNCTIONS_H_
 #define TILTCAL_STAGES_CALIBRATE_GROUND_COST_FUNCTIONS_H_
 
-// Ground-plane residuals of the calibrator (DESIGN §5, paper "Proposed
+// Ground-plane residuals of the calibrator (docs/design.md §8, paper "Proposed
 // Method"), one scan k at a time. The scan's ground plane (n_l, d_l) is in
 // the LiDAR frame l at the scan stamp t_k (LiDAR clock): unit normal n_l
 // pointing up, d_l > 0 the LiDAR's distance to the plane, ground points

@@ -35,10 +35,6 @@ const char* ModeName(proto::GroundResidualParams::Mode mode) {
   }
 }
 
-double SigmaOr(const proto::GroundResidualParams& p, double fallback) {
-  return p.sigma() > 0.0 ? p.sigma() : fallback;
-}
-
 std::unique_ptr<ceres::LossFunction> MakeLoss(const proto::GroundResidualParams& p) {
   if (!(p.cauchy_scale() > 0.0)) return nullptr;
   return std::make_unique<ceres::CauchyLoss>(p.cauchy_scale());
@@ -77,7 +73,7 @@ Eigen::Matrix3d WhiteningMatrix(double sigma, const Eigen::Matrix3d& extra) {
 
 }  // namespace
 
-GroundLosses::GroundLosses(const proto::CalibrateParams& params)
+GroundLosses::GroundLosses(const proto::GroundResidualsParams& params)
     : flat_(MakeLoss(params.flat())),
       dist_(MakeLoss(params.dist())),
       incl_(MakeLoss(params.incl())),
@@ -119,7 +115,8 @@ std::string GroundResidualSelection::Names() const {
   return names.empty() ? "none" : names;
 }
 
-Status SelectGroundResiduals(const proto::CalibrateParams& params, const GroundSequenceInfo& info,
+Status SelectGroundResiduals(const proto::GroundResidualsParams& params,
+                             const GroundSequenceInfo& info,
                              GroundResidualSelection* selection) {
   *selection = GroundResidualSelection();
   const bool have_db = info.imu_height_m > 0.0;
@@ -137,7 +134,7 @@ Status SelectGroundResiduals(const proto::CalibrateParams& params, const GroundS
   const Mode::Mode dist_mode = params.dist().mode();
   if (dist_mode == Mode::ON && !have_db) {
     return Status::Error(
-        "params: dist.mode = ON needs the IMU height d_b (rig imu_height_m > 0)");
+        "params: ground.dist.mode = ON needs the IMU height d_b (rig imu_height_m > 0)");
   }
   selection->dist = dist_mode == Mode::ON || (dist_mode == Mode::AUTO && have_db);
   note("dist", dist_mode, selection->dist,
@@ -154,7 +151,7 @@ Status SelectGroundResiduals(const proto::CalibrateParams& params, const GroundS
   const Mode::Mode incl_mode = params.incl().mode();
   if (incl_mode == Mode::ON && !have_gf) {
     return Status::Error(
-        "params: incl.mode = ON needs the flat-ground gravity g_f (gravity reference or rig "
+        "params: ground.incl.mode = ON needs the flat-ground gravity g_f (gravity reference or rig "
         "gravity_flat_in_imu)");
   }
   const bool tilted = info.level_known && !info.is_level;
@@ -166,7 +163,7 @@ Status SelectGroundResiduals(const proto::CalibrateParams& params, const GroundS
   const Mode::Mode up_mode = params.up().mode();
   if (up_mode == Mode::ON && !have_gf) {
     return Status::Error(
-        "params: up.mode = ON needs the flat-ground gravity g_f (gravity reference or rig "
+        "params: ground.up.mode = ON needs the flat-ground gravity g_f (gravity reference or rig "
         "gravity_flat_in_imu)");
   }
   selection->up = up_mode == Mode::ON;
@@ -186,9 +183,137 @@ std::string GroundResidualSummary::ToString() const {
   return buffer;
 }
 
+namespace {
+
+Status RequireBlock(const ceres::Problem& problem, const double* block, const char* name) {
+  if (!problem.HasParameterBlock(block)) {
+    return Status::Error(std::string("ground residuals: parameter block ") + name +
+                         " is not in the problem");
+  }
+  return Status::Ok();
+}
+
+// The state's blocks the selected residuals use must already be in the
+// problem with their manifolds.
+Status RequireStateBlocks(const GroundResidualSelection& selection, const CalibrationState& state,
+                          const ceres::Problem& problem) {
+  TILTCAL_RETURN_IF_ERROR(
+      RequireBlock(problem, state.imu_from_lidar_rotation, "imu_from_lidar_rotation"));
+  if (selection.dist) {
+    TILTCAL_RETURN_IF_ERROR(
+        RequireBlock(problem, state.imu_from_lidar_translation, "imu_from_lidar_translation"));
+  }
+  if (selection.flat || selection.incl) {
+    TILTCAL_RETURN_IF_ERROR(RequireBlock(problem, state.gravity_direction, "gravity_direction"));
+    TILTCAL_RETURN_IF_ERROR(RequireBlock(problem, state.time_offset_s, "time_offset_s"));
+  }
+  return Status::Ok();
+}
+
+// What the residuals of every plane share within one AddGroundResiduals call.
+struct GroundBuild {
+  const GroundResidualSelection& selection;
+  const proto::GroundResidualsParams& params;
+  const GroundSequenceInfo& info;
+  const GroundLosses& losses;
+  // Current state values, for propagating the plane covariance: C_bl,
+  // C_bl^T r_b^{lb} and the unit gravity direction n_g.
+  Eigen::Matrix3d c_bl;
+  Eigen::Vector3d r_l;
+  Eigen::Vector3d gravity_dir;
+};
+
+// One usable plane of scan k: (n_l, d_l) at LiDAR time t_k, its knot window
+// and, when asked for and usable, its fit covariance.
+struct GroundPlaneSample {
+  Eigen::Vector3d normal;
+  double height_m = 0.0;
+  double t_k = 0.0;
+  spline::KnotWindow window;
+  bool has_covariance = false;
+  Eigen::Matrix4d covariance = Eigen::Matrix4d::Zero();
+};
+
+// Adds the selected residuals of one plane.
+Status AddPlaneResiduals(const GroundBuild& build, const GroundPlaneSample& plane,
+                         CalibrationState* state, ceres::Problem* problem,
+                         GroundResidualSummary* summary) {
+  const GroundResidualSelection& selection = build.selection;
+  const proto::GroundResidualsParams& params = build.params;
+  const spline::UniformKnotGrid& grid = state->trajectory.grid();
+  const Eigen::Matrix3d cov_nn = plane.covariance.topLeftCorner<3, 3>();
+  double* knots[4] = {nullptr, nullptr, nullptr, nullptr};
+  double segment_start_s = 0.0;
+  if (selection.flat || selection.incl) {
+    for (int i = 0; i < 4; ++i) {
+      knots[i] = state->trajectory.rotation_knot(plane.window.first_knot + i);
+      TILTCAL_RETURN_IF_ERROR(RequireBlock(*problem, knots[i], "rotation knot"));
+    }
+    segment_start_s = grid.SegmentStart(plane.window.first_knot);
+  }
+  if (selection.flat) {
+    const Eigen::Matrix3d extra = plane.has_covariance && params.flat().use_plane_covariance()
+                                      ? cov_nn
+                                      : Eigen::Matrix3d::Zero();
+    auto* cost = new FlatGroundCostFunction(segment_start_s, grid.inv_dt(), plane.t_k, plane.normal,
+                                            WhiteningMatrix(params.flat().sigma(), extra));
+    problem->AddResidualBlock(cost, build.losses.flat(), knots[0], knots[1], knots[2], knots[3],
+                              state->gravity_direction, state->imu_from_lidar_rotation,
+                              state->time_offset_s);
+    ++summary->num_flat;
+  }
+  if (selection.dist) {
+    double variance = params.dist().sigma() * params.dist().sigma();
+    if (plane.has_covariance && params.dist().use_plane_covariance()) {
+      Eigen::Vector4d j;
+      j << -build.r_l, 1.0;
+      variance += j.dot(plane.covariance * j);
+    }
+    auto* cost = new DistanceCostFunction(plane.normal, plane.height_m, build.info.imu_height_m,
+                                          1.0 / std::sqrt(variance));
+    problem->AddResidualBlock(cost, build.losses.dist(), state->imu_from_lidar_rotation,
+                              state->imu_from_lidar_translation);
+    ++summary->num_dist;
+  }
+  if (selection.incl) {
+    double variance = params.incl().sigma() * params.incl().sigma();
+    if (plane.has_covariance && params.incl().use_plane_covariance()) {
+      // g~_b at the current state: -C_ab(t)^T n_g.
+      const double* const const_knots[4] = {knots[0], knots[1], knots[2], knots[3]};
+      spline::So3SplineSample s;
+      spline::EvaluateSo3Spline(
+          const_knots, (plane.t_k + state->time_offset_s[0] - segment_start_s) * grid.inv_dt(),
+          grid.inv_dt(), spline::kSo3Rotation, &s);
+      const Eigen::Vector3d up_l =
+          build.c_bl.transpose() * (-(s.rotation.transpose() * build.gravity_dir));
+      variance += up_l.dot(cov_nn * up_l);
+    }
+    auto* cost = new InclinationCostFunction(segment_start_s, grid.inv_dt(), plane.t_k,
+                                             plane.normal, build.info.gravity_flat_in_imu,
+                                             1.0 / std::sqrt(variance));
+    problem->AddResidualBlock(cost, build.losses.incl(), knots[0], knots[1], knots[2], knots[3],
+                              state->gravity_direction, state->imu_from_lidar_rotation,
+                              state->time_offset_s);
+    ++summary->num_incl;
+  }
+  if (selection.up) {
+    const Eigen::Matrix3d extra = plane.has_covariance && params.up().use_plane_covariance()
+                                      ? cov_nn
+                                      : Eigen::Matrix3d::Zero();
+    auto* cost = new UpCostFunction(plane.normal, build.info.gravity_flat_in_imu,
+                                    WhiteningMatrix(params.up().sigma(), extra));
+    problem->AddResidualBlock(cost, build.losses.up(), state->imu_from_lidar_rotation);
+    ++summary->num_up;
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
 Status AddGroundResiduals(const std::vector<proto::GroundPlane>& planes,
                           const GroundResidualSelection& selection,
-                          const proto::CalibrateParams& params, const GroundSequenceInfo& info,
+                          const proto::GroundResidualsParams& params,
+                          const GroundSequenceInfo& info,
                           const GroundLosses& losses, int64_t time_origin_ns,
                           CalibrationState* state, ceres::Problem* problem,
                           GroundResidualSummary* summary) {
@@ -201,129 +326,42 @@ Status AddGroundResiduals(const std::vector<proto::GroundPlane>& planes,
   if ((selection.incl || selection.up) && !info.has_gravity_flat) {
     return Status::Error("ground residuals: incl/up selected without the flat-ground gravity g_f");
   }
-  const bool spline_residuals = selection.flat || selection.incl;
-  // The blocks must already be in the problem with their manifolds.
-  auto need = [&](const double* block, const char* name) -> Status {
-    if (!problem->HasParameterBlock(block)) {
-      return Status::Error(std::string("ground residuals: parameter block ") + name +
-                           " is not in the problem");
-    }
-    return Status::Ok();
-  };
-  TILTCAL_RETURN_IF_ERROR(need(state->imu_from_lidar_rotation, "imu_from_lidar_rotation"));
-  if (selection.dist) {
-    TILTCAL_RETURN_IF_ERROR(need(state->imu_from_lidar_translation, "imu_from_lidar_translation"));
-  }
-  if (spline_residuals) {
-    TILTCAL_RETURN_IF_ERROR(need(state->gravity_direction, "gravity_direction"));
-    TILTCAL_RETURN_IF_ERROR(need(state->time_offset_s, "time_offset_s"));
-  }
-
-  const spline::UniformKnotGrid& grid = state->trajectory.grid();
-  const double sigma_flat = SigmaOr(params.flat(), kDefaultFlatSigma);
-  const double sigma_dist = SigmaOr(params.dist(), kDefaultDistSigmaM);
-  const double sigma_incl = SigmaOr(params.incl(), kDefaultInclSigma);
-  const double sigma_up = SigmaOr(params.up(), kDefaultUpSigma);
+  TILTCAL_RETURN_IF_ERROR(RequireStateBlocks(selection, *state, *problem));
   const bool want_covariance =
       (selection.flat && params.flat().use_plane_covariance()) ||
       (selection.dist && params.dist().use_plane_covariance()) ||
       (selection.incl && params.incl().use_plane_covariance()) ||
       (selection.up && params.up().use_plane_covariance());
-
-  // Current state values, for propagating the plane covariance.
-  const Eigen::Matrix3d c_bl = state->ImuFromLidarRotation().toRotationMatrix();
-  const Eigen::Vector3d r_l = c_bl.transpose() * state->ImuFromLidarTranslation();
-  const Eigen::Vector3d gravity_dir =
-      Eigen::Vector3d(state->gravity_direction[0], state->gravity_direction[1],
-                      state->gravity_direction[2])
-          .normalized();
+  GroundBuild build{selection, params, info, losses, Eigen::Matrix3d::Zero(),
+                    Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  build.c_bl = state->ImuFromLidarRotation().toRotationMatrix();
+  build.r_l = build.c_bl.transpose() * state->ImuFromLidarTranslation();
+  build.gravity_dir = Eigen::Vector3d(state->gravity_direction[0], state->gravity_direction[1],
+                                      state->gravity_direction[2])
+                          .normalized();
 
   for (const proto::GroundPlane& plane : planes) {
-    Eigen::Vector3d normal;
-    double height_m = 0.0;
-    if (!UsablePlane(plane, &normal, &height_m)) {
+    GroundPlaneSample sample;
+    if (!UsablePlane(plane, &sample.normal, &sample.height_m)) {
       ++summary->num_invalid;
       continue;
     }
-    const double t_k = static_cast<double>(plane.stamp_ns() - time_origin_ns) * 1e-9;
-    spline::KnotWindow window;
-    if (!state->TimeWindow(t_k, &window)) {
+    sample.t_k = static_cast<double>(plane.stamp_ns() - time_origin_ns) * 1e-9;
+    if (!state->TimeWindow(sample.t_k, &sample.window)) {
       ++summary->num_outside_spline;
       continue;
     }
-    Eigen::Matrix4d covariance = Eigen::Matrix4d::Zero();
-    const bool has_covariance = want_covariance && PlaneCovariance(plane, &covariance);
-    if (want_covariance && !has_covariance) ++summary->num_without_covariance;
-    const Eigen::Matrix3d cov_nn = covariance.topLeftCorner<3, 3>();
+    sample.has_covariance = want_covariance && PlaneCovariance(plane, &sample.covariance);
+    if (want_covariance && !sample.has_covariance) ++summary->num_without_covariance;
     ++summary->num_used;
-
-    double* knots[4] = {nullptr, nullptr, nullptr, nullptr};
-    double segment_start_s = 0.0;
-    if (spline_residuals) {
-      for (int i = 0; i < 4; ++i) {
-        knots[i] = state->trajectory.rotation_knot(window.first_knot + i);
-        TILTCAL_RETURN_IF_ERROR(need(knots[i], "rotation knot"));
-      }
-      segment_start_s = grid.SegmentStart(window.first_knot);
-    }
-
-    if (selection.flat) {
-      const Eigen::Matrix3d extra =
-          has_covariance && params.flat().use_plane_covariance() ? cov_nn : Eigen::Matrix3d::Zero();
-      auto* cost = new FlatGroundCostFunction(segment_start_s, grid.inv_dt(), t_k, normal,
-                                              WhiteningMatrix(sigma_flat, extra));
-      problem->AddResidualBlock(cost, losses.flat(), knots[0], knots[1], knots[2],
-                                knots[3], state->gravity_direction, state->imu_from_lidar_rotation,
-                                state->time_offset_s);
-      ++summary->num_flat;
-    }
-    if (selection.dist) {
-      double variance = sigma_dist * sigma_dist;
-      if (has_covariance && params.dist().use_plane_covariance()) {
-        Eigen::Vector4d j;
-        j << -r_l, 1.0;
-        variance += j.dot(covariance * j);
-      }
-      auto* cost =
-          new DistanceCostFunction(normal, height_m, info.imu_height_m, 1.0 / std::sqrt(variance));
-      problem->AddResidualBlock(cost, losses.dist(), state->imu_from_lidar_rotation,
-                                state->imu_from_lidar_translation);
-      ++summary->num_dist;
-    }
-    if (selection.incl) {
-      double variance = sigma_incl * sigma_incl;
-      if (has_covariance && params.incl().use_plane_covariance()) {
-        // g~_b at the current state: -C_ab(t)^T n_g.
-        const double* const const_knots[4] = {knots[0], knots[1], knots[2], knots[3]};
-        spline::So3SplineSample s;
-        spline::EvaluateSo3Spline(const_knots, (t_k + state->time_offset_s[0] - segment_start_s) *
-                                                   grid.inv_dt(),
-                                  grid.inv_dt(), spline::kSo3Rotation, &s);
-        const Eigen::Vector3d up_l = c_bl.transpose() * (-(s.rotation.transpose() * gravity_dir));
-        variance += up_l.dot(cov_nn * up_l);
-      }
-      auto* cost = new InclinationCostFunction(segment_start_s, grid.inv_dt(), t_k, normal,
-                                               info.gravity_flat_in_imu, 1.0 / std::sqrt(variance));
-      problem->AddResidualBlock(cost, losses.incl(), knots[0], knots[1], knots[2],
-                                knots[3], state->gravity_direction, state->imu_from_lidar_rotation,
-                                state->time_offset_s);
-      ++summary->num_incl;
-    }
-    if (selection.up) {
-      const Eigen::Matrix3d extra =
-          has_covariance && params.up().use_plane_covariance() ? cov_nn : Eigen::Matrix3d::Zero();
-      auto* cost = new UpCostFunction(normal, info.gravity_flat_in_imu,
-                                      WhiteningMatrix(sigma_up, extra));
-      problem->AddResidualBlock(cost, losses.up(), state->imu_from_lidar_rotation);
-      ++summary->num_up;
-    }
+    TILTCAL_RETURN_IF_ERROR(AddPlaneResiduals(build, sample, state, problem, summary));
   }
   return Status::Ok();
 }
 
 Status MakeGroundResidualAdder(
     const std::vector<proto::GroundPlane>& planes, int64_t time_origin_ns, const proto::Rig& rig,
-    const proto::GravityReference* gravity, const proto::CalibrateParams& params,
+    const proto::GravityReference* gravity, const proto::GroundResidualsParams& params,
     const GroundLosses* losses, std::ostream* log,
     std::function<Status(CalibrationState*, ceres::Problem*, int*)>* adder,
     std::vector<std::string>* used, std::string* reason) {

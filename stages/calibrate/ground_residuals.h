@@ -1,7 +1,7 @@
 #ifndef TILTCAL_STAGES_CALIBRATE_GROUND_RESIDUALS_H_
 #define TILTCAL_STAGES_CALIBRATE_GROUND_RESIDUALS_H_
 
-// Which ground residuals the calibrator uses (DESIGN §5, issue 6) and the
+// Which ground residuals the calibrator uses (docs/design.md §8) and the
 // function that adds them to the ceres::Problem. The residuals themselves are
 // in ground_cost_functions.h:
 //   flat  e_flat = n_l - C_bl^T g~_b                  (3, level ground only)
@@ -9,7 +9,7 @@
 //   incl  e_incl = g~_b^T (g~_f - C_bl n_l)            (1, needs g_f)
 //   up    e_up   = C_bl n_l - g~_f                     (3, needs g_f)
 //
-// Selection (CalibrateParams.{flat,dist,incl,up}.mode; AUTO = default):
+// Selection (GroundResidualsParams.{flat,dist,incl,up}.mode; AUTO = default):
 //   dist  AUTO -> on when d_b > 0 (Rig.imu_height_m);
 //   flat  AUTO -> on when the sequence is level (GravityReference.is_level);
 //   incl  AUTO -> on when the sequence is tilted and g_f is known;
@@ -19,7 +19,7 @@
 // OFF forces it off.
 //
 // Weighting, per residual type and per plane (k = flat, dist, incl, up):
-//   sigma_k = params.k.sigma, or the built-in default below when 0;
+//   sigma_k = params.k.sigma (> 0);
 //   without params.k.use_plane_covariance: W = I / sigma_k (w = 1 / sigma_k);
 //   with it, the plane fit's covariance Sigma of (n_l, d_l)
 //   (GroundPlane.covariance, 4x4) is propagated to the residual at the state
@@ -62,12 +62,6 @@
 
 namespace tiltcal::calibrate {
 
-// Built-in sigmas, used when params.k.sigma is 0.
-inline constexpr double kDefaultFlatSigma = 0.02;   // unit-vector units (~1.1 deg)
-inline constexpr double kDefaultDistSigmaM = 0.02;  // m
-inline constexpr double kDefaultInclSigma = 0.001;  // cosine units (~sin(slope) x normal error)
-inline constexpr double kDefaultUpSigma = 0.02;     // unit-vector units (~1.1 deg)
-
 // What the dataset says about the sequence.
 struct GroundSequenceInfo {
   double imu_height_m = 0.0;  // d_b, m; 0 = unknown
@@ -97,7 +91,8 @@ struct GroundResidualSelection {
 
 // Applies the modes of params to info. Errors (one line, naming the param)
 // when a residual is forced ON without its input.
-Status SelectGroundResiduals(const proto::CalibrateParams& params, const GroundSequenceInfo& info,
+Status SelectGroundResiduals(const proto::GroundResidualsParams& params,
+                             const GroundSequenceInfo& info,
                              GroundResidualSelection* selection);
 
 // The robust losses of the four residual types, each shared by all blocks of
@@ -107,7 +102,7 @@ Status SelectGroundResiduals(const proto::CalibrateParams& params, const GroundS
 // CalibrationProblem does), and this object must outlive it.
 class GroundLosses {
  public:
-  explicit GroundLosses(const proto::CalibrateParams& params);
+  explicit GroundLosses(const proto::GroundResidualsParams& params);
   ceres::LossFunction* flat() const { return flat_.get(); }  // null = no robust loss
   ceres::LossFunction* dist() const { return dist_.get(); }
   ceres::LossFunction* incl() const { return incl_.get(); }
@@ -136,7 +131,8 @@ struct GroundResidualSummary {
 // as the spline grid (the first IMU stamp).
 Status AddGroundResiduals(const std::vector<proto::GroundPlane>& planes,
                           const GroundResidualSelection& selection,
-                          const proto::CalibrateParams& params, const GroundSequenceInfo& info,
+                          const proto::GroundResidualsParams& params,
+                          const GroundSequenceInfo& info,
                           const GroundLosses& losses, int64_t time_origin_ns,
                           CalibrationState* state, ceres::Problem* problem,
                           GroundResidualSummary* summary);
@@ -152,7 +148,7 @@ Status AddGroundResiduals(const std::vector<proto::GroundPlane>& planes,
 // line per call with the GroundResidualSummary.
 Status MakeGroundResidualAdder(
     const std::vector<proto::GroundPlane>& planes, int64_t time_origin_ns, const proto::Rig& rig,
-    const proto::GravityReference* gravity, const proto::CalibrateParams& params,
+    const proto::GravityReference* gravity, const proto::GroundResidualsParams& params,
     const GroundLosses* losses, std::ostream* log,
     std::function<Status(CalibrationState*, ceres::Problem*, int*)>* adder,
     std::vector<std::string>* used, std::string* reason);

@@ -1,7 +1,7 @@
 #ifndef TILTCAL_STAGES_CALIBRATE_GYRO_COST_FUNCTION_H_
 #define TILTCAL_STAGES_CALIBRATE_GYRO_COST_FUNCTION_H_
 
-// Gyroscope residual of one IMU sample at IMU time t (DESIGN §5):
+// Gyroscope residual of one IMU sample at IMU time t (docs/design.md §6):
 //   r = (omega_b(t) + b_g - omega_m) / sigma_g          (3, dimensionless)
 // omega_b(t): body angular velocity of the SO(3) spline C_ab (Sommer recursion).
 //

@@ -52,10 +52,10 @@ Eigen::Vector3d LogQ(const Eigen::Quaterniond& q_in) {
 }  // namespace
 
 HandEyeResult EstimateHandEyeRotation(const std::vector<RotationPair>& pairs,
-                                      const HandEyeOptions& options) {
+                                      const proto::HandEyeParams& params) {
   HandEyeResult result;
   result.num_pairs = static_cast<int>(pairs.size());
-  if (pairs.empty() || result.num_pairs < options.min_pairs) return result;
+  if (pairs.empty() || result.num_pairs < static_cast<int>(params.min_pairs())) return result;
 
   Eigen::MatrixXd a(4 * pairs.size(), 4);
   double sum_h_sq = 0.0;
@@ -64,7 +64,7 @@ HandEyeResult EstimateHandEyeRotation(const std::vector<RotationPair>& pairs,
     const Eigen::Quaterniond qb = pairs[i].imu_delta.normalized();
     const Eigen::Quaterniond ql = pairs[i].lidar_delta.normalized();
     const double difference_deg = std::abs(Angle(qb) - Angle(ql)) * kRadToDeg;
-    const double h = difference_deg <= options.consistent_angle_deg ? 1.0 : 1.0 / difference_deg;
+    const double h = difference_deg <= params.consistent_angle_deg() ? 1.0 : 1.0 / difference_deg;
     // Same sign convention (w >= 0) for both: conjugation keeps w, so the
     // consistent pair satisfies the equation without a sign flip.
     Eigen::Quaterniond qb_pos = qb, ql_pos = ql;
@@ -91,7 +91,7 @@ HandEyeResult EstimateHandEyeRotation(const std::vector<RotationPair>& pairs,
   result.excitation_rad = result.singular_values(2) / std::sqrt(sum_h_sq);
   result.excitation_ratio =
       result.singular_values(0) > 0.0 ? result.singular_values(2) / result.singular_values(0) : 0.0;
-  result.excited = result.excitation_rad >= options.min_excitation_rad;
+  result.excited = result.excitation_rad >= params.min_excitation_rad();
 
   double sum_sq = 0.0;
   for (const RotationPair& p : pairs) {

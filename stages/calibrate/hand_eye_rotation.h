@@ -25,6 +25,8 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "tiltcal/proto/calibrate_params.pb.h"
+
 namespace tiltcal::calibrate {
 
 struct RotationPair {
@@ -32,18 +34,9 @@ struct RotationPair {
   Eigen::Quaterniond lidar_delta = Eigen::Quaterniond::Identity();  // C_{l_i l_j}
 };
 
-struct HandEyeOptions {
-  int min_pairs = 15;
-  // Accept the estimate when excitation_rad >= this (rad).
-  double min_excitation_rad = 0.02;
-  // Pairs whose rotation angles differ by more than this get weight
-  // 1 / (difference in deg) instead of 1 (OA-Calib: 1 deg).
-  double consistent_angle_deg = 1.0;
-};
-
 struct HandEyeResult {
   bool solved = false;    // enough pairs, SVD done
-  bool excited = false;   // solved and excitation_rad >= min_excitation_rad: use the estimate
+  bool excited = false;   // solved and excitation_rad >= params.min_excitation_rad: use it
   Eigen::Quaterniond imu_from_lidar_rotation = Eigen::Quaterniond::Identity();  // C_bl
   Eigen::Vector4d singular_values = Eigen::Vector4d::Zero();  // of A, descending
   double excitation_rad = 0.0;       // s[2] / sqrt(sum h^2)
@@ -56,8 +49,12 @@ struct HandEyeResult {
   int num_pairs = 0;
 };
 
+// Solved with at least params.min_pairs pairs; a pair whose IMU and LiDAR
+// rotation angles differ by more than params.consistent_angle_deg gets weight
+// 1 / (difference in deg) instead of 1 (OA-Calib: 1 deg); excited when
+// excitation_rad >= params.min_excitation_rad.
 HandEyeResult EstimateHandEyeRotation(const std::vector<RotationPair>& pairs,
-                                      const HandEyeOptions& options);
+                                      const proto::HandEyeParams& params);
 
 // Pairs (k, k + step) for k = 0, step, 2 step, ... from absolute rotations of
 // the same instants: imu_rotations[k] = C_ab(t_k), lidar_rotations[k] =

@@ -9,6 +9,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "common/imu/gyro_integrator.h"
+#include "common/io/static_detection_params.h"
 #include "common/spline/cubic_basis.h"
 #include "common/spline/so3_spline.h"
 #include "stages/calibrate/covariance_report.h"
@@ -61,16 +62,33 @@ class LidarPositionSampleCost final : public ceres::SizedCostFunction<3, 3, 3, 3
   double inv_sigma_;
 };
 
-ProblemOptions FitOptions(const InitialisationOptions& options) {
+// The initial fits hold the extrinsic, tau, gravity and the biases unless
+// told otherwise.
+ProblemOptions FitOptions(const proto::CalibrateParams& params) {
   ProblemOptions p;
-  p.gyro_sigma_radps = options.gyro_sigma_radps;
-  p.accel_sigma_mps2 = options.accel_sigma_mps2;
-  p.accel_bias_random_walk = options.accel_bias_random_walk;
+  p.time_offset_bound_s = params.time_offset_bound_s();
+  p.time_offset_step_bound_s = params.outer_loop().time_offset_step_bound_s();
   p.estimate_extrinsic = false;
   p.estimate_time_offset = false;
   p.estimate_gravity = false;
   p.estimate_biases = false;
   return p;
+}
+
+// The IMU noise of the initial fits: the gyro bias segments stay untied (the
+// gyro fit holds them, the position fit has no gyro residual).
+proto::ImuNoiseParams FitImuNoise(const proto::CalibrateParams& params) {
+  proto::ImuNoiseParams noise = params.imu_noise();
+  noise.set_gyro_bias_random_walk_radps2_sqrthz(0.0);
+  return noise;
+}
+
+imu::ImuInitialisationOptions ImuInitialisationOptionsFrom(const proto::CalibrateParams& params) {
+  imu::ImuInitialisationOptions options;
+  options.static_detection = ToStaticDetectionOptions(params.static_detection());
+  options.gravity_norm_mps2 = params.gravity_norm_mps2();
+  options.fallback_window_s = params.init().fallback_window_s();
+  return options;
 }
 
 double RmsResidual(const ceres::Solver::Summary& summary) {
@@ -79,9 +97,10 @@ double RmsResidual(const ceres::Solver::Summary& summary) {
 }
 
 // LM on one of the initial fits; returns the RMS weighted residual.
-double SolveFit(const InitialisationOptions& options, ceres::Problem* problem) {
+double SolveFit(const proto::CalibrateParams& params, ceres::Problem* problem) {
   const ceres::Solver::Options solver =
-      MakeSolverOptions(options.solver_iterations, options.num_threads, 1e-10);
+      MakeSolverOptions(static_cast<int>(params.init().solver_iterations()),
+                        static_cast<int>(params.num_threads()), params.init().function_tolerance());
   ceres::Solver::Summary summary;
   ceres::Solve(solver, problem, &summary);
   return RmsResidual(summary);
@@ -171,7 +190,7 @@ double SearchTimeOffset(const CalibrationState& state, const std::vector<double>
 }
 
 double FitRotationSplineToGyro(const std::vector<imu::ImuReading>& imu_samples,
-                               const InitialisationOptions& options, CalibrationState* state) {
+                               const proto::CalibrateParams& params, CalibrationState* state) {
   spline::SplineTrajectory& traj = state->trajectory;
   const spline::UniformKnotGrid& grid = traj.grid();
   const imu::GyroIntegrator integrator(imu_samples, state->GyroBias());
@@ -179,21 +198,21 @@ double FitRotationSplineToGyro(const std::vector<imu::ImuReading>& imu_samples,
   for (int i = 0; i < traj.num_knots(); ++i) {
     traj.SetRotationKnot(i, integrator.Rotation(grid.t0_s() + (i - 1) * grid.dt_s()));
   }
-  CalibrationProblem problem(state, FitOptions(options));
+  CalibrationProblem problem(state, FitImuNoise(params), params.lidar(), FitOptions(params));
   problem.AddImuResiduals(imu_samples, /*gyro=*/true, /*accel=*/false);
   problem.RemoveUnusedKnots();
-  return SolveFit(options, problem.problem());
+  return SolveFit(params, problem.problem());
 }
 
 double RefineRotationSpline(const std::vector<double>& times_s,
                             const std::vector<Eigen::Quaterniond>& orientations_a_from_b,
                             const std::vector<imu::ImuReading>& imu_samples,
-                            const InitialisationOptions& options, CalibrationState* state) {
+                            const proto::CalibrateParams& params, CalibrationState* state) {
   spline::SplineTrajectory& traj = state->trajectory;
   const spline::UniformKnotGrid& grid = traj.grid();
-  CalibrationProblem problem(state, FitOptions(options));
+  CalibrationProblem problem(state, FitImuNoise(params), params.lidar(), FitOptions(params));
   problem.AddImuResiduals(imu_samples, /*gyro=*/true, /*accel=*/false);
-  const double sigma = options.odometry_rotation_sigma_rad;
+  const double sigma = params.init().odometry_rotation_sigma_deg() * M_PI / 180.0;
   Status status = problem.AddExtraResiduals([&](CalibrationState* s, ceres::Problem* p, int* added) {
     for (size_t k = 0; k < times_s.size(); ++k) {
       spline::KnotWindow w;
@@ -209,13 +228,14 @@ double RefineRotationSpline(const std::vector<double>& times_s,
   });
   (void)status;
   problem.RemoveUnusedKnots();
-  return SolveFit(options, problem.problem());
+  return SolveFit(params, problem.problem());
 }
 
 double FitPositionSpline(const std::vector<double>& times_s,
                          const std::vector<Eigen::Vector3d>& lidar_positions_a,
                          const std::vector<imu::ImuReading>& imu_samples,
-                         const InitialisationOptions& options, CalibrationState* state) {
+                         const proto::CalibrateParams& params,
+                         const Eigen::Vector3d& translation_prior_axis_b, CalibrationState* state) {
   spline::SplineTrajectory& traj = state->trajectory;
   const spline::UniformKnotGrid& grid = traj.grid();
   // C_ab at the sample times (held) and the IMU positions they imply with
@@ -242,18 +262,18 @@ double FitPositionSpline(const std::vector<double>& times_s,
   // lever arm r_b^{lb} (prior at its current value): a wrong one makes the
   // IMU positions p_l - C_ab r_b^{lb} swing with the heading, which the
   // accelerometer contradicts.
-  ProblemOptions fit = FitOptions(options);
+  ProblemOptions fit = FitOptions(params);
   fit.estimate_biases = true;
   fit.estimate_gravity = true;
   fit.fix_first_knots = false;  // the position samples pin the gauge
-  fit.estimate_extrinsic = options.translation_prior_sigma_m > 0.0;
+  fit.translation_prior_sigma_m = params.extrinsic_translation_prior_sigma_m();
+  fit.estimate_extrinsic = fit.translation_prior_sigma_m > 0.0;
   fit.translation_prior_m = r_bl;
-  fit.translation_prior_sigma_m = options.translation_prior_sigma_m;
-  fit.translation_prior_axis_b = options.translation_prior_axis_b;
-  CalibrationProblem problem(state, fit);
+  fit.translation_prior_axis_b = translation_prior_axis_b;
+  CalibrationProblem problem(state, FitImuNoise(params), params.lidar(), fit);
   problem.SetRotationKnotsConstant();
   problem.AddImuResiduals(imu_samples, /*gyro=*/false, /*accel=*/true);
-  const double sigma = options.position_sigma_m;
+  const double sigma = params.init().odometry_position_sigma_m();
   Status status = problem.AddExtraResiduals(
       [&](CalibrationState* s, ceres::Problem* p, int* added) {
         for (size_t k = 0; k < times.size(); ++k) {
@@ -273,17 +293,165 @@ double FitPositionSpline(const std::vector<double>& times_s,
       });
   (void)status;
   problem.RemoveUnusedKnots();  // C_bl and tau: no residual here uses them
-  return SolveFit(options, problem.problem());
+  return SolveFit(params, problem.problem());
 }
+
+namespace {
+
+// Step 3: the odometry's poses and, per pose, its scan and C_ab at the scan
+// stamp (tau = 0).
+struct OdometryRun {
+  std::vector<LidarOdometryPose> poses;
+  std::vector<int> scan_of_pose;
+  std::vector<Eigen::Quaterniond> imu_rotations;
+  // Of the poses used further on (pose 0 and every registered one): their
+  // indices, C_ab and C_{l0 lk}.
+  std::vector<size_t> used;
+  std::vector<Eigen::Quaterniond> imu_used;
+  std::vector<Eigen::Quaterniond> lidar_used;
+};
+
+// Deskews scan k with the state's rotation spline and the rig's C_bl,
+// T_{lk a} T_{a l(t_j)} p, into *deskewed. False when the sweep is outside
+// the spline.
+bool DeskewScan(const CalibrationState& state, const LidarScan& scan, double node_spacing_s,
+                ScanPoseTable* table, std::vector<Eigen::Vector3f>* deskewed) {
+  if (!table->Build(state, scan, node_spacing_s)) return false;
+  Eigen::Quaterniond q_k;
+  Eigen::Vector3d t_k;
+  table->Interpolate(0.0, &q_k, &t_k);
+  const Eigen::Quaterniond q_k_inv = q_k.conjugate();
+  deskewed->resize(scan.points.size());
+  for (size_t j = 0; j < scan.points.size(); ++j) {
+    Eigen::Quaterniond q;
+    Eigen::Vector3d t;
+    table->Interpolate(scan.point_time_s[j], &q, &t);
+    (*deskewed)[j] = (q_k_inv * (q * scan.points[j].cast<double>() + t - t_k)).cast<float>();
+  }
+  return true;
+}
+
+// Odometry on scans deskewed with the rotation spline (positions are still
+// zero, so only rotation and the lever arm move the points).
+OdometryRun RunOdometry(const std::vector<LidarScan>& scans, const CalibrationState& state,
+                        const proto::CalibrateParams& params, InitialisationReport* report) {
+  LidarOdometry odometry(params.odometry(), params.scans());
+  const spline::SplineTrajectory& traj = state.trajectory;
+  const Eigen::Quaterniond c_bl = state.ImuFromLidarRotation();
+  OdometryRun run;
+  ScanPoseTable table;
+  std::vector<Eigen::Vector3f> deskewed;
+  bool have_first = false;
+  Eigen::Quaterniond c_ab_first = Eigen::Quaterniond::Identity();
+  const size_t scan_step = std::max<size_t>(params.odometry().scan_step(), 1);
+  for (size_t k = 0; k < scans.size(); k += scan_step) {
+    const LidarScan& scan = scans[k];
+    if (scan.points.empty()) continue;
+    spline::So3SplineSample rot;
+    if (!traj.Evaluate(scan.stamp_s, spline::kSo3Rotation, &rot, nullptr)) continue;
+    if (!DeskewScan(state, scan, params.init().deskew_node_spacing_s(), &table, &deskewed)) {
+      continue;
+    }
+    const Eigen::Quaterniond c_ab_k(rot.rotation);
+    if (!have_first) {
+      c_ab_first = c_ab_k;
+      have_first = true;
+    }
+    odometry.AddScan(scan.stamp_s, deskewed, LidarRotationPriorFromImu(c_ab_first, c_ab_k, c_bl));
+    run.scan_of_pose.push_back(static_cast<int>(k));
+    run.imu_rotations.push_back(c_ab_k);
+  }
+  run.poses = odometry.poses();
+  report->odometry_scans = static_cast<int>(run.poses.size());
+  double fitness = 0.0;
+  for (size_t i = 0; i < run.poses.size(); ++i) {
+    if (i > 0 && !run.poses[i].registered) continue;
+    if (i > 0) {
+      ++report->odometry_registered;
+      fitness += run.poses[i].fitness_rms_m;
+    }
+    run.used.push_back(i);
+    run.imu_used.push_back(run.imu_rotations[i]);
+    run.lidar_used.push_back(Eigen::Quaterniond(run.poses[i].l0_from_lidar.rotation()));
+  }
+  if (report->odometry_registered > 0) {
+    report->odometry_mean_fitness_m = fitness / report->odometry_registered;
+  }
+  return run;
+}
+
+// Step 4: C_bl from the rig, or hand-eye when excited; without excitation
+// the rig's C_bl aligned to the motion's rotation axis.
+Eigen::Quaterniond InitialExtrinsicRotation(const OdometryRun& run,
+                                            const Eigen::Quaterniond& measured_imu_from_lidar,
+                                            const proto::CalibrateParams& params,
+                                            InitialisationReport* report) {
+  const int pair_step = std::max(1, static_cast<int>(params.hand_eye().pair_step()));
+  report->hand_eye = EstimateHandEyeRotation(
+      MakeRotationPairs(run.imu_used, run.lidar_used, pair_step), params.hand_eye());
+  Eigen::Quaterniond c_bl_init = ChooseInitialRotation(measured_imu_from_lidar, report->hand_eye);
+  report->rotation_from_hand_eye = report->hand_eye.excited;
+  if (!report->rotation_from_hand_eye && params.init().align_rotation_axis()) {
+    // Planar motion: the rotation axis is still seen by both sensors.
+    const std::vector<RotationPair> pairs =
+        MakeRotationPairs(run.imu_used, run.lidar_used, pair_step);
+    const Eigen::Quaterniond aligned = AlignRotationAxes(pairs, c_bl_init);
+    const double correction_deg =
+        Eigen::AngleAxisd(aligned * c_bl_init.conjugate()).angle() * 180.0 / M_PI;
+    if (correction_deg <= params.init().max_axis_alignment_deg()) {
+      c_bl_init = aligned;
+      report->axis_alignment_deg = correction_deg;
+      report->axis_alignment_applied = true;
+    }
+  }
+  return c_bl_init;
+}
+
+// Step 4c: the rotation spline refitted to the gyro and the odometry's
+// orientations carried to b, C_ab(t_k + tau) = C_ab(t_f + tau) C_bl
+// C_{l0 lk} C_bl^T (f: the first registered scan). Returns the anchor
+// C_ab(t_f + tau) (identity when no scan is inside the spline).
+Eigen::Quaterniond RefineHeading(const OdometryRun& run, const std::vector<LidarScan>& scans,
+                                 const std::vector<imu::ImuReading>& imu_samples,
+                                 const Eigen::Quaterniond& c_bl_init,
+                                 const proto::CalibrateParams& params, CalibrationState* state,
+                                 InitialisationReport* report) {
+  const Eigen::Quaterniond c_bl_q = c_bl_init.normalized();
+  Eigen::Quaterniond anchor = Eigen::Quaterniond::Identity();
+  std::vector<double> times;
+  std::vector<Eigen::Quaterniond> orientations;
+  bool have_anchor = false;
+  for (const size_t i : run.used) {
+    const double t_imu = scans[run.scan_of_pose[i]].stamp_s + state->time_offset_s[0];
+    spline::So3SplineSample rot;
+    if (!state->trajectory.Evaluate(t_imu, spline::kSo3Rotation, &rot, nullptr)) continue;
+    if (!have_anchor) {
+      anchor = Eigen::Quaterniond(rot.rotation);
+      have_anchor = true;
+    }
+    times.push_back(t_imu);
+    orientations.push_back(anchor * c_bl_q *
+                           Eigen::Quaterniond(run.poses[i].l0_from_lidar.rotation()) *
+                           c_bl_q.conjugate());
+  }
+  if (params.init().odometry_rotation_sigma_deg() > 0.0 && times.size() >= 2) {
+    report->rotation_refit_rms =
+        RefineRotationSpline(times, orientations, imu_samples, params, state);
+  }
+  return anchor;
+}
+
+}  // namespace
 
 Status InitialiseState(const std::vector<imu::ImuReading>& imu_samples,
                        const std::vector<LidarScan>& scans, const Rigid3d& measured_imu_from_lidar,
-                       const InitialisationOptions& options, CalibrationState* state,
+                       const proto::CalibrateParams& params, CalibrationState* state,
                        InitialisationReport* report) {
   *report = InitialisationReport();
   // 1. IMU: gyro bias, gravity.
   auto start = std::chrono::steady_clock::now();
-  TILTCAL_RETURN_IF_ERROR(imu::InitialiseImu(imu_samples, options.imu, &report->imu));
+  TILTCAL_RETURN_IF_ERROR(
+      imu::InitialiseImu(imu_samples, ImuInitialisationOptionsFrom(params), &report->imu));
   state->SetGyroBias(report->imu.gyro_bias_radps);
   state->SetAccelBias(Eigen::Vector3d::Zero());
   state->SetGravityDirection(report->imu.gravity_in_world_mps2);
@@ -298,134 +466,37 @@ Status InitialiseState(const std::vector<imu::ImuReading>& imu_samples,
 
   // 2. Rotation spline from the gyro.
   start = std::chrono::steady_clock::now();
-  report->gyro_fit_rms = FitRotationSplineToGyro(imu_samples, options, state);
+  report->gyro_fit_rms = FitRotationSplineToGyro(imu_samples, params, state);
   report->rotation_fit_seconds = Seconds(start);
 
-  // 3. Odometry on scans deskewed with the rotation spline (positions are
-  // still zero, so only rotation and the lever arm move the points).
+  // 3. Odometry.
   start = std::chrono::steady_clock::now();
-  LidarOdometry odometry(options.odometry);
-  const spline::SplineTrajectory& traj = state->trajectory;
-  const Eigen::Quaterniond c_bl = state->ImuFromLidarRotation();
-  std::vector<int> scan_of_pose;
-  std::vector<Eigen::Quaterniond> imu_rotations;
-  ScanPoseTable table;
-  std::vector<Eigen::Vector3f> deskewed;
-  bool have_first = false;
-  Eigen::Quaterniond c_ab_first = Eigen::Quaterniond::Identity();
-  const size_t scan_step = static_cast<size_t>(std::max(1, options.odometry_scan_step));
-  for (size_t k = 0; k < scans.size(); k += scan_step) {
-    const LidarScan& scan = scans[k];
-    if (scan.points.empty()) continue;
-    spline::So3SplineSample rot;
-    if (!traj.Evaluate(scan.stamp_s, spline::kSo3Rotation, &rot, nullptr)) continue;
-    if (!table.Build(*state, scan, options.deskew_node_spacing_s)) continue;
-    const Eigen::Quaterniond c_ab_k(rot.rotation);
-    if (!have_first) {
-      c_ab_first = c_ab_k;
-      have_first = true;
-    }
-    // T_{lk a} T_{a l(t_j)} p.
-    Eigen::Quaterniond q_k;
-    Eigen::Vector3d t_k;
-    table.Interpolate(0.0, &q_k, &t_k);
-    const Eigen::Quaterniond q_k_inv = q_k.conjugate();
-    deskewed.resize(scan.points.size());
-    for (size_t j = 0; j < scan.points.size(); ++j) {
-      Eigen::Quaterniond q;
-      Eigen::Vector3d t;
-      table.Interpolate(scan.point_time_s[j], &q, &t);
-      deskewed[j] = (q_k_inv * (q * scan.points[j].cast<double>() + t - t_k)).cast<float>();
-    }
-    odometry.AddScan(scan.stamp_s, deskewed, LidarRotationPriorFromImu(c_ab_first, c_ab_k, c_bl));
-    scan_of_pose.push_back(static_cast<int>(k));
-    imu_rotations.push_back(c_ab_k);
-  }
-  const std::vector<LidarOdometryPose>& poses = odometry.poses();
-  report->odometry_scans = static_cast<int>(poses.size());
+  const OdometryRun run = RunOdometry(scans, *state, params, report);
   report->odometry_seconds = Seconds(start);
-  if (poses.size() < 2) {
+  if (run.poses.size() < 2) {
     return Status::Error("too few scans inside the IMU time range for the LiDAR odometry (" +
-                         std::to_string(poses.size()) + ")");
+                         std::to_string(run.poses.size()) + ")");
   }
 
-  // 4. Extrinsic rotation: rig, or hand-eye when excited.
-  std::vector<Eigen::Quaterniond> imu_reg, lidar_reg;
-  double fitness = 0.0;
-  for (size_t i = 0; i < poses.size(); ++i) {
-    if (i > 0 && !poses[i].registered) continue;
-    if (i > 0) {
-      ++report->odometry_registered;
-      fitness += poses[i].fitness_rms_m;
-    }
-    imu_reg.push_back(imu_rotations[i]);
-    lidar_reg.push_back(Eigen::Quaterniond(poses[i].l0_from_lidar.rotation()));
-  }
-  if (report->odometry_registered > 0) {
-    report->odometry_mean_fitness_m = fitness / report->odometry_registered;
-  }
-  report->hand_eye = EstimateHandEyeRotation(
-      MakeRotationPairs(imu_reg, lidar_reg, std::max(1, options.hand_eye_pair_step)),
-      options.hand_eye);
-  Eigen::Quaterniond c_bl_init =
-      ChooseInitialRotation(measured_imu_from_lidar.rotation, report->hand_eye);
-  report->rotation_from_hand_eye = report->hand_eye.excited;
-  if (!report->rotation_from_hand_eye && options.align_rotation_axis) {
-    // Planar motion: the rotation axis is still seen by both sensors.
-    const std::vector<RotationPair> pairs =
-        MakeRotationPairs(imu_reg, lidar_reg, std::max(1, options.hand_eye_pair_step));
-    const Eigen::Quaterniond aligned = AlignRotationAxes(pairs, c_bl_init);
-    const double correction_deg =
-        Eigen::AngleAxisd(aligned * c_bl_init.conjugate()).angle() * 180.0 / M_PI;
-    if (correction_deg <= options.max_axis_alignment_deg) {
-      c_bl_init = aligned;
-      report->axis_alignment_deg = correction_deg;
-      report->axis_alignment_applied = true;
-    }
-  }
+  // 4. Extrinsic rotation.
+  const Eigen::Quaterniond c_bl_init =
+      InitialExtrinsicRotation(run, measured_imu_from_lidar.rotation, params, report);
   state->SetImuFromLidarRotation(c_bl_init);
 
-  // Coarse tau from consecutive odometry rotations against the gyro spline.
-  if (options.time_offset_search_s > 0.0) {
-    std::vector<double> times_reg;
-    for (size_t i = 0; i < poses.size(); ++i) {
-      if (i > 0 && !poses[i].registered) continue;
-      times_reg.push_back(scans[scan_of_pose[i]].stamp_s);
-    }
+  // 4b. Coarse tau from consecutive odometry rotations against the gyro spline.
+  if (params.time_offset_bound_s() > 0.0) {
+    std::vector<double> times_used;
+    for (const size_t i : run.used) times_used.push_back(scans[run.scan_of_pose[i]].stamp_s);
     report->time_offset_init_s =
-        SearchTimeOffset(*state, times_reg, lidar_reg, options.time_offset_search_s,
-                         options.time_offset_search_step_s);
+        SearchTimeOffset(*state, times_used, run.lidar_used, params.time_offset_bound_s(),
+                         params.init().time_offset_search_step_s());
     state->time_offset_s[0] = report->time_offset_init_s;
   }
 
-  // 4c. Heading: the rotation spline refitted to the gyro and the
-  // odometry's orientations carried to b, C_ab(t_k + tau) =
-  // C_ab(t_f + tau) C_bl C_{l0 lk} C_bl^T (f: the first registered scan).
+  // 4c. Heading.
   start = std::chrono::steady_clock::now();
-  const Eigen::Quaterniond c_bl_q = c_bl_init.normalized();
-  Eigen::Quaterniond anchor = Eigen::Quaterniond::Identity();  // C_ab(t_f + tau)
-  {
-    std::vector<double> times;
-    std::vector<Eigen::Quaterniond> orientations;
-    bool have_anchor = false;
-    for (size_t i = 0; i < poses.size(); ++i) {
-      if (i > 0 && !poses[i].registered) continue;
-      const double t_imu = scans[scan_of_pose[i]].stamp_s + state->time_offset_s[0];
-      spline::So3SplineSample rot;
-      if (!traj.Evaluate(t_imu, spline::kSo3Rotation, &rot, nullptr)) continue;
-      if (!have_anchor) {
-        anchor = Eigen::Quaterniond(rot.rotation);
-        have_anchor = true;
-      }
-      times.push_back(t_imu);
-      orientations.push_back(anchor * c_bl_q * Eigen::Quaterniond(poses[i].l0_from_lidar.rotation()) *
-                             c_bl_q.conjugate());
-    }
-    if (options.odometry_rotation_sigma_rad > 0.0 && times.size() >= 2) {
-      report->rotation_refit_rms =
-          RefineRotationSpline(times, orientations, imu_samples, options, state);
-    }
-  }
+  const Eigen::Quaterniond anchor =
+      RefineHeading(run, scans, imu_samples, c_bl_init, params, state, report);
   report->rotation_fit_seconds += Seconds(start);
 
   // 5. Position spline (and lever arm) from the odometry's LiDAR positions,
@@ -435,14 +506,12 @@ Status InitialiseState(const std::vector<imu::ImuReading>& imu_samples,
   const Eigen::Matrix3d c_bl_m = c_bl_init.toRotationMatrix();
   std::vector<double> times;
   std::vector<Eigen::Vector3d> positions;
-  for (size_t i = 0; i < poses.size(); ++i) {
-    if (i > 0 && !poses[i].registered) continue;
-    times.push_back(scans[scan_of_pose[i]].stamp_s + state->time_offset_s[0]);
-    positions.push_back(anchor * (c_bl_m * poses[i].l0_from_lidar.translation()));
+  for (const size_t i : run.used) {
+    times.push_back(scans[run.scan_of_pose[i]].stamp_s + state->time_offset_s[0]);
+    positions.push_back(anchor * (c_bl_m * run.poses[i].l0_from_lidar.translation()));
   }
-  InitialisationOptions fit_options = options;
-  fit_options.translation_prior_axis_b = axis.axis_b;
-  report->position_fit_rms = FitPositionSpline(times, positions, imu_samples, fit_options, state);
+  report->position_fit_rms =
+      FitPositionSpline(times, positions, imu_samples, params, axis.axis_b, state);
   report->position_fit_seconds = Seconds(start);
   return Status::Ok();
 }

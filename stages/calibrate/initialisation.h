@@ -2,7 +2,7 @@
 #define TILTCAL_STAGES_CALIBRATE_INITIALISATION_H_
 
 // Initial values of the calibration state that survive planar motion
-// (issue 5 item 4), in this order:
+// (docs/design.md §9), in this order:
 //  1. gyro bias and g_a from the static start or the first seconds
 //     (common/imu/imu_initialisation.h); accelerometer bias 0;
 //  2. rotation spline C_ab(t): knots from the integrated gyro
@@ -28,7 +28,11 @@
 //     fitted by LM together with the accelerometer residuals (rotation held;
 //     gravity direction, accelerometer bias and r_b^{lb} free, the latter
 //     with a prior at the rig's value).
-// The odometry registers every odometry_scan_step-th scan.
+// The odometry registers every LidarOdometryParams.scan_step-th scan. The
+// initialisation reads these CalibrateParams: init, imu_noise,
+// static_detection, odometry, hand_eye, scans (the odometry's range crop),
+// gravity_norm_mps2, time_offset_bound_s (the coarse tau search range),
+// extrinsic_translation_prior_sigma_m and num_threads.
 
 #include <vector>
 
@@ -40,36 +44,9 @@
 #include "stages/calibrate/hand_eye_rotation.h"
 #include "stages/calibrate/lidar_odometry.h"
 #include "stages/calibrate/lidar_scans.h"
+#include "tiltcal/proto/calibrate_params.pb.h"
 
 namespace tiltcal::calibrate {
-
-struct InitialisationOptions {
-  imu::ImuInitialisationOptions imu;
-  LidarOdometryOptions odometry;
-  HandEyeOptions hand_eye;
-  int hand_eye_pair_step = 5;        // odometry poses between the two of a rotation pair
-  int odometry_scan_step = 1;        // register every this-many-th scan
-  double gyro_sigma_radps = 0.01;
-  double accel_sigma_mps2 = 0.05;
-  double accel_bias_random_walk = 0.0;  // m/s^3/sqrt(Hz), ties the b_a segments
-  double position_sigma_m = 0.05;    // odometry position samples
-  double odometry_rotation_sigma_rad = 0.0017;  // odometry orientation samples (0 = off)
-  // Prior on r_b^{lb} at the rig's value in the position fit, along the
-  // motion's principal rotation axis (0: r_b^{lb} held).
-  double translation_prior_sigma_m = 0.05;
-  Eigen::Vector3d translation_prior_axis_b = Eigen::Vector3d::Zero();  // 0: isotropic
-  double deskew_node_spacing_s = 0.005;
-  int solver_iterations = 10;
-  int num_threads = 1;
-  // Without hand-eye excitation, turn the rig's C_bl by the smallest
-  // rotation that maps the LiDAR's principal rotation axis onto the IMU's
-  // (AlignRotationAxes), if that rotation is at most max_axis_alignment_deg.
-  bool align_rotation_axis = true;
-  double max_axis_alignment_deg = 10.0;
-  // Coarse tau: grid search over [-time_offset_search_s, +...] (0 = off).
-  double time_offset_search_s = 0.05;
-  double time_offset_search_step_s = 0.001;
-};
 
 struct InitialisationReport {
   imu::ImuInitialisation imu;
@@ -99,7 +76,7 @@ struct InitialisationReport {
 // measured extrinsic.
 Status InitialiseState(const std::vector<imu::ImuReading>& imu_samples,
                        const std::vector<LidarScan>& scans, const Rigid3d& measured_imu_from_lidar,
-                       const InitialisationOptions& options, CalibrationState* state,
+                       const proto::CalibrateParams& params, CalibrationState* state,
                        InitialisationReport* report);
 
 // Rotation-axis alignment for planar motion: with a_b, a_l the principal
@@ -121,24 +98,29 @@ double SearchTimeOffset(const CalibrationState& state, const std::vector<double>
 // Step 2 alone: knots from the integrated gyro (bias = state's b_g), then the
 // gyro-only LM fit. Returns the RMS weighted gyro residual.
 double FitRotationSplineToGyro(const std::vector<imu::ImuReading>& imu_samples,
-                               const InitialisationOptions& options, CalibrationState* state);
+                               const proto::CalibrateParams& params, CalibrationState* state);
 
 // Step 4c alone: LM fit of the rotation knots (from their current values) to
 // the gyro and to orientations C_ab at IMU times (OrientationSampleCostFunction,
-// sigma options.odometry_rotation_sigma_rad). Returns the RMS weighted residual.
+// sigma InitParams.odometry_rotation_sigma_deg). Returns the RMS weighted
+// residual.
 double RefineRotationSpline(const std::vector<double>& times_s,
                             const std::vector<Eigen::Quaterniond>& orientations_a_from_b,
                             const std::vector<imu::ImuReading>& imu_samples,
-                            const InitialisationOptions& options, CalibrationState* state);
+                            const proto::CalibrateParams& params, CalibrationState* state);
 
 // Step 5 alone: position knots, r_b^{lb}, g_a and b_a from LiDAR positions
 // p_l(t) in a at IMU times and the accelerometer, rotation knots held
-// (knots first interpolated linearly from p_l - C_ab r_b^{lb}). Returns the
-// RMS weighted residual.
+// (knots first interpolated linearly from p_l - C_ab r_b^{lb}); position
+// samples of sigma InitParams.odometry_position_sigma_m; r_b^{lb} free with a
+// prior of sigma CalibrateParams.extrinsic_translation_prior_sigma_m at its
+// current value along translation_prior_axis_b (unit, frame b; zero:
+// isotropic), held when that sigma is 0. Returns the RMS weighted residual.
 double FitPositionSpline(const std::vector<double>& times_s,
                          const std::vector<Eigen::Vector3d>& lidar_positions_a,
                          const std::vector<imu::ImuReading>& imu_samples,
-                         const InitialisationOptions& options, CalibrationState* state);
+                         const proto::CalibrateParams& params,
+                         const Eigen::Vector3d& translation_prior_axis_b, CalibrationState* state);
 
 }  // namespace tiltcal::calibrate
 

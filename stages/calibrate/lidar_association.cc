@@ -25,19 +25,20 @@ void KeepEvenlySpaced(size_t keep, std::vector<T>* v) {
 }  // namespace
 
 void BuildMapAndAssociate(const CalibrationState& state, const std::vector<LidarScan>& scans,
-                          const AssociationStageOptions& options,
+                          const proto::SurfelMapParams& map_params,
+                          const proto::AssociationParams& params,
                           std::vector<LidarPointResidual>* residuals,
                           AssociationStageSummary* summary) {
   *summary = AssociationStageSummary();
   residuals->clear();
   auto start = std::chrono::steady_clock::now();
-  SurfelMap map(options.map);
+  SurfelMap map(map_params);
   ScanPoseTable table;
   std::vector<Eigen::Vector3d> world;
   std::vector<char> usable(scans.size(), 0);
   for (size_t k = 0; k < scans.size(); ++k) {
     const LidarScan& scan = scans[k];
-    if (scan.points.empty() || !table.Build(state, scan, options.node_spacing_s)) continue;
+    if (scan.points.empty() || !table.Build(state, scan, params.deskew_node_spacing_s())) continue;
     usable[k] = 1;
     world.resize(scan.points.size());
     for (size_t j = 0; j < scan.points.size(); ++j) world[j] = table.ToWorld(scan, j);
@@ -49,25 +50,21 @@ void BuildMapAndAssociate(const CalibrationState& state, const std::vector<Lidar
   summary->map_seconds = Seconds(start);
 
   start = std::chrono::steady_clock::now();
-  AssociationOptions assoc;
-  assoc.max_distance_m = options.max_distance_m;
-  assoc.point_stride = 1;
-  assoc.max_points_per_surfel = std::max(1, options.max_points_per_surfel_per_scan);
-  const int stride = std::max(1, options.association_stride);
+  const size_t stride = std::max<size_t>(params.point_stride(), 1);
   std::vector<size_t> index;
   std::unordered_set<int> surfels_used;
   for (size_t k = 0; k < scans.size(); ++k) {
     if (!usable[k]) continue;
     const LidarScan& scan = scans[k];
-    table.Build(state, scan, options.node_spacing_s);
+    table.Build(state, scan, params.deskew_node_spacing_s());
     world.clear();
     index.clear();
     for (size_t j = 0; j < scan.points.size(); j += stride) {
       world.push_back(table.ToWorld(scan, j));
       index.push_back(j);
     }
-    std::vector<SurfelAssociation> found = map.Associate(world, assoc);
-    KeepEvenlySpaced(static_cast<size_t>(std::max(1, options.max_residuals_per_scan)), &found);
+    std::vector<SurfelAssociation> found = map.Associate(world, params);
+    KeepEvenlySpaced(std::max<size_t>(params.max_residuals_per_scan(), 1), &found);
     for (const SurfelAssociation& a : found) {
       const size_t j = index[a.point_index];
       const Surfel& s = map.surfels()[a.surfel_index];

@@ -1,12 +1,14 @@
 #ifndef TILTCAL_STAGES_CALIBRATE_LIDAR_ASSOCIATION_H_
 #define TILTCAL_STAGES_CALIBRATE_LIDAR_ASSOCIATION_H_
 
-// One outer iteration's LiDAR data association (issue 5 item 5): every raw
-// scan is mapped to frame a with the current state (each point at its own
-// time, ScanPoseTable), the points go into a voxel surfel map
-// (surfel_map.h: planarity gate, PCA plane fit), and a subsample of the
-// points is associated with the surfel of its voxel:
-//   - only every association_stride-th stored point of a scan is tried;
+// One outer iteration's LiDAR data association (docs/design.md §7): every
+// kept point of a scan is mapped to frame a with the current state (each
+// point at its own time, ScanPoseTable with nodes every
+// AssociationParams.deskew_node_spacing_s), the points go into a voxel surfel
+// map (surfel_map.h: planarity gate, PCA plane fit; SurfelMapParams), and a
+// subsample of the points is associated with the surfel of its voxel
+// (AssociationParams):
+//   - only every point_stride-th kept point of a scan is tried;
 //   - at most max_points_per_surfel_per_scan points per surfel and scan
 //     (evenly spaced when more qualify);
 //   - at most max_residuals_per_scan per scan (evenly spaced).
@@ -20,17 +22,9 @@
 #include "stages/calibrate/lidar_scans.h"
 #include "stages/calibrate/problem_builder.h"
 #include "stages/calibrate/surfel_map.h"
+#include "tiltcal/proto/calibrate_params.pb.h"
 
 namespace tiltcal::calibrate {
-
-struct AssociationStageOptions {
-  SurfelMapOptions map;
-  double max_distance_m = 0.05;
-  int association_stride = 7;
-  int max_points_per_surfel_per_scan = 2;
-  int max_residuals_per_scan = 64;
-  double node_spacing_s = 0.005;
-};
 
 struct AssociationStageSummary {
   SurfelExtractionSummary map;
@@ -43,7 +37,8 @@ struct AssociationStageSummary {
 };
 
 void BuildMapAndAssociate(const CalibrationState& state, const std::vector<LidarScan>& scans,
-                          const AssociationStageOptions& options,
+                          const proto::SurfelMapParams& map_params,
+                          const proto::AssociationParams& params,
                           std::vector<LidarPointResidual>* residuals,
                           AssociationStageSummary* summary);
 

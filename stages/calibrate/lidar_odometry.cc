@@ -52,7 +52,8 @@ struct LidarOdometry::Impl {
     Eigen::Isometry3d pose;                // T_{l0 l}
   };
 
-  LidarOdometryOptions options;
+  proto::LidarOdometryParams params;
+  proto::LidarScanParams scans;
   std::vector<LidarOdometryPose> poses;
   std::vector<std::optional<Eigen::Quaterniond>> priors;
   std::deque<Keyframe> keyframes;
@@ -62,17 +63,21 @@ struct LidarOdometry::Impl {
   pcl::GeneralizedIterativeClosestPoint<pcl::PointXYZ, pcl::PointXYZ> gicp;
   pcl::NormalDistributionsTransform<pcl::PointXYZ, pcl::PointXYZ> ndt;
 
-  explicit Impl(const LidarOdometryOptions& o) : options(o) {
-    gicp.setMaximumIterations(o.max_iterations);
-    gicp.setTransformationEpsilon(o.transformation_epsilon);
-    gicp.setMaxCorrespondenceDistance(o.max_correspondence_m);
-    gicp.setCorrespondenceRandomness(o.gicp_neighbours);
-    gicp.setMaximumOptimizerIterations(20);
-    ndt.setResolution(static_cast<float>(o.ndt_resolution_m));
-    ndt.setStepSize(o.ndt_step_size_m);
-    ndt.setTransformationEpsilon(o.transformation_epsilon);
-    ndt.setMaximumIterations(o.max_iterations);
+  Impl(const proto::LidarOdometryParams& p, const proto::LidarScanParams& s)
+      : params(p), scans(s) {
+    const int max_iterations = static_cast<int>(p.max_iterations());
+    gicp.setMaximumIterations(max_iterations);
+    gicp.setTransformationEpsilon(p.transformation_epsilon());
+    gicp.setMaxCorrespondenceDistance(p.max_correspondence_m());
+    gicp.setCorrespondenceRandomness(static_cast<int>(p.gicp_neighbours()));
+    gicp.setMaximumOptimizerIterations(static_cast<int>(p.gicp_optimizer_iterations()));
+    ndt.setResolution(static_cast<float>(p.ndt_resolution_m()));
+    ndt.setStepSize(p.ndt_step_size_m());
+    ndt.setTransformationEpsilon(p.transformation_epsilon());
+    ndt.setMaximumIterations(max_iterations);
   }
+
+  bool UsesGicp() const { return params.method() == proto::LidarOdometryParams::GICP; }
 
   // Range crop (into *cropped) and voxel downsampling (returned).
   Cloud::Ptr Preprocess(const std::vector<Eigen::Vector3f>& points, std::vector<Eigen::Vector3f>* cropped) const {
@@ -80,41 +85,35 @@ struct LidarOdometry::Impl {
     cloud->reserve(points.size());
     cropped->clear();
     cropped->reserve(points.size());
-    const float min_sq = static_cast<float>(options.min_range_m * options.min_range_m);
-    const float max_sq = static_cast<float>(options.max_range_m * options.max_range_m);
+    const float min_sq = static_cast<float>(scans.min_range_m() * scans.min_range_m());
+    const float max_sq = static_cast<float>(scans.max_range_m() * scans.max_range_m());
     for (const Eigen::Vector3f& p : points) {
       const float r_sq = p.squaredNorm();
       if (!p.allFinite() || r_sq < min_sq || r_sq > max_sq) continue;
       cloud->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
       cropped->push_back(p);
     }
-    return Downsample(cloud, options.scan_voxel_m);
+    return Downsample(cloud, params.scan_voxel_m());
   }
 
   void AddKeyframe(const Cloud::ConstPtr& scan_lidar, std::vector<Eigen::Vector3f> points,
                    const Eigen::Isometry3d& pose) {
     Cloud::Ptr in_l0(new Cloud);
     pcl::transformPointCloud(*scan_lidar, *in_l0, pose.matrix().cast<float>());
-    keyframes.push_back(Keyframe{Downsample(in_l0, options.map_voxel_m), std::move(points), pose});
-    while (static_cast<int>(keyframes.size()) > std::max(options.local_map_keyframes, 1)) {
+    keyframes.push_back(Keyframe{Downsample(in_l0, params.map_voxel_m()), std::move(points), pose});
+    while (static_cast<int>(keyframes.size()) > std::max(static_cast<int>(params.local_map_keyframes()), 1)) {
       keyframes.pop_front();
     }
     Cloud::Ptr merged(new Cloud);
     for (const Keyframe& k : keyframes) *merged += *k.map_cloud;
-    target = Downsample(merged, options.map_voxel_m);
-    if (options.method == RegistrationMethod::kGicp) {
+    target = Downsample(merged, params.map_voxel_m());
+    if (UsesGicp()) {
       gicp.setInputTarget(target);
     } else {
       ndt.setInputTarget(target);
     }
     // Quality reference: surfels of the full-resolution local map.
-    SurfelMapOptions surfel_options;
-    surfel_options.voxel_size_m = options.quality_voxel_m;
-    surfel_options.min_points = 10;
-    surfel_options.sample_points_per_voxel = 0;
-    surfel_options.max_thickness_m = 0.1;
-    surfel_options.max_normal_sigma_rad = 0.05;
-    quality_map = std::make_unique<SurfelMap>(surfel_options);
+    quality_map = std::make_unique<SurfelMap>(params.quality_map());
     for (const Keyframe& k : keyframes) quality_map->AddPoints(k.pose, k.points);
     quality_map->ExtractSurfels();
     last_keyframe_pose = pose;
@@ -151,7 +150,7 @@ struct LidarOdometry::Impl {
   // local map's surfels.
   void Quality(const Cloud& aligned, LidarOdometryPose* pose) const {
     if (aligned.empty() || !quality_map) return;
-    const double gate = options.inlier_distance_m;
+    const double gate = params.quality_inlier_distance_m();
     double sum_sq = 0.0;
     int covered = 0, inliers = 0;
     for (const pcl::PointXYZ& p : aligned.points) {
@@ -172,8 +171,9 @@ struct LidarOdometry::Impl {
   }
 };
 
-LidarOdometry::LidarOdometry(const LidarOdometryOptions& options)
-    : impl_(std::make_unique<Impl>(options)) {}
+LidarOdometry::LidarOdometry(const proto::LidarOdometryParams& params,
+                             const proto::LidarScanParams& scans)
+    : impl_(std::make_unique<Impl>(params, scans)) {}
 
 LidarOdometry::~LidarOdometry() = default;
 
@@ -204,7 +204,7 @@ const LidarOdometryPose& LidarOdometry::AddScan(double time_s,
       Cloud aligned;
       const Eigen::Matrix4f guess_f = guess.matrix().cast<float>();
       Eigen::Matrix4f result;
-      if (m.options.method == RegistrationMethod::kGicp) {
+      if (m.UsesGicp()) {
         m.gicp.setInputSource(source);
         m.gicp.align(aligned, guess_f);
         pose.converged = m.gicp.hasConverged();
@@ -223,8 +223,8 @@ const LidarOdometryPose& LidarOdometry::AddScan(double time_s,
     }
     const Eigen::Isometry3d since_keyframe = m.last_keyframe_pose.inverse() * pose.l0_from_lidar;
     if (pose.registered &&
-        (since_keyframe.translation().norm() > m.options.keyframe_distance_m ||
-         RotationAngle(since_keyframe.linear()) * 180.0 / M_PI > m.options.keyframe_angle_deg)) {
+        (since_keyframe.translation().norm() > m.params.keyframe_distance_m() ||
+         RotationAngle(since_keyframe.linear()) * 180.0 / M_PI > m.params.keyframe_angle_deg())) {
       m.AddKeyframe(source, std::move(cropped), pose.l0_from_lidar);
       pose.keyframe = true;
     }

@@ -2,13 +2,15 @@
 #define TILTCAL_STAGES_CALIBRATE_LIDAR_ODOMETRY_H_
 
 // Scan-to-local-map LiDAR odometry on deskewed scans, for the position
-// initialisation of the calibrator (issue 5 item 4; OA-Calib's NDT odometry).
+// initialisation of the calibrator (docs/design.md §9; OA-Calib's NDT
+// odometry). Settings: proto::LidarOdometryParams.
 //
 // Frames: each scan's points are in its LiDAR frame l_k at the scan time
 // (deskewed). Poses are T_{l0 lk} = (C_{l0 lk}, r_{l0}^{lk l0}), i.e.
 // l0_from_lidar, with l0 the first scan's LiDAR frame (so pose 0 = identity).
 //
-// Per scan: voxel downsampling (scan_voxel_m) and a range crop; prediction
+// Per scan: a range crop (LidarScanParams min_range_m, max_range_m) and voxel
+// downsampling (scan_voxel_m); prediction
 //   C_pred = C_{l0 l(k-1)} C_prior(k-1)^T C_prior(k)   when a rotation prior
 //            (e.g. gyro mapped through the measured extrinsic, see
 //            LidarRotationPriorFromImu) is given, else constant rotation rate;
@@ -28,30 +30,9 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "tiltcal/proto/calibrate_params.pb.h"
+
 namespace tiltcal::calibrate {
-
-enum class RegistrationMethod { kGicp, kNdt };
-
-struct LidarOdometryOptions {
-  RegistrationMethod method = RegistrationMethod::kGicp;
-  double scan_voxel_m = 0.5;    // source downsampling, m
-  double map_voxel_m = 0.4;     // local map downsampling, m
-  double min_range_m = 1.0;     // points closer to the sensor are dropped, m
-  double max_range_m = 80.0;    // points farther are dropped, m
-  int max_iterations = 10;      // registration iterations per scan
-  double transformation_epsilon = 1e-4;  // convergence on the update (PCL's squared-change test)
-  double max_correspondence_m = 1.0;     // GICP correspondence distance, m
-  int gicp_neighbours = 10;              // k for the GICP covariances
-  double ndt_resolution_m = 2.0;         // NDT cell size, m
-  double ndt_step_size_m = 0.1;          // NDT More-Thuente max step, m
-  double keyframe_distance_m = 1.0;
-  double keyframe_angle_deg = 5.0;
-  int local_map_keyframes = 6;
-  // Quality: surfels of the full-resolution local map (voxel edge, m); a
-  // source point is an inlier within inlier_distance_m of its voxel's surfel.
-  double quality_voxel_m = 1.0;
-  double inlier_distance_m = 0.1;
-};
 
 struct LidarOdometryPose {
   double time_s = 0.0;
@@ -61,9 +42,9 @@ struct LidarOdometryPose {
   bool keyframe = false;
   int num_source_points = 0;  // after downsampling and cropping
   // Quality after alignment, against planar surfels of the local map (the
-  // keyframes at full resolution, quality_voxel_m voxels): of the source
+  // keyframes at full resolution, surfel map quality_map): of the source
   // points that fall in a surfel voxel (num_quality_points), the fraction
-  // within inlier_distance_m of the plane and their RMS point-to-plane
+  // within quality_inlier_distance_m of the plane and their RMS point-to-plane
   // distance (m). A good registration gives ~1 and ~the range noise.
   int num_quality_points = 0;
   double fitness_rms_m = 0.0;
@@ -73,7 +54,7 @@ struct LidarOdometryPose {
 
 class LidarOdometry {
  public:
-  explicit LidarOdometry(const LidarOdometryOptions& options);
+  LidarOdometry(const proto::LidarOdometryParams& params, const proto::LidarScanParams& scans);
   ~LidarOdometry();
   LidarOdometry(const LidarOdometry&) = delete;
   LidarOdometry& operator=(const LidarOdometry&) = delete;

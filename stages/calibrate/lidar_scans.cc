@@ -10,14 +10,14 @@
 namespace tiltcal::calibrate {
 
 Status ReadLidarScans(const std::string& path, int64_t first_imu_stamp_ns,
-                      const ScanReadOptions& options, std::vector<LidarScan>* scans) {
+                      const proto::LidarScanParams& params, std::vector<LidarScan>* scans) {
   scans->clear();
   RecordReader reader;
   TILTCAL_RETURN_IF_ERROR(reader.Open(path, proto::Scan::descriptor()->full_name()));
   proto::Scan scan;
-  const double min_r2 = options.min_range_m * options.min_range_m;
-  const double max_r2 = options.max_range_m * options.max_range_m;
-  const int stride = std::max(1, options.point_stride);
+  const double min_r2 = params.min_range_m() * params.min_range_m();
+  const double max_r2 = params.max_range_m() * params.max_range_m();
+  const int stride = std::max(1, static_cast<int>(params.point_stride()));
   for (int record = 0;; ++record) {
     bool end = false;
     scan.Clear();

@@ -17,6 +17,7 @@
 
 #include "common/status.h"
 #include "stages/calibrate/calibration_state.h"
+#include "tiltcal/proto/calibrate_params.pb.h"
 
 namespace tiltcal::calibrate {
 
@@ -29,17 +30,13 @@ struct LidarScan {
   double max_time_s = 0.0;
 };
 
-struct ScanReadOptions {
-  double min_range_m = 1.0;
-  double max_range_m = 100.0;
-  int point_stride = 1;  // keep points 0, k, 2k, ... of each scan (after the range crop)
-};
-
 // Reads a Scan stream (scans.binpb[.lz4]). Non-finite points and points out
-// of range are dropped. Mismatched column lengths are an error naming the
-// file and record; scans left empty are kept (with no points).
+// of [params.min_range_m, params.max_range_m] are dropped; of the rest, points
+// 0, k, 2k, ... of each scan are kept (k = params.point_stride). Mismatched
+// column lengths are an error naming the file and record; scans left empty
+// are kept (with no points).
 Status ReadLidarScans(const std::string& path, int64_t first_imu_stamp_ns,
-                      const ScanReadOptions& options, std::vector<LidarScan>* scans);
+                      const proto::LidarScanParams& params, std::vector<LidarScan>* scans);
 
 // T_al(t) = (C_ab(t) C_bl, C_ab(t) r_b^{lb} + r_a^{ba}(t)) of one scan's
 // sweep, tabulated on nodes spaced <= node_spacing_s over

@@ -1,47 +1,41 @@
 // tiltcal_calibrate: continuous-time LiDAR-IMU calibration.
-//   tiltcal_calibrate --imu=imu.binpb --scans=scans.binpb.lz4 [--ground=ground.binpb]
-//                     [--gravity=gravity.txtpb] --rig=rig.txtpb --params=P
-//                     --out=calibration.txtpb
 #include <iostream>
 
-#include <gflags/gflags.h>
-
-#include "common/io/params.h"
-#include "common/io/provenance.h"
+#include "common/cli/command_line.h"
 #include "stages/calibrate/calibrate.h"
-
-DEFINE_string(imu, "", "input: imu.binpb");
-DEFINE_string(scans, "", "input: scans.binpb.lz4 (raw scans, not deskewed)");
-DEFINE_string(ground, "", "input: ground.binpb (optional)");
-DEFINE_string(gravity, "", "input: gravity.txtpb (optional)");
-DEFINE_string(rig, "", "input: the dataset's rig.txtpb");
-DEFINE_string(params, "", "input: params (stages/calibrate/default_params.txtpb)");
-DEFINE_string(out, "", "output: calibration.txtpb");
-DEFINE_bool(quiet, false, "no progress lines on stderr");
+#include "stages/calibrate/calibrate_params_validation.h"
 
 int main(int argc, char** argv) {
-  gflags::SetUsageMessage(
-      "continuous-time LiDAR-IMU calibration\n"
-      "  tiltcal_calibrate --imu=IMU --scans=SCANS [--ground=G] [--gravity=GRAV] --rig=RIG "
-      "--params=P --out=calibration.txtpb");
-  const std::string command_line = tiltcal::JoinCommandLine(argc, argv);
-  gflags::ParseCommandLineFlags(&argc, &argv, /*remove_flags=*/true);
-  if (FLAGS_imu.empty() || FLAGS_scans.empty() || FLAGS_rig.empty() || FLAGS_params.empty() ||
-      FLAGS_out.empty()) {
-    std::cerr << "tiltcal_calibrate: --imu, --scans, --rig, --params and --out are required "
-                 "(see --help)\n";
-    return 2;
-  }
+  using tiltcal::cli::kRequired;
+  tiltcal::cli::CommandLine cli("tiltcal_calibrate",
+                                "continuous-time LiDAR-IMU calibration: extrinsic, time offset, "
+                                "gravity and IMU biases with their uncertainties");
+  cli.AddFlag("imu", "input: imu.binpb", kRequired);
+  cli.AddFlag("scans", "input: scans.binpb.lz4 (raw scans, not deskewed)", kRequired);
+  cli.AddFlag("ground", "input: ground.binpb (for the ground residuals)");
+  cli.AddFlag("gravity", "input: gravity.txtpb (the flat-ground gravity reference)");
+  cli.AddFlag("rig", "input: the dataset's rig.txtpb", kRequired);
+  cli.AddFlag("params", "input: params (default: stages/calibrate/default_params.txtpb)");
+  cli.AddFlag("out", "output: calibration.txtpb", kRequired);
+  cli.AddSwitch("quiet", "no progress lines on stderr");
+  cli.AddExample(
+      "tiltcal_calibrate --imu=out/run1/imu.binpb --scans=out/run1/scans.binpb.lz4 "
+      "--ground=out/run1/ground.binpb --gravity=out/run1/gravity.txtpb "
+      "--rig=datasets/husky/rig.txtpb --out=out/run1/calibration.txtpb");
+  if (const auto exit_code = cli.Parse(argc, argv)) return *exit_code;
+  tiltcal::calibrate::CalibratePaths paths;
+  paths.imu = cli.Get("imu");
+  paths.scans = cli.Get("scans");
+  paths.ground = cli.Get("ground");
+  paths.gravity = cli.Get("gravity");
+  paths.rig = cli.Get("rig");
+  paths.params = cli.Get("params");
+  paths.out = cli.Get("out");
+  paths.command_line = cli.command_line();
   tiltcal::proto::CalibrateParams params;
-  tiltcal::Status status = tiltcal::LoadParams(FLAGS_params, &params);
+  tiltcal::Status status = tiltcal::calibrate::LoadCalibrateParams(paths.params, &params);
   if (status.ok()) {
-    status = tiltcal::calibrate::Run({FLAGS_imu, FLAGS_scans, FLAGS_ground, FLAGS_gravity,
-                                      FLAGS_rig, FLAGS_params, FLAGS_out, command_line},
-                                     params, FLAGS_quiet ? nullptr : &std::cerr);
+    status = tiltcal::calibrate::Run(paths, params, cli.GetSwitch("quiet") ? nullptr : &std::cerr);
   }
-  if (!status.ok()) {
-    std::cerr << "tiltcal_calibrate: " << status.message() << "\n";
-    return 1;
-  }
-  return 0;
+  return cli.Finish(status);
 }

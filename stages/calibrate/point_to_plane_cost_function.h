@@ -1,7 +1,7 @@
 #ifndef TILTCAL_STAGES_CALIBRATE_POINT_TO_PLANE_COST_FUNCTION_H_
 #define TILTCAL_STAGES_CALIBRATE_POINT_TO_PLANE_COST_FUNCTION_H_
 
-// LiDAR point-to-plane residual (DESIGN §5). A point p_l (LiDAR frame, m)
+// LiDAR point-to-plane residual (docs/design.md §7). A point p_l (LiDAR frame, m)
 // measured at LiDAR time t_j is mapped to the world frame a at IMU time
 // t = t_j + tau:
 //   p_a = C_ab(t) (C_bl p_l + r_b^{lb}) + r_a^{ba}(t)

@@ -41,10 +41,13 @@ class TranslationPriorCost final : public ceres::SizedCostFunction<3, 3> {
 
 }  // namespace
 
-CalibrationProblem::CalibrationProblem(CalibrationState* state, const ProblemOptions& options)
-    : state_(state), options_(options) {
-  if (options_.lidar_cauchy_scale > 0.0) {
-    lidar_loss_ = std::make_unique<ceres::CauchyLoss>(options_.lidar_cauchy_scale);
+CalibrationProblem::CalibrationProblem(CalibrationState* state,
+                                       const proto::ImuNoiseParams& imu_noise,
+                                       const proto::LidarResidualParams& lidar,
+                                       const ProblemOptions& options)
+    : state_(state), imu_noise_(imu_noise), lidar_(lidar), options_(options) {
+  if (lidar_.cauchy_scale() > 0.0) {
+    lidar_loss_ = std::make_unique<ceres::CauchyLoss>(lidar_.cauchy_scale());
   }
   ceres::Problem::Options problem_options;
   problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
@@ -88,8 +91,8 @@ CalibrationProblem::CalibrationProblem(CalibrationState* state, const ProblemOpt
   }
   if (!options_.estimate_gravity) p.SetParameterBlockConstant(state_->gravity_direction);
   const std::pair<BiasSegments*, double> biases[] = {
-      {&state_->gyro_bias, options_.gyro_bias_random_walk},
-      {&state_->accel_bias, options_.accel_bias_random_walk}};
+      {&state_->gyro_bias, imu_noise_.gyro_bias_random_walk_radps2_sqrthz()},
+      {&state_->accel_bias, imu_noise_.accel_bias_random_walk_mps3_sqrthz()}};
   for (const auto& [bias, random_walk] : biases) {
     if (!options_.estimate_biases) {
       for (std::array<double, 3>& b : bias->values) p.SetParameterBlockConstant(b.data());
@@ -132,7 +135,7 @@ void CalibrationProblem::AddImuResiduals(const std::vector<imu::ImuReading>& sam
     if (gyro) {
       problem_->AddResidualBlock(
           new GyroCostFunction(w, grid.inv_dt(), s.angular_velocity_radps,
-                               options_.gyro_sigma_radps),
+                               imu_noise_.gyro_sigma_radps()),
           nullptr, traj.rotation_knot(k), traj.rotation_knot(k + 1), traj.rotation_knot(k + 2),
           traj.rotation_knot(k + 3), state_->gyro_bias.Block(s.time_s));
       ++counts_.gyro_residuals;
@@ -141,7 +144,7 @@ void CalibrationProblem::AddImuResiduals(const std::vector<imu::ImuReading>& sam
     if (accel) {
       problem_->AddResidualBlock(
           new AccelCostFunction(w, grid.inv_dt(), s.linear_acceleration_mps2,
-                                options_.accel_sigma_mps2, state_->gravity_norm_mps2),
+                                imu_noise_.accel_sigma_mps2(), state_->gravity_norm_mps2),
           nullptr,
           {traj.rotation_knot(k), traj.rotation_knot(k + 1), traj.rotation_knot(k + 2),
            traj.rotation_knot(k + 3), traj.position_knot(k), traj.position_knot(k + 1),
@@ -166,7 +169,7 @@ void CalibrationProblem::AddLidarResiduals(const std::vector<LidarPointResidual>
     problem_->AddResidualBlock(
         new PointToPlaneCostFunction(grid.SegmentStart(k), grid.inv_dt(), r.time_s,
                                      r.point_lidar_m, r.plane_normal, r.plane_offset_m,
-                                     options_.lidar_sigma_m),
+                                     lidar_.sigma_m()),
         lidar_loss_.get(),
         {traj.rotation_knot(k), traj.rotation_knot(k + 1), traj.rotation_knot(k + 2),
          traj.rotation_knot(k + 3), traj.position_knot(k), traj.position_knot(k + 1),

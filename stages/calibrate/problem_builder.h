@@ -1,15 +1,18 @@
 #ifndef TILTCAL_STAGES_CALIBRATE_PROBLEM_BUILDER_H_
 #define TILTCAL_STAGES_CALIBRATE_PROBLEM_BUILDER_H_
 
-// The ceres::Problem of the spline calibration (DESIGN §5, §6): parameter
-// blocks of a CalibrationState with their manifolds, gauge, the bound on tau,
-// and the residual blocks (all analytic, fixed-size):
-//   gyro  (gyro_cost_function.h):  one per IMU sample, weight 1/sigma_g;
-//   accel (accel_cost_function.h): one per IMU sample, weight 1/sigma_a;
+// The ceres::Problem of the spline calibration (docs/design.md §6, §7, §13):
+// parameter blocks of a CalibrationState with their manifolds, gauge, the
+// bound on tau, and the residual blocks (all analytic, fixed-size):
+//   gyro  (gyro_cost_function.h):  one per IMU sample, weight
+//         1/ImuNoiseParams.gyro_sigma_radps;
+//   accel (accel_cost_function.h): one per IMU sample, weight
+//         1/ImuNoiseParams.accel_sigma_mps2;
 //   lidar (point_to_plane_cost_function.h): one per associated point, weight
-//         1/sigma_l, Cauchy loss of scale lidar_cauchy_scale (in units of the
-//         weighted residual, i.e. of sigma_l);
-//   more residual sets (the ground residuals of issue 6) through
+//         1/LidarResidualParams.sigma_m, Cauchy loss of scale
+//         LidarResidualParams.cauchy_scale (in units of the weighted
+//         residual, i.e. of sigma_m; 0 = none);
+//   more residual sets (the ground residuals, ground_residuals.h) through
 //   AddExtraResiduals, which only adds residual blocks on the state's pointers.
 //
 // Gauge (world frame a, 6 DoF): with fix_first_knots, rotation knot 0 and
@@ -23,7 +26,8 @@
 //
 // Gyro and accelerometer biases: one block per segment of the state; with
 // more than one, a random-walk prior between consecutive segments
-// (gyro_bias_random_walk, accel_bias_random_walk).
+// (ImuNoiseParams gyro_bias_random_walk_radps2_sqrthz,
+// accel_bias_random_walk_mps3_sqrthz; 0 = untied).
 //
 // Optional prior on r_b^{lb} (translation_prior_sigma_m > 0): one residual
 // (r_b^{lb} - r_prior) / sigma (3), or, with a unit translation_prior_axis_b,
@@ -57,6 +61,7 @@
 #include "common/spline/quaternion_manifold.h"
 #include "common/status.h"
 #include "stages/calibrate/calibration_state.h"
+#include "tiltcal/proto/calibrate_params.pb.h"
 
 namespace tiltcal::calibrate {
 
@@ -69,24 +74,18 @@ struct LidarPointResidual {
   double plane_offset_m = 0.0;
 };
 
+// What one build estimates and its bounds; the noise comes from the params
+// messages given to the constructor.
 struct ProblemOptions {
-  double gyro_sigma_radps = 0.01;
-  double accel_sigma_mps2 = 0.05;
-  double lidar_sigma_m = 0.02;
-  double lidar_cauchy_scale = 1.0;  // 0 = no robust loss
-  double time_offset_bound_s = 0.05;       // B
-  double time_offset_step_bound_s = 0.015;  // S
+  // B and S of the tau bound above (CalibrateParams.time_offset_bound_s,
+  // OuterLoopParams.time_offset_step_bound_s), s.
+  double time_offset_bound_s = 0.0;
+  double time_offset_step_bound_s = 0.0;
   // Which calibration blocks are free (constant otherwise).
   bool estimate_extrinsic = true;
   bool estimate_time_offset = true;
   bool estimate_gravity = true;
   bool estimate_biases = true;
-  // Random walks of the biases, rad/s^2/sqrt(Hz) (gyro) and m/s^3/sqrt(Hz)
-  // (accelerometer): tie consecutive segments of b_g and b_a
-  // (CalibrationState::gyro_bias, accel_bias) by BiasRandomWalkCostFunction;
-  // 0 = segments independent. Counted in ProblemCounts::prior_residuals.
-  double gyro_bias_random_walk = 0.0;
-  double accel_bias_random_walk = 0.0;
   // Gauge by holding rotation knot 0 and position knot 0 (see above). Off
   // when fixed map planes already pin the world frame.
   bool fix_first_knots = true;
@@ -118,7 +117,8 @@ class CalibrationProblem {
  public:
   // Adds all blocks of *state (which must outlive this object) with their
   // manifolds, the gauge and the tau bounds. tau is clamped into its bounds.
-  CalibrationProblem(CalibrationState* state, const ProblemOptions& options);
+  CalibrationProblem(CalibrationState* state, const proto::ImuNoiseParams& imu_noise,
+                     const proto::LidarResidualParams& lidar, const ProblemOptions& options);
   CalibrationProblem(const CalibrationProblem&) = delete;
   CalibrationProblem& operator=(const CalibrationProblem&) = delete;
 
@@ -148,6 +148,8 @@ class CalibrationProblem {
   void MarkKnots(int first_knot, bool position);
 
   CalibrationState* state_;
+  proto::ImuNoiseParams imu_noise_;
+  proto::LidarResidualParams lidar_;
   ProblemOptions options_;
   spline::RightQuaternionManifold quaternion_manifold_;
   ceres::SphereManifold<3> sphere_manifold_;

@@ -2,18 +2,18 @@
 #define TILTCAL_STAGES_CALIBRATE_SURFEL_MAP_H_
 
 // Planar surfels of a voxelised point map in the world frame a, and
-// point-to-surfel association (OA-Calib style map, issue 5 item 5).
+// point-to-surfel association (OA-Calib style map; docs/design.md §7).
 //
 // Frames: every point handed to the map or to Associate() is already resolved
 // in a (the IMU frame at the first IMU sample). A surfel is the plane
 //   n_pi^T p_a + d_pi = 0,   |n_pi| = 1,
-// fitted by PCA to the points of one voxel of a cubic grid of edge
-// voxel_size_m whose cell (i, j, k) covers [i, i+1) * voxel_size_m etc.
+// fitted by PCA (geometry::FitPlane) to the points of one voxel of a cubic
+// grid of edge voxel_m whose cell (i, j, k) covers [i, i+1) * voxel_m etc.
 //
-// The map keeps per-voxel moments (count, sum, sum of outer products, all
-// relative to the voxel centre for numerical accuracy) and a bounded,
-// evenly thinned sample of the points (at most sample_points_per_voxel), so
-// memory grows with the number of occupied voxels, not with the points.
+// The map keeps per-voxel moments (geometry::PlaneMoments of the points
+// relative to the voxel centre, for numerical accuracy) and a bounded,
+// evenly thinned sample of the points (at most sample_points), so memory
+// grows with the number of occupied voxels, not with the points.
 //
 // Plane fit (PCA of the moments), then a robustness check on the sample in
 // place of OA-Calib's per-voxel RANSAC: sample points farther from the plane
@@ -22,12 +22,14 @@
 // a wall in a floor voxel); with more than (1 - min_inlier_fraction) of them
 // the voxel is rejected, with fewer the plane is refitted (PCA) on the inlier
 // sample (two rounds).
-// Planarity gate, with the covariance eigenvalues l1 >= l2 >= l3 (m^2):
+// Planarity gate (proto::SurfelMapParams), with the covariance eigenvalues
+// l1 >= l2 >= l3 (m^2):
 //   count >= min_points,
-//   l2 / l1 >= min_spread_ratio       (a patch, not a line: a normal exists),
-//   l3 / l2 <= max_eigen_ratio        (flat: smallest spread << middle one),
+//   l2 / l1 >= min_spread_ratio       (a patch, not a line: a normal exists;
+//                                      FitPlane also fails below 1e-5),
+//   l3 / l2 <= max_planarity          (flat: smallest spread << middle one),
 //   sqrt(l3) <= max_thickness_m       (RMS distance of the points to the plane),
-//   sqrt(l3 / (n l2)) <= max_normal_sigma_rad
+//   sqrt(l3 / (n l2)) <= max_normal_sigma_deg (converted to rad)
 //                       (first-order standard deviation of the fitted normal
 //                        of n points with in-plane spread l2: a few noisy
 //                        scan lines on a far wall give a poorly known normal).
@@ -41,22 +43,10 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
-namespace tiltcal::calibrate {
+#include "common/geometry/plane_fit.h"
+#include "tiltcal/proto/calibrate_params.pb.h"
 
-struct SurfelMapOptions {
-  double voxel_size_m = 0.5;       // cubic voxel edge, m (0.5 indoor, 1.0 outdoor)
-  int min_points = 20;             // points per voxel to attempt a fit
-  double max_eigen_ratio = 0.02;   // l3 / l2 upper bound (dimensionless, 0..1)
-  double min_spread_ratio = 0.05;  // l2 / l1 lower bound (dimensionless, 0..1)
-  double max_thickness_m = 0.04;   // sqrt(l3) upper bound, m
-  double max_normal_sigma_rad = 0.005;  // sqrt(l3 / (n l2)) upper bound, rad (0.29 deg)
-  int sample_points_per_voxel = 64;   // kept points per voxel for the outlier check
-  // Inlier gate on the sample: 3 robust sigmas of its plane residuals,
-  // clamped to [min_inlier_distance_m, inlier_distance_m], m.
-  double inlier_distance_m = 0.05;
-  double min_inlier_distance_m = 0.01;
-  double min_inlier_fraction = 0.8;   // of the sample, else the voxel is rejected
-};
+namespace tiltcal::calibrate {
 
 // One planar patch of the map, frame a.
 struct Surfel {
@@ -75,25 +65,12 @@ struct SurfelExtractionSummary {
   int num_voxels = 0;
   int num_surfels = 0;
   int rejected_too_few_points = 0;
-  int rejected_line_like = 0;    // l2 / l1 < min_spread_ratio (checked first)
-  int rejected_not_flat = 0;     // l3 / l2 > max_eigen_ratio
+  int rejected_line_like = 0;    // l2 / l1 < min_spread_ratio or no plane fit (checked first)
+  int rejected_not_flat = 0;     // l3 / l2 > max_planarity
   int rejected_too_thick = 0;    // sqrt(l3) > max_thickness_m
   int rejected_outliers = 0;     // inlier fraction of the sample < min_inlier_fraction
-  int rejected_uncertain_normal = 0;  // sqrt(l3 / (n l2)) > max_normal_sigma_rad
+  int rejected_uncertain_normal = 0;  // sqrt(l3 / (n l2)) > max_normal_sigma_deg
   int refitted = 0;              // surfels refitted on their inlier sample
-};
-
-struct AssociationOptions {
-  // |n_pi^T p + d_pi| gate, m (OA-Calib: 0.05).
-  double max_distance_m = 0.05;
-  // Also require |p - centroid| <= max_centroid_distance_factor * voxel size,
-  // which keeps a point inside the patch that the surfel describes.
-  double max_centroid_distance_factor = 1.0;
-  // Deterministic subsampling: only query points 0, k, 2k, ... are tried.
-  int point_stride = 1;
-  // Per-surfel cap for one Associate() call (0 = no cap). When more points
-  // qualify, evenly spaced ones (in query order) are kept.
-  int max_points_per_surfel = 0;
 };
 
 struct SurfelAssociation {
@@ -104,7 +81,7 @@ struct SurfelAssociation {
 
 class SurfelMap {
  public:
-  explicit SurfelMap(const SurfelMapOptions& options);
+  explicit SurfelMap(const proto::SurfelMapParams& params);
 
   // Adds points measured in the LiDAR frame, moved to a by a_from_lidar
   // (p_a = C_al p_l + r_a^{la}). The sensor origin a_from_lidar.translation()
@@ -121,16 +98,20 @@ class SurfelMap {
   SurfelExtractionSummary ExtractSurfels();
 
   const std::vector<Surfel>& surfels() const { return surfels_; }
-  const SurfelMapOptions& options() const { return options_; }
+  const proto::SurfelMapParams& params() const { return params_; }
 
   // Index of the surfel of the voxel containing p_a, or -1.
   int SurfelIndexAt(const Eigen::Vector3d& p_a) const;
 
-  // Point-to-surfel association for query points in frame a: each (strided)
-  // point is matched to the surfel of its own voxel if it passes the gates.
+  // Point-to-surfel association for query points in frame a: each point is
+  // matched to the surfel of its own voxel when |n_pi^T p + d_pi| <=
+  // params.max_distance_m and |p - centroid| <=
+  // params.max_centroid_distance_factor x voxel_m (a point inside the patch
+  // that the surfel describes); at most params.max_points_per_surfel_per_scan
+  // points per surfel (evenly spaced in query order when more qualify).
   // Output sorted by point_index.
   std::vector<SurfelAssociation> Associate(const std::vector<Eigen::Vector3d>& points_a,
-                                           const AssociationOptions& options) const;
+                                           const proto::AssociationParams& params) const;
 
   // Integer voxel index of a point in frame a.
   Eigen::Vector3i VoxelOf(const Eigen::Vector3d& p_a) const;
@@ -138,9 +119,7 @@ class SurfelMap {
  private:
   struct VoxelStats {
     Eigen::Vector3i voxel = Eigen::Vector3i::Zero();
-    int count = 0;
-    Eigen::Vector3d sum = Eigen::Vector3d::Zero();        // sum of (p - centre)
-    Eigen::Matrix3d sum_outer = Eigen::Matrix3d::Zero();  // sum of (p - centre)(p - centre)^T
+    geometry::PlaneMoments moments;  // of (p - centre)
     int num_with_sensor = 0;
     Eigen::Vector3d sum_sensor = Eigen::Vector3d::Zero(); // sum of (sensor origin - centre)
     // Every sample_stride-th point (relative to the centre); when the sample
@@ -148,11 +127,24 @@ class SurfelMap {
     std::vector<Eigen::Vector3f> sample;
     int sample_stride = 1;
   };
+  // The PCA plane of moments relative to a voxel centre (surfel_map.cc).
+  struct PcaResult;
+  static PcaResult FitPca(const geometry::PlaneMoments& moments);
+  enum class SampleCheck { kAccepted, kOutliers, kDegenerate };
+  // The outlier check on a voxel's sample; refits *pca (and sets *fit_count,
+  // *refitted) on the inliers when some are off.
+  SampleCheck CheckSampleOutliers(const std::vector<Eigen::Vector3f>& sample, PcaResult* pca,
+                                  int* fit_count, bool* refitted) const;
+  // The planarity gate; counts a rejection in *summary.
+  bool PassesPlanarityGate(const PcaResult& pca, int fit_count, SurfelExtractionSummary* summary,
+                           double* normal_sigma_rad) const;
+  Surfel MakeSurfel(const VoxelStats& stats, const PcaResult& pca, double normal_sigma_rad) const;
   static std::uint64_t Key(const Eigen::Vector3i& v);
   Eigen::Vector3d Centre(const Eigen::Vector3i& v) const;
   void Accumulate(const Eigen::Vector3d& p_a, const Eigen::Vector3d* sensor_a);
 
-  SurfelMapOptions options_;
+  proto::SurfelMapParams params_;
+  double voxel_m_;
   std::unordered_map<std::uint64_t, VoxelStats> voxels_;
   std::unordered_map<std::uint64_t, int> surfel_of_voxel_;
   std::vector<Surfel> surfels_;

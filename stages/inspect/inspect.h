@@ -28,9 +28,9 @@ struct CsvOptions {
   std::string field;       // text files: which repeated field to tabulate
 };
 // `tiltcal_inspect csv FILE`: a header row of dotted field paths and one row per
-// record (DESIGN §8). For a text file (e.g. gravity.txtpb, truth.txtpb) the rows
-// are the elements of its longest repeated message field (the per-scan list),
-// or of `field`.
+// record (the column names are a fixed interface, docs/design.md §4). For a
+// text file (e.g. gravity.txtpb, truth.txtpb) the rows are the elements of its
+// longest repeated message field (the per-scan list), or of `field`.
 // With `points`: x,y,z,intensity,ring,time_offset_ns of scan `record`.
 Status RunCsv(const std::string& path, const CsvOptions& options, std::ostream& out);
 

@@ -24,6 +24,7 @@
 #include "common/spline/quaternion_manifold.h"
 #include "stages/calibrate/calibration_state.h"
 #include "stages/calibrate/ground_residuals.h"
+#include "tests/stages/calibrate/calibrate_params_text.h"
 
 namespace tiltcal::calibrate {
 namespace {
@@ -133,8 +134,14 @@ GroundSequenceInfo InfoFor(const Scenario& sc, bool level) {
   return info;
 }
 
-proto::CalibrateParams UnitSigmaParams() {
-  proto::CalibrateParams params;
+// The program's ground residual settings (every mode AUTO).
+proto::GroundResidualsParams DefaultGround() {
+  return tiltcal::testing::DefaultCalibrateParamsWith().ground();
+}
+
+// Sigma 1 and no robust loss for every residual type.
+proto::GroundResidualsParams UnitSigmaParams() {
+  proto::GroundResidualsParams params = DefaultGround();
   for (auto* p : {params.mutable_flat(), params.mutable_dist(), params.mutable_incl(),
                   params.mutable_up()}) {
     p->set_sigma(1.0);
@@ -266,7 +273,7 @@ TEST(GroundResidualsTest, CauchyLossPerResidualType) {
   const Scenario sc;
   proto::GroundPlane plane = sc.Plane(2.0);
   plane.set_height_m(plane.height_m() + 0.05);  // e_dist = 0.05 m
-  proto::CalibrateParams params = UnitSigmaParams();
+  proto::GroundResidualsParams params = UnitSigmaParams();
   params.mutable_dist()->set_sigma(0.01);        // r = 5
   params.mutable_dist()->set_cauchy_scale(2.0);
   params.mutable_up()->set_cauchy_scale(7.0);    // e_up = 0: no contribution
@@ -326,7 +333,7 @@ TEST(GroundResidualsTest, PlaneCovarianceWhitening) {
   plane.mutable_normal_in_lidar()->set_y(n_meas.y());
   plane.mutable_normal_in_lidar()->set_z(n_meas.z());
 
-  proto::CalibrateParams params = UnitSigmaParams();
+  proto::GroundResidualsParams params = UnitSigmaParams();
   const double sigma = 0.01;
   for (auto* k : {params.mutable_flat(), params.mutable_dist(), params.mutable_incl(),
                   params.mutable_up()}) {
@@ -405,7 +412,7 @@ TEST(GroundResidualsTest, DistAndUpRecoverTheirObservableDirections) {
     ceres::Problem problem{ProblemOptions()};
     AddStateBlocks(&state, &problem);
     GroundResidualSummary summary;
-    proto::CalibrateParams params = UnitSigmaParams();
+    proto::GroundResidualsParams params = UnitSigmaParams();
     params.mutable_dist()->set_sigma(0.02);
     ASSERT_TRUE(AddGroundResiduals(sc.Planes(), Only(false, true, false, false), params,
                                    InfoFor(sc, false), NoLosses(), kOriginNs, &state, &problem, &summary)
@@ -459,7 +466,7 @@ TEST(GroundResidualsTest, AdderForTheProblemBuilder) {
   gravity.mutable_gravity_flat_in_imu()->set_x(g_f.x());
   gravity.mutable_gravity_flat_in_imu()->set_y(g_f.y());
   gravity.mutable_gravity_flat_in_imu()->set_z(g_f.z());
-  const proto::CalibrateParams params = UnitSigmaParams();
+  const proto::GroundResidualsParams params = UnitSigmaParams();
   const GroundLosses losses(params);
   std::function<Status(CalibrationState*, ceres::Problem*, int*)> adder;
   std::vector<std::string> used;
@@ -487,7 +494,7 @@ TEST(GroundResidualsTest, AdderForTheProblemBuilder) {
   EXPECT_TRUE(used.empty());
   EXPECT_NE(reason.find("no ground planes"), std::string::npos) << reason;
   // ON without its input is an error here too.
-  proto::CalibrateParams on = params;
+  proto::GroundResidualsParams on = params;
   on.mutable_up()->set_mode(proto::GroundResidualParams::ON);
   EXPECT_FALSE(MakeGroundResidualAdder(planes, kOriginNs, rig, nullptr, on, &losses, nullptr,
                                        &adder, &used, &reason)
@@ -506,7 +513,7 @@ GroundSequenceInfo Info(double d_b, bool level_known, bool level, bool g_f) {
   return info;
 }
 
-std::string Select(const proto::CalibrateParams& params, const GroundSequenceInfo& info) {
+std::string Select(const proto::GroundResidualsParams& params, const GroundSequenceInfo& info) {
   GroundResidualSelection selection;
   const Status status = SelectGroundResiduals(params, info, &selection);
   EXPECT_TRUE(status.ok()) << status.message();
@@ -517,7 +524,7 @@ std::string Select(const proto::CalibrateParams& params, const GroundSequenceInf
 }
 
 TEST(SelectGroundResidualsTest, AutoDefaults) {
-  const proto::CalibrateParams params;  // all AUTO
+  const proto::GroundResidualsParams params = DefaultGround();  // all AUTO
   // Level: flat, plus dist when d_b is known; never incl on level ground.
   EXPECT_EQ(Select(params, Info(0.4, true, true, true)), "flat+dist");
   EXPECT_EQ(Select(params, Info(0.0, true, true, true)), "flat");
@@ -532,34 +539,34 @@ TEST(SelectGroundResidualsTest, AutoDefaults) {
 }
 
 TEST(SelectGroundResidualsTest, OnAndOffOverride) {
-  proto::CalibrateParams params;
+  proto::GroundResidualsParams params = DefaultGround();
   params.mutable_up()->set_mode(proto::GroundResidualParams::ON);
   EXPECT_EQ(Select(params, Info(0.4, true, false, true)), "dist+incl+up");
   params.mutable_dist()->set_mode(proto::GroundResidualParams::OFF);
   params.mutable_incl()->set_mode(proto::GroundResidualParams::OFF);
   EXPECT_EQ(Select(params, Info(0.4, true, false, true)), "up");
   // flat forced on a tilted sequence is allowed (ablation) and said.
-  proto::CalibrateParams forced;
+  proto::GroundResidualsParams forced = DefaultGround();
   forced.mutable_flat()->set_mode(proto::GroundResidualParams::ON);
   GroundResidualSelection selection;
   ASSERT_TRUE(SelectGroundResiduals(forced, Info(0.4, true, false, false), &selection).ok());
   EXPECT_EQ(selection.Names(), "flat+dist");
   EXPECT_NE(selection.reason.find("forced"), std::string::npos) << selection.reason;
   // OFF on a level sequence.
-  proto::CalibrateParams off;
+  proto::GroundResidualsParams off = DefaultGround();
   off.mutable_flat()->set_mode(proto::GroundResidualParams::OFF);
   EXPECT_EQ(Select(off, Info(0.4, true, true, true)), "dist");
 }
 
 TEST(SelectGroundResidualsTest, OnWithoutItsInputIsAnError) {
   GroundResidualSelection selection;
-  proto::CalibrateParams dist_on;
+  proto::GroundResidualsParams dist_on = DefaultGround();
   dist_on.mutable_dist()->set_mode(proto::GroundResidualParams::ON);
   Status status = SelectGroundResiduals(dist_on, Info(0.0, true, false, true), &selection);
   ASSERT_FALSE(status.ok());
   EXPECT_NE(status.message().find("dist.mode"), std::string::npos) << status.message();
   for (int which = 0; which < 2; ++which) {
-    proto::CalibrateParams on;
+    proto::GroundResidualsParams on = DefaultGround();
     (which == 0 ? on.mutable_incl() : on.mutable_up())->set_mode(proto::GroundResidualParams::ON);
     status = SelectGroundResiduals(on, Info(0.4, true, false, false), &selection);
     ASSERT_FALSE(status.ok());

@@ -6,10 +6,18 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/stages/calibrate/calibrate_params_text.h"
+
 namespace tiltcal::calibrate {
 namespace {
 
 constexpr double kDegToRad = M_PI / 180.0;
+
+// The program's hand-eye settings: at least 15 pairs, excited from 0.02 rad,
+// pairs disagreeing by more than 1 deg down-weighted.
+proto::HandEyeParams DefaultHandEye() {
+  return tiltcal::testing::DefaultCalibrateParamsWith().hand_eye();
+}
 
 Eigen::Quaterniond Exp(const Eigen::Vector3d& phi) {
   const double theta = phi.norm();
@@ -54,7 +62,7 @@ TEST(HandEyeRotationTest, RecoversKnownRotationWithThreeAxisExcitation) {
   const Eigen::Quaterniond c_bl = TrueExtrinsic();
   const std::vector<RotationPair> pairs =
       MakePairs(c_bl, Eigen::Vector3d(0.15, 0.12, 0.3), /*noise_deg=*/0.05, 60, 11);
-  const HandEyeResult r = EstimateHandEyeRotation(pairs, HandEyeOptions());
+  const HandEyeResult r = EstimateHandEyeRotation(pairs, DefaultHandEye());
   ASSERT_TRUE(r.solved);
   EXPECT_TRUE(r.excited) << "excitation " << r.excitation_rad;
   std::printf("hand-eye 3-axis: error %.4f deg, singular values %.3f %.3f %.3f %.5f, excitation %.4f rad\n",
@@ -76,7 +84,7 @@ TEST(HandEyeRotationTest, ReportsDegeneracyForPlanarMotion) {
   // Ground vehicle: yaw about the IMU z axis only (plus noise-level wobble).
   const std::vector<RotationPair> pairs =
       MakePairs(c_bl, Eigen::Vector3d(0.0005, 0.0005, 0.4), /*noise_deg=*/0.05, 60, 12);
-  const HandEyeResult r = EstimateHandEyeRotation(pairs, HandEyeOptions());
+  const HandEyeResult r = EstimateHandEyeRotation(pairs, DefaultHandEye());
   ASSERT_TRUE(r.solved);
   EXPECT_FALSE(r.excited) << "excitation " << r.excitation_rad;
   std::printf("hand-eye planar: singular values %.3f %.3f %.5f %.5f, excitation %.5f rad, ratio %.5f\n",
@@ -101,10 +109,11 @@ TEST(HandEyeRotationTest, DownWeightsInconsistentPairs) {
     pairs[static_cast<std::size_t>(7 * i)].lidar_delta =
         pairs[static_cast<std::size_t>(7 * i)].lidar_delta * Exp(Eigen::Vector3d(0.35, 0.0, 0.0));
   }
-  const HandEyeResult r = EstimateHandEyeRotation(pairs, HandEyeOptions());
+  const HandEyeResult r = EstimateHandEyeRotation(pairs, DefaultHandEye());
   ASSERT_TRUE(r.solved);
-  HandEyeOptions unweighted;
-  unweighted.consistent_angle_deg = 180.0;  // every pair weight 1
+  const proto::HandEyeParams unweighted =  // every pair weight 1
+      tiltcal::testing::DefaultCalibrateParamsWith("hand_eye { consistent_angle_deg: 180 }")
+          .hand_eye();
   const HandEyeResult plain = EstimateHandEyeRotation(pairs, unweighted);
   const double weighted_deg = AngleDeg(r.imu_from_lidar_rotation, c_bl);
   const double plain_deg = AngleDeg(plain.imu_from_lidar_rotation, c_bl);
@@ -116,7 +125,7 @@ TEST(HandEyeRotationTest, DownWeightsInconsistentPairs) {
 TEST(HandEyeRotationTest, NeedsEnoughPairsAndBuildsPairsFromTrajectories) {
   const Eigen::Quaterniond c_bl = TrueExtrinsic();
   EXPECT_FALSE(EstimateHandEyeRotation(MakePairs(c_bl, Eigen::Vector3d::Constant(0.2), 0.0, 10, 14),
-                                       HandEyeOptions())
+                                       DefaultHandEye())
                    .solved);
   // Absolute trajectories: C_ab(t_k) and C_{l0 lk} = C_bl^T C_ab(t_0)^T C_ab(t_k) C_bl.
   std::vector<Eigen::Quaterniond> imu, lidar;
@@ -129,7 +138,7 @@ TEST(HandEyeRotationTest, NeedsEnoughPairsAndBuildsPairsFromTrajectories) {
   for (int k = 0; k < 100; ++k) lidar.push_back(c_bl.conjugate() * imu[0].conjugate() * imu[static_cast<std::size_t>(k)] * c_bl);
   const std::vector<RotationPair> pairs = MakeRotationPairs(imu, lidar, 5);
   ASSERT_EQ(pairs.size(), 19u);
-  const HandEyeResult r = EstimateHandEyeRotation(pairs, HandEyeOptions());
+  const HandEyeResult r = EstimateHandEyeRotation(pairs, DefaultHandEye());
   ASSERT_TRUE(r.solved);
   EXPECT_TRUE(r.excited);
   EXPECT_LT(AngleDeg(r.imu_from_lidar_rotation, c_bl), 1e-6);

@@ -32,6 +32,7 @@
 #include "stages/calibrate/initialisation.h"
 #include "stages/calibrate/orientation_sample_cost_function.h"
 #include "stages/calibrate/problem_builder.h"
+#include "tests/stages/calibrate/calibrate_params_text.h"
 
 namespace tiltcal::calibrate {
 namespace {
@@ -98,15 +99,15 @@ void LidarPositions(const Eigen::Vector3d& r_bl, std::mt19937* rng, std::vector<
   }
 }
 
-InitialisationOptions Options() {
-  InitialisationOptions o;
-  o.gyro_sigma_radps = 0.003;
-  o.accel_sigma_mps2 = 0.02;
-  o.position_sigma_m = 0.02;
-  o.odometry_rotation_sigma_rad = 0.0017;
-  o.solver_iterations = 30;  // init_solver_iterations default
-  o.num_threads = 2;
-  return o;
+// The fits as tested: the program's settings with position samples of 2 cm,
+// orientation samples of 0.0017 rad and 30 LM iterations.
+proto::CalibrateParams Options() {
+  return tiltcal::testing::DefaultCalibrateParamsWith(R"pb(
+    init {
+      odometry_position_sigma_m: 0.02
+      odometry_rotation_sigma_deg: 0.097402825172239
+      solver_iterations: 30
+    })pb");
 }
 
 TEST(InitialSplineFitTest, OrientationSamplesRemoveTheHeadingDriftOfAWrongGyroBias) {
@@ -153,7 +154,7 @@ TEST(InitialSplineFitTest, PositionFitEstimatesTheAccelerometerBiasAndTheLeverAr
   std::vector<double> times;
   std::vector<Eigen::Vector3d> positions;
   LidarPositions(r_bl, &rng, &times, &positions);
-  FitPositionSpline(times, positions, imu, Options(), &state);
+  FitPositionSpline(times, positions, imu, Options(), Eigen::Vector3d::Zero(), &state);
   // The gyro-only rotation's tilt error (~1 mrad) tilts g_b by as much:
   // ~0.01 m/s^2 of bias.
   EXPECT_LT((state.AccelBias() - accel_bias).norm(), 0.02) << state.AccelBias().transpose();
@@ -202,13 +203,14 @@ double WorstAccelBiasSegmentError(double segment_s, const Eigen::Vector3d& accel
   state.SetGyroBias(gyro_bias);
   state.SetGravityDirection(kGravity);
   state.SetImuFromLidarTranslation(r_bl);
-  InitialisationOptions options = Options();
-  options.accel_bias_random_walk = 1e-3;
+  // Segments tied by a random walk of 1e-3 m/s^3/sqrt(Hz).
+  proto::CalibrateParams options = Options();
+  options.mutable_imu_noise()->set_accel_bias_random_walk_mps3_sqrthz(1e-3);
   FitRotationSplineToGyro(imu, options, &state);
   std::vector<double> times;
   std::vector<Eigen::Vector3d> positions;
   LidarPositions(r_bl, &rng, &times, &positions);
-  FitPositionSpline(times, positions, imu, options, &state);
+  FitPositionSpline(times, positions, imu, options, Eigen::Vector3d::Zero(), &state);
   return WorstBiasError(state.accel_bias, accel_bias, drift);
 }
 
@@ -240,13 +242,15 @@ double WorstGyroBiasSegmentError(double segment_s, const Eigen::Vector3d& gyro_b
   state.SetGyroBias(gyro_bias);
   FitRotationSplineToGyro(imu, Options(), &state);
 
+  const proto::CalibrateParams params = tiltcal::testing::DefaultCalibrateParamsWith(
+      "imu_noise { gyro_sigma_radps: 0.003 gyro_bias_random_walk_radps2_sqrthz: 1e-4 }");
   ProblemOptions options;
-  options.gyro_sigma_radps = 0.003;
-  options.gyro_bias_random_walk = 1e-4;
+  options.time_offset_bound_s = params.time_offset_bound_s();
+  options.time_offset_step_bound_s = params.outer_loop().time_offset_step_bound_s();
   options.estimate_extrinsic = false;
   options.estimate_time_offset = false;
   options.estimate_gravity = false;
-  CalibrationProblem problem(&state, options);
+  CalibrationProblem problem(&state, params.imu_noise(), params.lidar(), options);
   problem.AddImuResiduals(imu, /*gyro=*/true, /*accel=*/false);
   std::normal_distribution<double> n(0.0, 1.0);
   const Status status =

@@ -4,9 +4,11 @@
 #include <cstdio>
 #include <ctime>
 #include <random>
+#include <string>
 
 #include <gtest/gtest.h>
 
+#include "tests/stages/calibrate/calibrate_params_text.h"
 #include "tests/stages/calibrate/synthetic_room.h"
 
 namespace tiltcal::calibrate {
@@ -44,11 +46,21 @@ struct OdometryErrors {
   double worst_inlier_fraction = 1.0;
 };
 
-OdometryErrors RunOdometry(const LidarOdometryOptions& options, bool with_prior, int num_scans) {
+// The odometry these tests measure: the program's settings but a 0.4 m local
+// map voxel, 10 registration iterations, 2 m NDT cells, a keyframe every
+// 1 m and a local map of 6 keyframes (the room is small).
+proto::CalibrateParams RoomOdometryParams(const std::string& method) {
+  return tiltcal::testing::DefaultCalibrateParamsWith(
+      "odometry { method: " + method +
+      " map_voxel_m: 0.4 max_iterations: 10 ndt_resolution_m: 2.0 keyframe_distance_m: 1.0 "
+      "local_map_keyframes: 6 }");
+}
+
+OdometryErrors RunOdometry(const proto::CalibrateParams& params, bool with_prior, int num_scans) {
   const Scene scene = MakeDefaultScene();
   std::mt19937 rng(31);
   const LidarPattern pattern;  // full VLP-16 resolution: 16 x 1800
-  LidarOdometry odometry(options);
+  LidarOdometry odometry(params.odometry(), params.scans());
   const Eigen::Isometry3d w_from_l0 = TruePose(0.0);
   std::vector<Eigen::Isometry3d> truth;
   std::vector<std::vector<Eigen::Vector3f>> scans;
@@ -96,14 +108,14 @@ OdometryErrors RunOdometry(const LidarOdometryOptions& options, bool with_prior,
       "odometry %s prior=%d: |dr| %.4f m, |dphi| %.4f deg (abs); step %.4f m, %.4f deg; "
       "%.2f ms/scan wall, %.2f ms/scan cpu (600 scans: %.1f s cpu); worst rms %.3f m, worst inliers %.2f; "
       "%d source pts\n",
-      options.method == RegistrationMethod::kGicp ? "GICP" : "NDT", with_prior ? 1 : 0, e.worst_translation_m,
+      proto::LidarOdometryParams::Method_Name(params.odometry().method()).c_str(), with_prior ? 1 : 0, e.worst_translation_m,
       e.worst_rotation_deg, e.worst_step_translation_m, e.worst_step_rotation_deg, 1e3 * e.mean_seconds,
       1e3 * e.mean_cpu_seconds, 600 * e.mean_cpu_seconds, e.worst_rms_m, e.worst_inlier_fraction, poses.back().num_source_points);
   return e;
 }
 
 TEST(LidarOdometryTest, GicpRecoversRelativePosesWithGyroPrior) {
-  const OdometryErrors e = RunOdometry(LidarOdometryOptions(), /*with_prior=*/true, 60);
+  const OdometryErrors e = RunOdometry(RoomOdometryParams("GICP"), /*with_prior=*/true, 60);
   EXPECT_LT(e.worst_translation_m, 0.05);
   EXPECT_LT(e.worst_rotation_deg, 0.3);
   EXPECT_LT(e.worst_step_translation_m, 0.02);
@@ -114,15 +126,13 @@ TEST(LidarOdometryTest, GicpRecoversRelativePosesWithGyroPrior) {
 }
 
 TEST(LidarOdometryTest, GicpWithoutPriorUsesConstantVelocity) {
-  const OdometryErrors e = RunOdometry(LidarOdometryOptions(), /*with_prior=*/false, 30);
+  const OdometryErrors e = RunOdometry(RoomOdometryParams("GICP"), /*with_prior=*/false, 30);
   EXPECT_LT(e.worst_translation_m, 0.05);
   EXPECT_LT(e.worst_rotation_deg, 0.3);
 }
 
 TEST(LidarOdometryTest, NdtRecoversRelativePoses) {
-  LidarOdometryOptions options;
-  options.method = RegistrationMethod::kNdt;
-  const OdometryErrors e = RunOdometry(options, /*with_prior=*/true, 30);
+  const OdometryErrors e = RunOdometry(RoomOdometryParams("NDT"), /*with_prior=*/true, 30);
   // NDT (2 m cells) is coarser than GICP here.
   EXPECT_LT(e.worst_translation_m, 0.05);
   EXPECT_LT(e.worst_rotation_deg, 0.5);
@@ -142,7 +152,8 @@ TEST(LidarOdometryTest, RotationPriorFromImuMapsThroughTheExtrinsic) {
 }
 
 TEST(LidarOdometryTest, EmptyScanKeepsThePrediction) {
-  LidarOdometry odometry{LidarOdometryOptions()};
+  const proto::CalibrateParams params = RoomOdometryParams("GICP");
+  LidarOdometry odometry(params.odometry(), params.scans());
   const Scene scene = MakeDefaultScene();
   std::mt19937 rng(3);
   LidarPattern pattern;

@@ -3,12 +3,14 @@
 #include <cmath>
 #include <map>
 #include <random>
+#include <string>
 #include <set>
 #include <algorithm>
 #include <cstdio>
 
 #include <gtest/gtest.h>
 
+#include "tests/stages/calibrate/calibrate_params_text.h"
 #include "tests/stages/calibrate/synthetic_room.h"
 
 namespace tiltcal::calibrate {
@@ -51,6 +53,30 @@ Eigen::Isometry3d AFromW() {
   return t;
 }
 
+// The surfel map of a room: 0.5 m voxels, surfels at most 4 cm thick with a
+// normal known to 0.005 rad (0.2865 deg), sample inliers within 5 cm and at
+// least 80 % of them (the program's defaults are for outdoor sequences).
+proto::SurfelMapParams RoomMapParams() {
+  return tiltcal::testing::DefaultCalibrateParamsWith(R"pb(
+           map {
+             voxel_m: 0.5
+             max_thickness_m: 0.04
+             max_normal_sigma_deg: 0.28647889756541161
+             inlier_distance_m: 0.05
+             min_inlier_fraction: 0.8
+           })pb")
+      .map();
+}
+
+// Association with a 5 cm plane gate and, unless given, no per-surfel cap
+// in effect.
+proto::AssociationParams RoomAssociation(int max_points_per_surfel = 1000000) {
+  return tiltcal::testing::DefaultCalibrateParamsWith(
+             "association { max_distance_m: 0.05 max_points_per_surfel_per_scan: " +
+             std::to_string(max_points_per_surfel) + " }")
+      .association();
+}
+
 class SurfelMapRoomTest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -66,7 +92,7 @@ class SurfelMapRoomTest : public ::testing::Test {
   }
 
   Scene scene_;
-  SurfelMapOptions options_;
+  proto::SurfelMapParams options_ = RoomMapParams();
   Eigen::Isometry3d a_from_w_ = AFromW();
   std::unique_ptr<SurfelMap> map_;
   SurfelExtractionSummary summary_;
@@ -164,7 +190,7 @@ TEST_F(SurfelMapRoomTest, AssociationReturnsTheSurfelOfTheTrueSurface) {
   std::vector<Eigen::Vector3d> points_a;
   for (const Eigen::Vector3f& p : scan.points) points_a.push_back(a_from_w_ * w_from_l * p.cast<double>());
 
-  AssociationOptions options;
+  const proto::AssociationParams options = RoomAssociation();
   const std::vector<SurfelAssociation> all = map_->Associate(points_a, options);
   int planar_points = 0;
   for (const int id : scan.surfaces) planar_points += scene_.IsCylinder(id) ? 0 : 1;
@@ -174,7 +200,7 @@ TEST_F(SurfelMapRoomTest, AssociationReturnsTheSurfelOfTheTrueSurface) {
   for (const SurfelAssociation& a : all) {
     const int id = scan.surfaces[static_cast<std::size_t>(a.point_index)];
     const Surfel& s = map_->surfels()[static_cast<std::size_t>(a.surfel_index)];
-    EXPECT_LE(std::abs(a.distance_m), options.max_distance_m);
+    EXPECT_LE(std::abs(a.distance_m), options.max_distance_m());
     EXPECT_NEAR(a.distance_m, s.normal.dot(points_a[static_cast<std::size_t>(a.point_index)]) + s.offset_m, 1e-12);
     // The surfel describes the plane the point was measured on.
     // Wrong: a cylinder point, or a surfel not on the point's plane.
@@ -188,18 +214,19 @@ TEST_F(SurfelMapRoomTest, AssociationReturnsTheSurfelOfTheTrueSurface) {
   // Only points right at plane intersections may pick the neighbouring plane's surfel.
   EXPECT_LT(wrong, 0.01 * static_cast<double>(all.size())) << wrong << " of " << all.size();
 
-  // Deterministic subsampling: stride and per-surfel cap.
-  AssociationOptions sub;
-  sub.point_stride = 4;
-  sub.max_points_per_surfel = 3;
-  const std::vector<SurfelAssociation> a1 = map_->Associate(points_a, sub);
-  const std::vector<SurfelAssociation> a2 = map_->Associate(points_a, sub);
+  // Deterministic subsampling: every 4th point (as the association stage
+  // queries them) and a per-surfel cap.
+  const proto::AssociationParams sub = RoomAssociation(3);
+  std::vector<Eigen::Vector3d> every_fourth;
+  for (std::size_t i = 0; i < points_a.size(); i += 4) every_fourth.push_back(points_a[i]);
+  const std::vector<SurfelAssociation> a1 = map_->Associate(every_fourth, sub);
+  const std::vector<SurfelAssociation> a2 = map_->Associate(every_fourth, sub);
   ASSERT_EQ(a1.size(), a2.size());
   std::map<int, int> per_surfel;
   for (std::size_t i = 0; i < a1.size(); ++i) {
     EXPECT_EQ(a1[i].point_index, a2[i].point_index);
     EXPECT_EQ(a1[i].surfel_index, a2[i].surfel_index);
-    EXPECT_EQ(a1[i].point_index % 4, 0);
+    EXPECT_LT(a1[i].point_index, static_cast<int>(every_fourth.size()));
     if (i > 0) {
       EXPECT_LT(a1[i - 1].point_index, a1[i].point_index);
     }
@@ -226,8 +253,7 @@ std::vector<Eigen::Vector3d> GridOnPlane(const Eigen::Vector3d& origin, const Ei
 }
 
 TEST(SurfelMapTest, GateRejectsCornersCurvesLinesAndThickClouds) {
-  SurfelMapOptions options;
-  options.voxel_size_m = 0.5;
+  const proto::SurfelMapParams options = RoomMapParams();
   SurfelMap map(options);
   const Eigen::Vector3d ex = Eigen::Vector3d::UnitX(), ey = Eigen::Vector3d::UnitY(), ez = Eigen::Vector3d::UnitZ();
   // Voxel (0,0,0): a tilted plane -> accepted, exact normal.
@@ -262,10 +288,10 @@ TEST(SurfelMapTest, GateRejectsCornersCurvesLinesAndThickClouds) {
   for (const Eigen::Vector3d& p : GridOnPlane(Eigen::Vector3d(4.0, 0.0, 0.25), ex, ey, 10, 0.5)) {
     thick.push_back(Eigen::Vector3d(p.x(), p.y(), std::clamp(p.z() + n(rng), 0.01, 0.49)));
   }
-  SurfelMapOptions loose = options;
-  loose.max_eigen_ratio = 1.0;  // isolate the thickness gate on this voxel
-  loose.sample_points_per_voxel = 0;  // no outlier check
-  loose.max_normal_sigma_rad = 1.0;
+  proto::SurfelMapParams loose = options;
+  loose.set_max_planarity(1.0);  // isolate the thickness gate on this voxel
+  loose.set_sample_points(0);    // no outlier check
+  loose.set_max_normal_sigma_deg(1.0 * 180.0 / M_PI);
   map.AddPointsInWorld(thick);
   // Voxel (10,0,0): too few points.
   map.AddPointsInWorld({Eigen::Vector3d(5.1, 0.1, 0.1), Eigen::Vector3d(5.2, 0.3, 0.1), Eigen::Vector3d(5.3, 0.1, 0.2)});
@@ -308,7 +334,7 @@ TEST(SurfelMapTest, GateRejectsCornersCurvesLinesAndThickClouds) {
 }
 
 TEST(SurfelMapTest, MomentsStayAccurateFarFromTheOrigin) {
-  SurfelMap map(SurfelMapOptions{});
+  SurfelMap map(RoomMapParams());
   const Eigen::Vector3d far(80000.1, -65000.4, 120.3);
   const Eigen::Vector3d n = Eigen::Vector3d(0.0, 0.6, 0.8);
   const Eigen::Vector3d u = Eigen::Vector3d::UnitX(), v = n.cross(u);

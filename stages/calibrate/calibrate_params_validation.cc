@@ -1,0 +1,74 @@
+#include "stages/calibrate/calibrate_params_validation.h"
+
+#include <string>
+
+#include "common/io/params.h"
+#include "stages/calibrate/default_params_text.h"
+
+namespace tiltcal::calibrate {
+namespace {
+
+Status MustBePositive(double value, const std::string& field) {
+  if (value > 0.0) return Status::Ok();
+  return Status::Error("params: " + field + " must be > 0");
+}
+
+}  // namespace
+
+Status ValidateImuNoiseParams(const proto::ImuNoiseParams& params) {
+  TILTCAL_RETURN_IF_ERROR(MustBePositive(params.gyro_sigma_radps(), "imu_noise.gyro_sigma_radps"));
+  return MustBePositive(params.accel_sigma_mps2(), "imu_noise.accel_sigma_mps2");
+}
+
+Status ValidateLidarScanParams(const proto::LidarScanParams& params) {
+  if (params.max_range_m() <= params.min_range_m()) {
+    return Status::Error("params: scans.max_range_m must exceed scans.min_range_m");
+  }
+  return Status::Ok();
+}
+
+Status ValidateLidarResidualParams(const proto::LidarResidualParams& params) {
+  return MustBePositive(params.sigma_m(), "lidar.sigma_m");
+}
+
+Status ValidateInitParams(const proto::InitParams& params) {
+  TILTCAL_RETURN_IF_ERROR(
+      MustBePositive(params.odometry_position_sigma_m(), "init.odometry_position_sigma_m"));
+  return MustBePositive(params.deskew_node_spacing_s(), "init.deskew_node_spacing_s");
+}
+
+Status ValidateSurfelMapParams(const proto::SurfelMapParams& params, const std::string& path) {
+  return MustBePositive(params.voxel_m(), path + ".voxel_m");
+}
+
+Status ValidateAssociationParams(const proto::AssociationParams& params) {
+  TILTCAL_RETURN_IF_ERROR(MustBePositive(params.max_distance_m(), "association.max_distance_m"));
+  return MustBePositive(params.deskew_node_spacing_s(), "association.deskew_node_spacing_s");
+}
+
+Status ValidateGroundResidualsParams(const proto::GroundResidualsParams& params) {
+  TILTCAL_RETURN_IF_ERROR(MustBePositive(params.flat().sigma(), "ground.flat.sigma"));
+  TILTCAL_RETURN_IF_ERROR(MustBePositive(params.dist().sigma(), "ground.dist.sigma"));
+  TILTCAL_RETURN_IF_ERROR(MustBePositive(params.incl().sigma(), "ground.incl.sigma"));
+  return MustBePositive(params.up().sigma(), "ground.up.sigma");
+}
+
+Status ValidateCalibrateParams(const proto::CalibrateParams& params) {
+  TILTCAL_RETURN_IF_ERROR(ValidateImuNoiseParams(params.imu_noise()));
+  TILTCAL_RETURN_IF_ERROR(ValidateLidarScanParams(params.scans()));
+  TILTCAL_RETURN_IF_ERROR(ValidateLidarResidualParams(params.lidar()));
+  TILTCAL_RETURN_IF_ERROR(ValidateInitParams(params.init()));
+  TILTCAL_RETURN_IF_ERROR(
+      ValidateSurfelMapParams(params.odometry().quality_map(), "odometry.quality_map"));
+  TILTCAL_RETURN_IF_ERROR(ValidateSurfelMapParams(params.map(), "map"));
+  TILTCAL_RETURN_IF_ERROR(ValidateAssociationParams(params.association()));
+  return ValidateGroundResidualsParams(params.ground());
+}
+
+Status LoadCalibrateParams(const std::string& path, proto::CalibrateParams* params) {
+  TILTCAL_RETURN_IF_ERROR(LoadParamsOrDefaults(path, DefaultParamsText(), params));
+  return ValidateCalibrateParams(*params).WithContext(path.empty() ? "default CalibrateParams"
+                                                                   : path);
+}
+
+}  // namespace tiltcal::calibrate

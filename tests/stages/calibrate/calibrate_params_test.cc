@@ -1,0 +1,104 @@
+// The calibrator's params: the default file sets every field (no component
+// runs on a value the file does not show), and each cross-field rule rejects
+// its violation with an error naming the field.
+
+#include <string>
+#include <utility>
+
+#include <google/protobuf/descriptor.h>
+#include <google/protobuf/text_format.h>
+#include <gtest/gtest.h>
+
+#include "common/io/atomic_file.h"
+#include "stages/calibrate/calibrate_params_validation.h"
+#include "stages/calibrate/default_params_text.h"
+#include "tests/stages/calibrate/calibrate_params_text.h"
+#include "tests/testing/test_env.h"
+
+namespace tiltcal::calibrate {
+namespace {
+
+using google::protobuf::Descriptor;
+using google::protobuf::FieldDescriptor;
+using google::protobuf::TextFormat;
+
+// Appends to *missing the dotted path of every field of `descriptor`
+// (recursively) that the text behind `tree` does not set.
+void CollectUnsetFields(const Descriptor* descriptor, const TextFormat::ParseInfoTree* tree,
+                        const std::string& prefix, std::string* missing) {
+  for (int i = 0; i < descriptor->field_count(); ++i) {
+    const FieldDescriptor* field = descriptor->field(i);
+    const std::string path = prefix + field->name();
+    if (tree->GetLocation(field, -1).line < 0) {
+      *missing += path + " ";
+      continue;
+    }
+    if (field->cpp_type() == FieldDescriptor::CPPTYPE_MESSAGE) {
+      CollectUnsetFields(field->message_type(), tree->GetTreeForNested(field, -1), path + ".",
+                         missing);
+    }
+  }
+}
+
+TEST(CalibrateParamsTest, DefaultParamsFileSetsEveryField) {
+  proto::CalibrateParams params;
+  TextFormat::ParseInfoTree tree;
+  TextFormat::Parser parser;
+  parser.WriteLocationsTo(&tree);
+  ASSERT_TRUE(parser.ParseFromString(std::string(DefaultParamsText()), &params));
+  std::string missing;
+  CollectUnsetFields(proto::CalibrateParams::descriptor(), &tree, "", &missing);
+  EXPECT_EQ(missing, "") << "fields the default params file does not set";
+  EXPECT_TRUE(ValidateCalibrateParams(params).ok());
+}
+
+TEST(CalibrateParamsTest, LoadingChecksTheRulesAndNamesTheFile) {
+  proto::CalibrateParams params;
+  ASSERT_TRUE(LoadCalibrateParams("", &params).ok());  // the embedded defaults
+  EXPECT_DOUBLE_EQ(params.map().voxel_m(), 1.0);
+  tiltcal::testing::TempDir dir;
+  std::string text(DefaultParamsText());
+  const std::string min_range = "min_range_m: 1.0";
+  ASSERT_NE(text.find(min_range), std::string::npos);
+  text.replace(text.find(min_range), min_range.size(), "min_range_m: 90");  // > max_range_m (80)
+  ASSERT_TRUE(WriteFileAtomically(dir.File("p.txtpb"), text).ok());
+  const Status status = LoadCalibrateParams(dir.File("p.txtpb"), &params);
+  ASSERT_FALSE(status.ok());
+  EXPECT_NE(status.message().find("p.txtpb"), std::string::npos) << status.message();
+  EXPECT_NE(status.message().find("scans.max_range_m"), std::string::npos) << status.message();
+}
+
+// The error of ValidateCalibrateParams on the defaults with `override_text`.
+std::string ErrorWith(const std::string& override_text) {
+  proto::CalibrateParams params = tiltcal::testing::DefaultCalibrateParamsWith();
+  EXPECT_TRUE(TextFormat::MergeFromString(override_text, &params)) << override_text;
+  const Status status = ValidateCalibrateParams(params);
+  EXPECT_FALSE(status.ok()) << override_text;
+  return status.message();
+}
+
+TEST(CalibrateParamsTest, EachRuleNamesItsField) {
+  const std::pair<const char*, const char*> cases[] = {
+      {"imu_noise { gyro_sigma_radps: 0 }", "imu_noise.gyro_sigma_radps"},
+      {"imu_noise { accel_sigma_mps2: 0 }", "imu_noise.accel_sigma_mps2"},
+      {"scans { min_range_m: 5 max_range_m: 5 }", "scans.max_range_m"},
+      {"lidar { sigma_m: 0 }", "lidar.sigma_m"},
+      {"init { odometry_position_sigma_m: 0 }", "init.odometry_position_sigma_m"},
+      {"init { deskew_node_spacing_s: 0 }", "init.deskew_node_spacing_s"},
+      {"odometry { quality_map { voxel_m: 0 } }", "odometry.quality_map.voxel_m"},
+      {"map { voxel_m: 0 }", "map.voxel_m"},
+      {"association { max_distance_m: 0 }", "association.max_distance_m"},
+      {"association { deskew_node_spacing_s: 0 }", "association.deskew_node_spacing_s"},
+      {"ground { flat { sigma: 0 } }", "ground.flat.sigma"},
+      {"ground { dist { sigma: 0 } }", "ground.dist.sigma"},
+      {"ground { incl { sigma: 0 } }", "ground.incl.sigma"},
+      {"ground { up { sigma: 0 } }", "ground.up.sigma"},
+  };
+  for (const auto& [override_text, field] : cases) {
+    const std::string message = ErrorWith(override_text);
+    EXPECT_NE(message.find(field), std::string::npos) << override_text << ": " << message;
+  }
+}
+
+}  // namespace
+}  // namespace tiltcal::calibrate
