@@ -121,8 +121,11 @@ void PrintSummary(std::ostream* log, const DecodePaths& paths, double shift_s,
                           ? fmt::format(" (LiDAR stamps shifted by {:.3f} s, lidar_stamp_shift_s)",
                                         shift_s)
                           : "");
-  for (const std::string& note : s.imu_notes) *log << "  imu: " << note << "\n";
-  for (const std::string& warning : s.imu_warnings) *log << "  WARNING: " << warning << "\n";
+  for (const std::string& note : s.imu_notes) {
+    const bool warning =
+        std::find(s.imu_warnings.begin(), s.imu_warnings.end(), note) != s.imu_warnings.end();
+    *log << (warning ? "  WARNING: imu: " : "  imu: ") << note << "\n";
+  }
   if (s.scans_without_point_time > 0) {
     *log << fmt::format(
         "  WARNING: {} scans have no per-point time field (time_source POINT_TIME_NONE): "

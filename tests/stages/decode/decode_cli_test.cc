@@ -354,6 +354,39 @@ TEST_F(DecodeCli, ClockDomainsTenMinutesApart) {
       << output;
 }
 
+// A driver publishing gravity instead of the specific force: against the
+// rig's g_f an error, against its rotation alone a warning (exit 0).
+TEST_F(DecodeCli, SignFlippedAccelerometer) {
+  testing::VehicleBagOptions flipped;
+  flipped.accel_scale = -1.0;
+  const std::string bag = VehicleBag("flipped.bag", flipped);
+  const std::string rig = WriteRigWithTopics("gravity_flat_in_imu { z: -9.81 }\n");
+  std::string output;
+  const int rc = Decode(bag, params_, &output, "--rig=" + rig);
+  EXPECT_EQ(rc, 1);
+  EXPECT_EQ(output,
+            "tiltcal_decode: " + rig +
+                ": the mean specific force over 400 static samples, (-0.002, -0.003, -9.810) "
+                "m/s² in the IMU frame, points 180.0 deg from up (−gravity_flat_in_imu of the "
+                "rig; more than 90): the accelerometer of " +
+                bag +
+                " publishes gravity instead of specific force (sign-flipped), or "
+                "gravity_flat_in_imu has the wrong sign (g_f points down: it is minus the mean "
+                "accelerometer reading at rest on flat ground)\n");
+  ExpectCleanFailure(rc, output, {});
+
+  ASSERT_EQ(Decode(bag, params_, &output, "--rig=" + WriteRigWithTopics()), 0) << output;
+  const std::string warning =
+      "  WARNING: imu: the mean specific force over 400 static samples, (-0.002, -0.003, "
+      "-9.810) m/s² in the IMU frame, points 180.0 deg from the LiDAR's +z (through "
+      "imu_from_lidar of the rig; more than 90): the accelerometer publishes gravity instead of "
+      "specific force (sign-flipped), or the rig's rotation is wrong (an IMU mounted upside "
+      "down and not declared), or the LiDAR is mounted upside down; imu.binpb keeps the "
+      "published sign\n";
+  EXPECT_NE(output.find(warning), std::string::npos) << output;
+  EXPECT_EQ(output.find("WARNING"), output.rfind("WARNING")) << output;  // said once
+}
+
 TEST_F(DecodeCli, ImuUnitsParamsAreValidated) {
   std::string text = testing::ReadFileOrEmpty(params_);
   for (const std::string field : {"accel_norm_ratio_min: 0.8", "accel_norm_ratio_max: 1.25"}) {
