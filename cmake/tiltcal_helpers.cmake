@@ -46,7 +46,7 @@ function(tiltcal_add_stage)
   endif()
   tiltcal_add_library(NAME tiltcal_${ARG_NAME}_lib SRCS ${ARG_SRCS} DEPS ${ARG_DEPS})
   add_executable(tiltcal_${ARG_NAME} main.cc)
-  target_link_libraries(tiltcal_${ARG_NAME} PRIVATE tiltcal_${ARG_NAME}_lib gflags)
+  target_link_libraries(tiltcal_${ARG_NAME} PRIVATE tiltcal_${ARG_NAME}_lib)
   tiltcal_set_target_options(tiltcal_${ARG_NAME})
 endfunction()
 

@@ -5,7 +5,7 @@ set -euo pipefail
 
 PACKAGES=(
   build-essential cmake ninja-build pkg-config git
-  libeigen3-dev libceres-dev libgflags-dev libgoogle-glog-dev
+  libeigen3-dev libceres-dev libgoogle-glog-dev
   libpcl-dev libprotobuf-dev protobuf-compiler
   liblz4-dev lz4 libbz2-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev

@@ -151,9 +151,15 @@ std::string CommandLine::Help() const {
   }
   help += fmt::format(
       "\nexit codes: {} done, {} the run failed (the reason is on stderr, no output is left), "
-      "{} wrong command line\n",
+      "{} wrong command line",
       kExitOk, kExitFailure, kExitUsage);
+  for (const auto& [code, meaning] : exit_codes_) help += fmt::format(", {} {}", code, meaning);
+  help += "\n";
   return help;
+}
+
+void CommandLine::AddExitCode(int code, const std::string& meaning) {
+  exit_codes_.emplace_back(code, meaning);
 }
 
 int CommandLine::Finish(const Status& status) const {

@@ -6,6 +6,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "common/status.h"
@@ -16,6 +17,9 @@ namespace tiltcal::cli {
 inline constexpr int kExitOk = 0;       // done, outputs written
 inline constexpr int kExitFailure = 1;  // the run failed (bad input, failed solve); no output left
 inline constexpr int kExitUsage = 2;    // the command line is wrong (unknown or missing flag)
+// The result was written but is not to be used without reading why (e.g.
+// tiltcal_calibrate's verdict SUSPECT; the reasons are in the file and on stderr).
+inline constexpr int kExitSuspect = 3;
 
 // The command line of one tool: named flags `--name=value` (or `--name value`),
 // switches `--name` (or `--name=true|false`), and positional arguments.
@@ -44,6 +48,8 @@ class CommandLine {
   void SetPositional(const std::string& usage, const std::string& help, int min_count,
                      int max_count);
   void AddExample(const std::string& example);
+  // An exit code of this tool beyond 0, 1 and 2 (e.g. kExitSuspect), listed in --help.
+  void AddExitCode(int code, const std::string& meaning);
 
   // Parses argv. Returns the exit code when the tool must stop now (--help,
   // or a usage error already printed), std::nullopt when it should run.
@@ -85,6 +91,7 @@ class CommandLine {
   int positional_min_ = 0;
   int positional_max_ = 0;
   std::vector<std::string> examples_;
+  std::vector<std::pair<int, std::string>> exit_codes_;
   std::map<std::string, std::string> values_;
   std::vector<std::string> positional_;
   std::string command_line_;

@@ -72,12 +72,77 @@ bool IncreasingAndFinite(const std::vector<TimedValue>& series) {
   return true;
 }
 
-}  // namespace
+// r(lag) for lag in [-max_lag, max_lag] (index lag + max_lag); kUnusable
+// where the overlap is shorter than min_count grid samples.
+constexpr double kUnusable = -2.0;
 
-Status AlignAngularSpeeds(const std::vector<TimedValue>& gyro_speed,
-                          const std::vector<TimedValue>& reference_speed,
-                          const AngularSpeedAlignmentOptions& options,
-                          AngularSpeedAlignment* alignment) {
+struct CorrelationCurve {
+  long max_lag = 0;
+  std::vector<double> r;
+  double at(long lag) const { return r[lag + max_lag]; }
+  bool usable(long lag) const { return at(lag) > kUnusable; }
+};
+
+CorrelationCurve CorrelateOverLags(const Grid& reference, const Grid& gyro, long max_lag,
+                                   long min_count) {
+  CorrelationCurve curve{max_lag, std::vector<double>(2 * max_lag + 1, kUnusable)};
+  for (long lag = -max_lag; lag <= max_lag; ++lag) {
+    long count = 0;
+    const double r = Correlation(reference, gyro, lag, &count);
+    if (count >= std::max(min_count, 3L)) curve.r[lag + max_lag] = r;
+  }
+  return curve;
+}
+
+// Offset of the parabola's vertex through the best lag and its neighbours,
+// in grid steps within [-0.5, 0.5].
+double PeakFraction(const CorrelationCurve& curve, long best) {
+  if (best <= -curve.max_lag || best >= curve.max_lag) return 0.0;
+  if (!curve.usable(best - 1) || !curve.usable(best + 1)) return 0.0;
+  const double left = curve.at(best - 1), right = curve.at(best + 1);
+  const double curvature = left - 2 * curve.at(best) + right;
+  return curvature < 0 ? std::clamp(0.5 * (left - right) / curvature, -0.5, 0.5) : 0.0;
+}
+
+// The best r outside the main peak's lobe: the lags around `best` over which
+// r keeps falling (a rise of less than 0.001 counts as falling, for noise).
+double SecondPeak(const CorrelationCurve& curve, long best) {
+  const long max_lag = curve.max_lag;
+  long begin = best, end = best;
+  while (begin > -max_lag && curve.usable(begin - 1) &&
+         curve.at(begin - 1) < curve.at(begin) + 1e-3) {
+    --begin;
+  }
+  while (end < max_lag && curve.usable(end + 1) && curve.at(end + 1) < curve.at(end) + 1e-3) {
+    ++end;
+  }
+  double second = -1.0;
+  for (long lag = -max_lag; lag <= max_lag; ++lag) {
+    if (lag < begin || lag > end) second = std::max(second, curve.at(lag));
+  }
+  return second;
+}
+
+// Σ s_g(t + τ) s_r(t) / Σ s_r(t)² over the reference samples faster than
+// min_speed whose t + τ is within the gyro's span.
+double Scale(const std::vector<TimedValue>& gyro_speed,
+             const std::vector<TimedValue>& reference_speed, double time_offset_s,
+             double min_speed) {
+  double sum_gr = 0, sum_rr = 0;
+  for (const TimedValue& r : reference_speed) {
+    const double t = r.time_s + time_offset_s;
+    if (r.value < min_speed || t < gyro_speed.front().time_s || t > gyro_speed.back().time_s) {
+      continue;
+    }
+    sum_gr += Interpolate(gyro_speed, t) * r.value;
+    sum_rr += r.value * r.value;
+  }
+  return sum_rr > 0 ? sum_gr / sum_rr : 0.0;
+}
+
+Status CheckInputs(const std::vector<TimedValue>& gyro_speed,
+                   const std::vector<TimedValue>& reference_speed,
+                   const AngularSpeedAlignmentOptions& options) {
   if (!(options.grid_step_s > 0) || !(options.max_time_offset_s > 0)) {
     return Status::Error("angular speed alignment: grid_step_s and max_time_offset_s must be > 0");
   }
@@ -89,23 +154,27 @@ Status AlignAngularSpeeds(const std::vector<TimedValue>& gyro_speed,
   if (!IncreasingAndFinite(gyro_speed) || !IncreasingAndFinite(reference_speed)) {
     return Status::Error("angular speed alignment: times not increasing or values not finite");
   }
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status AlignAngularSpeeds(const std::vector<TimedValue>& gyro_speed,
+                          const std::vector<TimedValue>& reference_speed,
+                          const AngularSpeedAlignmentOptions& options,
+                          AngularSpeedAlignment* alignment) {
+  TILTCAL_RETURN_IF_ERROR(CheckInputs(gyro_speed, reference_speed, options));
   const double step = options.grid_step_s;
   const double origin = reference_speed.front().time_s;
-  const Grid reference = Resample(reference_speed, origin, step);
-  const Grid gyro = Resample(gyro_speed, origin, step);
   const long max_lag = static_cast<long>(std::floor(options.max_time_offset_s / step));
-  const long min_count = static_cast<long>(std::ceil(options.min_overlap_s / step));
-
-  std::vector<double> correlation(2 * max_lag + 1, -2.0);  // -2: lag not usable
+  const CorrelationCurve curve =
+      CorrelateOverLags(Resample(reference_speed, origin, step), Resample(gyro_speed, origin, step),
+                        max_lag, static_cast<long>(std::ceil(options.min_overlap_s / step)));
   long best = 0;
   bool any = false;
   for (long lag = -max_lag; lag <= max_lag; ++lag) {
-    long count = 0;
-    const double r = Correlation(reference, gyro, lag, &count);
-    if (count < std::max(min_count, 3L)) continue;
-    correlation[lag + max_lag] = r;
-    if (!any || r > correlation[best + max_lag]) best = lag;
-    any = true;
+    if (curve.usable(lag) && (!any || curve.at(lag) > curve.at(best))) best = lag;
+    any = any || curve.usable(lag);
   }
   if (!any) {
     return Status::Error(fmt::format(
@@ -114,55 +183,16 @@ Status AlignAngularSpeeds(const std::vector<TimedValue>& gyro_speed,
         gyro_speed.front().time_s, gyro_speed.back().time_s, reference_speed.front().time_s,
         reference_speed.back().time_s, options.min_overlap_s, options.max_time_offset_s));
   }
-  const double r_best = correlation[best + max_lag];
-  if (r_best == 0.0) {
+  if (curve.at(best) == 0.0) {
     return Status::Error("angular speed alignment: no variation of the angular speed to align "
                          "(the sensors did not turn)");
   }
-  // Parabola through the best lag and its neighbours: vertex offset in steps.
-  double fraction = 0.0;
-  if (best > -max_lag && best < max_lag) {
-    const double left = correlation[best - 1 + max_lag];
-    const double right = correlation[best + 1 + max_lag];
-    const double curvature = left - 2 * r_best + right;
-    if (left > -2 && right > -2 && curvature < 0) {
-      fraction = std::clamp(0.5 * (left - right) / curvature, -0.5, 0.5);
-    }
-  }
-  alignment->time_offset_s = (static_cast<double>(best) + fraction) * step;
-  alignment->correlation = r_best;
+  alignment->time_offset_s = (static_cast<double>(best) + PeakFraction(curve, best)) * step;
+  alignment->correlation = curve.at(best);
   alignment->at_search_bound = std::abs(best) >= max_lag - 1;
-  // The main peak's lobe: from the best lag down to where r stops falling
-  // (a rise of less than 0.001 counts as falling, for noise); the second
-  // peak is the best lag outside it.
-  const auto usable = [&](long lag) { return correlation[lag + max_lag] > -2; };
-  long lobe_begin = best, lobe_end = best;
-  while (lobe_begin > -max_lag && usable(lobe_begin - 1) &&
-         correlation[lobe_begin - 1 + max_lag] < correlation[lobe_begin + max_lag] + 1e-3) {
-    --lobe_begin;
-  }
-  while (lobe_end < max_lag && usable(lobe_end + 1) &&
-         correlation[lobe_end + 1 + max_lag] < correlation[lobe_end + max_lag] + 1e-3) {
-    ++lobe_end;
-  }
-  alignment->second_peak_correlation = -1.0;
-  for (long lag = -max_lag; lag <= max_lag; ++lag) {
-    if (lag >= lobe_begin && lag <= lobe_end) continue;
-    alignment->second_peak_correlation =
-        std::max(alignment->second_peak_correlation, correlation[lag + max_lag]);
-  }
-  // Scale on the original reference samples, the gyro interpolated at t + τ.
-  double sum_gr = 0, sum_rr = 0;
-  for (const TimedValue& r : reference_speed) {
-    const double t = r.time_s + alignment->time_offset_s;
-    if (r.value < options.min_reference_speed || t < gyro_speed.front().time_s ||
-        t > gyro_speed.back().time_s) {
-      continue;
-    }
-    sum_gr += Interpolate(gyro_speed, t) * r.value;
-    sum_rr += r.value * r.value;
-  }
-  alignment->scale = sum_rr > 0 ? sum_gr / sum_rr : 0.0;
+  alignment->second_peak_correlation = SecondPeak(curve, best);
+  alignment->scale = Scale(gyro_speed, reference_speed, alignment->time_offset_s,
+                           options.min_reference_speed);
   return Status::Ok();
 }
 

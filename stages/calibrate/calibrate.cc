@@ -19,7 +19,10 @@
 #include "stages/calibrate/ground_residuals.h"
 #include "stages/calibrate/initialisation.h"
 #include "stages/calibrate/lidar_association.h"
+#include "stages/calibrate/map_sharpness.h"
 #include "stages/calibrate/problem_builder.h"
+#include "stages/calibrate/residual_statistics.h"
+#include "stages/calibrate/verdict.h"
 
 namespace tiltcal::calibrate {
 namespace {
@@ -66,6 +69,51 @@ Status ReadCalibrateInputs(const CalibratePaths& paths, const proto::CalibratePa
 
 namespace {
 
+// The wide-window tau of the initialisation and the scans it leaves out.
+void LogCoarseTimeOffset(const InitialisationReport& init, std::ostream* log) {
+  const imu::AngularSpeedAlignment& a = init.coarse.alignment;
+  Log(log, fmt::format("init: wide-window tau {:.4f} s (r {:.3f}, second peak {:.3f}, gyro/LiDAR "
+                       "rate scale {:.3f}){}{}",
+                       a.time_offset_s, a.correlation, a.second_peak_correlation, a.scale,
+                       init.odometry_rerun ? "; odometry rerun at that tau" : "",
+                       init.odometry_without_gyro ? " (measured on the odometry without the gyro)"
+                                                  : ""));
+  if (!init.coarse.trusted) {
+    Log(log, "init: wide-window tau not trusted, the search starts from 0: " +
+                 init.coarse.distrust_reason);
+  }
+  if (init.dropped_scans_outside_imu > 0) {
+    Log(log, fmt::format("init: {} scans lie outside the IMU time span at tau {:.4f} s and are "
+                         "not used",
+                         init.dropped_scans_outside_imu, init.time_offset_center_s));
+  }
+}
+
+// What the initialisation's checks of the rig rotation found.
+void LogRigChecks(const InitialisationReport& init, std::ostream* log) {
+  const AccelerationCheck& check = init.acceleration_check;
+  Log(log, fmt::format("init: rig rotation axis off by {:.2f} deg; starting C_bl {:.2f} deg from "
+                       "the rig's; acceleration yaw check {:.2f} deg ({}, RMS {:.2f} m/s^2)",
+                       init.rig_axis_disagreement_deg, init.rig_rotation_correction_deg,
+                       check.yaw_error_deg, check.decided ? "decided" : "not decided",
+                       check.rms_horizontal_acceleration_mps2));
+}
+
+// The initialisation's findings for the verdict (CalibrationResult 80-89).
+void FillInitialisationFacts(const InitialisationReport& init, proto::CalibrationResult* result) {
+  result->set_coarse_time_offset_s(init.coarse.alignment.time_offset_s);
+  result->set_coarse_time_offset_correlation(init.coarse.alignment.correlation);
+  result->set_coarse_time_offset_second_peak_correlation(
+      init.coarse.alignment.second_peak_correlation);
+  result->set_coarse_time_offset_trusted(init.coarse.trusted);
+  result->set_gyro_to_lidar_rate_scale(init.coarse.alignment.scale);
+  result->set_rig_rotation_correction_deg(init.rig_rotation_correction_deg);
+  result->set_dropped_scans_outside_imu(init.dropped_scans_outside_imu);
+  result->set_rig_rotation_axis_disagreement_deg(init.rig_axis_disagreement_deg);
+  result->set_rig_yaw_error_from_accelerations_deg(init.acceleration_check.yaw_error_deg);
+  result->set_acceleration_check_decided(init.acceleration_check.decided);
+}
+
 // Initialisation (initialisation.h) with its timings and log lines.
 Status Initialise(const CalibrateInputs& inputs, const proto::CalibrateParams& params,
                   CalibrationState* state, InitialisationReport* init,
@@ -87,9 +135,11 @@ Status Initialise(const CalibrateInputs& inputs, const proto::CalibrateParams& p
                        init->hand_eye.excitation_rad, init->hand_eye.num_pairs,
                        init->position_fit_rms, Seconds(start),
                        init->rotation_from_hand_eye ? "hand-eye" : "the rig"));
+  LogCoarseTimeOffset(*init, log);
   Log(log, fmt::format("init: rotation-axis alignment {:d} ({:.3f} deg), coarse tau {:.2f} ms",
                        init->axis_alignment_applied ? 1 : 0, init->axis_alignment_deg,
                        init->time_offset_init_s * 1e3));
+  LogRigChecks(*init, log);
   const Eigen::Vector3d r = state->ImuFromLidarTranslation();
   Log(log, fmt::format("init: rotation refit rms {:.3f}; r_bl ({:.4f}, {:.4f}, {:.4f}) m from the "
                        "position fit",
@@ -276,6 +326,59 @@ void FillEstimate(const CalibrationState& state, const std::vector<std::string>&
   result->set_ground_residuals_reason(ground_reason);
 }
 
+// A solve that failed outright (ceres FAILURE) or ended on a non-finite
+// cost leaves no usable estimate: an error, not a result.
+Status CheckSolveUsable(const OuterLoop& loop) {
+  if (loop.summary.termination_type == ceres::FAILURE) {
+    return Status::Error("the solve failed: " + loop.summary.message);
+  }
+  if (!std::isfinite(loop.summary.final_cost)) {
+    return Status::Error("the solve ended on a non-finite cost");
+  }
+  return Status::Ok();
+}
+
+// What the verdict is decided from besides the estimate and the covariance:
+// residual statistics and tau bounds of the last problem, the map sharpness
+// with the estimate and with the rig's extrinsic (same trajectory and tau),
+// the move from the rig, hand-eye and static start.
+void FillVerdictFacts(const CalibrateInputs& inputs, const proto::CalibrateParams& params,
+                      const InitialisationReport& init, CalibrationProblem* problem,
+                      const CalibrationState& state, proto::CalibrationResult* result) {
+  const auto start = Clock::now();
+  result->clear_residual_statistics();
+  for (proto::ResidualStatistics& s : ComputeResidualStatistics(problem->problem())) {
+    *result->add_residual_statistics() = std::move(s);
+  }
+  result->set_time_offset_lower_bound_s(problem->time_offset_lower_s());
+  result->set_time_offset_upper_bound_s(problem->time_offset_upper_s());
+
+  const Rigid3d rig = ToEigen(inputs.rig.imu_from_lidar());
+  const double spacing_s = params.association().deskew_node_spacing_s();
+  *result->mutable_map_sharpness_estimate() =
+      MeasureMapSharpness(state, inputs.scans, params.map(), spacing_s);
+  CalibrationState with_rig = state;
+  with_rig.SetImuFromLidarRotation(rig.rotation);
+  with_rig.SetImuFromLidarTranslation(rig.translation);
+  *result->mutable_map_sharpness_rig() =
+      MeasureMapSharpness(with_rig, inputs.scans, params.map(), spacing_s);
+
+  const Eigen::Quaterniond c_bl = state.ImuFromLidarRotation();
+  *result->mutable_rig_imu_from_lidar() = ToProto(rig);
+  result->set_rotation_from_rig_deg(
+      Eigen::AngleAxisd(rig.rotation.conjugate() * c_bl).angle() * 180.0 / M_PI);
+  result->set_translation_from_rig_m((state.ImuFromLidarTranslation() - rig.translation).norm());
+  result->set_hand_eye_used(init.rotation_from_hand_eye);
+  if (init.rotation_from_hand_eye) {
+    result->set_hand_eye_disagreement_deg(
+        Eigen::AngleAxisd(init.hand_eye.imu_from_lidar_rotation.conjugate() * c_bl).angle() *
+        180.0 / M_PI);
+  }
+  result->set_static_start(init.imu.from_static_start);
+  result->set_static_samples(init.imu.num_samples_averaged);
+  AddTiming("verdict_facts", Seconds(start), result);
+}
+
 }  // namespace
 
 Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& params,
@@ -317,6 +420,7 @@ Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& pa
                            ground_used.end()};
   ProblemOptions& problem_options = setup.problem_options;
   problem_options.time_offset_bound_s = params.time_offset_bound_s();
+  problem_options.time_offset_center_s = init.time_offset_center_s;
   problem_options.time_offset_step_bound_s = params.outer_loop().time_offset_step_bound_s();
   problem_options.fix_first_knots = false;  // the fixed map planes pin the gauge
   problem_options.translation_prior_m = ToEigen(inputs.rig.imu_from_lidar()).translation;
@@ -328,14 +432,18 @@ Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& pa
   while (loop.rounds < max_rounds && !settled) {
     TILTCAL_RETURN_IF_ERROR(RunOuterRound(setup, &state, &loop, &settled, log));
   }
+  TILTCAL_RETURN_IF_ERROR(CheckSolveUsable(loop));
   FillSolverReport(loop, result);
   FillCovariance(inputs, params, loop.problem.get(), &state, result);
+  FillVerdictFacts(inputs, params, init, loop.problem.get(), state, result);
   loop.problem.reset();
 
   ReexpressInFirstImuFrame(&state);
   FillEstimate(state, ground_used, ground_reason, result);
+  FillInitialisationFacts(init, result);
   AddTiming("total", Seconds(total_start), result);
   if (final_state != nullptr) *final_state = state;
+  DecideVerdict(params.verdict(), result);
   for (const proto::ObservabilityDirection& d : result->observability()) Log(log, d.description());
   Log(log, fmt::format("done in {:.2f} s, {} LM iterations, {:.3f} s per iteration",
                        Seconds(total_start), loop.total_iterations,
@@ -343,7 +451,8 @@ Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& pa
   return Status::Ok();
 }
 
-Status Run(const CalibratePaths& paths, const proto::CalibrateParams& params, std::ostream* log) {
+Status Run(const CalibratePaths& paths, const proto::CalibrateParams& params, std::ostream* log,
+           proto::CalibrationResult* written) {
   const auto start = Clock::now();
   CalibrateInputs inputs;
   TILTCAL_RETURN_IF_ERROR(ReadCalibrateInputs(paths, params, &inputs));
@@ -359,7 +468,9 @@ Status Run(const CalibratePaths& paths, const proto::CalibrateParams& params, st
   if (!paths.gravity.empty()) input_paths.push_back({"gravity", paths.gravity});
   *result.mutable_provenance() =
       MakeProvenance("tiltcal_calibrate", params, input_paths, paths.command_line);
-  return WriteTextProto(paths.out, result);
+  TILTCAL_RETURN_IF_ERROR(WriteTextProto(paths.out, result));
+  if (written != nullptr) *written = std::move(result);
+  return Status::Ok();
 }
 
 }  // namespace tiltcal::calibrate

@@ -13,6 +13,9 @@
 //     (problem_builder.h: gyro, accel, point-to-plane, ground when available),
 //     LM solve (SPARSE_NORMAL_CHOLESKY);
 //   covariance and observability report (covariance_report.h);
+//   the facts of the verdict (residual statistics, map sharpness with the
+//   estimate and with the rig, move from the rig) and the verdict
+//   (verdict.h);
 //   re-expression in the gauge C_ab(t0) = 1, r_a^{ba}(t0) = 0.
 // Times: seconds from the first IMU stamp; LiDAR point times
 // t_j = scan stamp + time_offset_ns (LiDAR clock), at IMU time t_j + tau.
@@ -67,8 +70,12 @@ Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& pa
                  proto::CalibrationResult* result, CalibrationState* final_state,
                  std::ostream* log);
 
-// Reads, calibrates, writes calibration.txtpb atomically with provenance.
-Status Run(const CalibratePaths& paths, const proto::CalibrateParams& params, std::ostream* log);
+// Reads, calibrates, writes calibration.txtpb atomically with provenance;
+// the result written (with its verdict) also goes to *written when not null.
+// A SUSPECT verdict is not an error here: the caller decides (main exits
+// cli::kExitSuspect unless VerdictParams.allow_suspect).
+Status Run(const CalibratePaths& paths, const proto::CalibrateParams& params, std::ostream* log,
+           proto::CalibrationResult* written = nullptr);
 
 }  // namespace tiltcal::calibrate
 

@@ -53,6 +53,16 @@ Status ValidateGroundResidualsParams(const proto::GroundResidualsParams& params)
   return MustBePositive(params.up().sigma(), "ground.up.sigma");
 }
 
+Status ValidateVerdictParams(const proto::VerdictParams& params) {
+  TILTCAL_RETURN_IF_ERROR(MustBePositive(params.max_gyro_rms(), "verdict.max_gyro_rms"));
+  TILTCAL_RETURN_IF_ERROR(MustBePositive(params.max_accel_rms(), "verdict.max_accel_rms"));
+  TILTCAL_RETURN_IF_ERROR(MustBePositive(params.max_lidar_rms(), "verdict.max_lidar_rms"));
+  TILTCAL_RETURN_IF_ERROR(MustBePositive(params.max_ground_rms(), "verdict.max_ground_rms"));
+  TILTCAL_RETURN_IF_ERROR(
+      MustBePositive(params.large_rotation_deg(), "verdict.large_rotation_deg"));
+  return MustBePositive(params.large_translation_m(), "verdict.large_translation_m");
+}
+
 Status ValidateCalibrateParams(const proto::CalibrateParams& params) {
   TILTCAL_RETURN_IF_ERROR(ValidateImuNoiseParams(params.imu_noise()));
   TILTCAL_RETURN_IF_ERROR(ValidateLidarScanParams(params.scans()));
@@ -62,7 +72,8 @@ Status ValidateCalibrateParams(const proto::CalibrateParams& params) {
       ValidateSurfelMapParams(params.odometry().quality_map(), "odometry.quality_map"));
   TILTCAL_RETURN_IF_ERROR(ValidateSurfelMapParams(params.map(), "map"));
   TILTCAL_RETURN_IF_ERROR(ValidateAssociationParams(params.association()));
-  return ValidateGroundResidualsParams(params.ground());
+  TILTCAL_RETURN_IF_ERROR(ValidateGroundResidualsParams(params.ground()));
+  return ValidateVerdictParams(params.verdict());
 }
 
 Status LoadCalibrateParams(const std::string& path, proto::CalibrateParams* params) {

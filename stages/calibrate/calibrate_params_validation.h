@@ -24,6 +24,7 @@ Status ValidateInitParams(const proto::InitParams& params);
 Status ValidateSurfelMapParams(const proto::SurfelMapParams& params, const std::string& path);
 Status ValidateAssociationParams(const proto::AssociationParams& params);
 Status ValidateGroundResidualsParams(const proto::GroundResidualsParams& params);
+Status ValidateVerdictParams(const proto::VerdictParams& params);
 
 Status ValidateCalibrateParams(const proto::CalibrateParams& params);
 

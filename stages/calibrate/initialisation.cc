@@ -3,18 +3,21 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <optional>
 
 #include <ceres/sized_cost_function.h>
 
-#include <Eigen/Eigenvalues>
+#include <fmt/format.h>
 
 #include "common/imu/gyro_integrator.h"
 #include "common/io/static_detection_params.h"
 #include "common/spline/cubic_basis.h"
 #include "common/spline/so3_spline.h"
+#include "stages/calibrate/coarse_time_offset.h"
 #include "stages/calibrate/covariance_report.h"
 #include "stages/calibrate/orientation_sample_cost_function.h"
 #include "stages/calibrate/problem_builder.h"
+#include "stages/calibrate/rig_rotation_check.h"
 
 namespace tiltcal::calibrate {
 namespace {
@@ -62,11 +65,12 @@ class LidarPositionSampleCost final : public ceres::SizedCostFunction<3, 3, 3, 3
   double inv_sigma_;
 };
 
-// The initial fits hold the extrinsic, tau, gravity and the biases unless
-// told otherwise.
-ProblemOptions FitOptions(const proto::CalibrateParams& params) {
+// The initial fits hold the extrinsic, tau (at the state's value), gravity
+// and the biases unless told otherwise.
+ProblemOptions FitOptions(const proto::CalibrateParams& params, const CalibrationState& state) {
   ProblemOptions p;
   p.time_offset_bound_s = params.time_offset_bound_s();
+  p.time_offset_center_s = state.time_offset_s[0];
   p.time_offset_step_bound_s = params.outer_loop().time_offset_step_bound_s();
   p.estimate_extrinsic = false;
   p.estimate_time_offset = false;
@@ -120,29 +124,15 @@ Eigen::Vector3d Interpolate(const std::vector<double>& times,
 
 Eigen::Quaterniond AlignRotationAxes(const std::vector<RotationPair>& pairs,
                                      const Eigen::Quaterniond& imu_from_lidar) {
-  Eigen::Matrix3d mb = Eigen::Matrix3d::Zero(), ml = Eigen::Matrix3d::Zero();
-  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> phis;
-  for (const RotationPair& p : pairs) {
-    const Eigen::AngleAxisd ab(p.imu_delta), al(p.lidar_delta);
-    const Eigen::Vector3d phi_b = ab.angle() * ab.axis();
-    const Eigen::Vector3d phi_l = al.angle() * al.axis();
-    mb += phi_b * phi_b.transpose();
-    ml += phi_l * phi_l.transpose();
-    phis.emplace_back(phi_b, phi_l);
-  }
-  if (mb.trace() <= 0.0 || ml.trace() <= 0.0) return imu_from_lidar;
-  const Eigen::Vector3d a_b = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(mb).eigenvectors().col(2);
-  Eigen::Vector3d a_l = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(ml).eigenvectors().col(2);
-  double corr = 0.0;
-  for (const auto& [pb, pl] : phis) corr += pb.dot(a_b) * pl.dot(a_l);
-  if (corr < 0.0) a_l = -a_l;
+  Eigen::Vector3d a_b, a_l;
+  if (!MatchedPrincipalAxes(pairs, &a_b, &a_l)) return imu_from_lidar;
   const Eigen::Vector3d mapped = imu_from_lidar * a_l;
   return (Eigen::Quaterniond::FromTwoVectors(mapped, a_b) * imu_from_lidar).normalized();
 }
 
 double SearchTimeOffset(const CalibrationState& state, const std::vector<double>& scan_times_s,
-                        const std::vector<Eigen::Quaterniond>& lidar_rotations, double bound_s,
-                        double step_s) {
+                        const std::vector<Eigen::Quaterniond>& lidar_rotations, double center_s,
+                        double bound_s, double step_s) {
   const Eigen::Quaterniond c_bl = state.ImuFromLidarRotation();
   const spline::SplineTrajectory& traj = state.trajectory;
   // b-frame rotation vectors of consecutive LiDAR poses.
@@ -167,19 +157,19 @@ double SearchTimeOffset(const CalibrationState& state, const std::vector<double>
     }
     return sum;
   };
-  if (phi_l.empty() || step_s <= 0.0) return 0.0;
+  if (phi_l.empty() || step_s <= 0.0) return center_s;
   const int n = static_cast<int>(std::floor(bound_s / step_s));
   int best = 0;
-  double best_cost = cost(0.0);
+  double best_cost = cost(center_s);
   std::vector<double> costs(2 * n + 1);
   for (int i = -n; i <= n; ++i) {
-    costs[i + n] = cost(i * step_s);
+    costs[i + n] = cost(center_s + i * step_s);
     if (costs[i + n] < best_cost) {
       best_cost = costs[i + n];
       best = i;
     }
   }
-  double tau = best * step_s;
+  double tau = center_s + best * step_s;
   // Parabola through the neighbours.
   if (best > -n && best < n) {
     const double c0 = costs[best + n - 1], c1 = costs[best + n], c2 = costs[best + n + 1];
@@ -198,7 +188,7 @@ double FitRotationSplineToGyro(const std::vector<imu::ImuReading>& imu_samples,
   for (int i = 0; i < traj.num_knots(); ++i) {
     traj.SetRotationKnot(i, integrator.Rotation(grid.t0_s() + (i - 1) * grid.dt_s()));
   }
-  CalibrationProblem problem(state, FitImuNoise(params), params.lidar(), FitOptions(params));
+  CalibrationProblem problem(state, FitImuNoise(params), params.lidar(), FitOptions(params, *state));
   problem.AddImuResiduals(imu_samples, /*gyro=*/true, /*accel=*/false);
   problem.RemoveUnusedKnots();
   return SolveFit(params, problem.problem());
@@ -210,7 +200,7 @@ double RefineRotationSpline(const std::vector<double>& times_s,
                             const proto::CalibrateParams& params, CalibrationState* state) {
   spline::SplineTrajectory& traj = state->trajectory;
   const spline::UniformKnotGrid& grid = traj.grid();
-  CalibrationProblem problem(state, FitImuNoise(params), params.lidar(), FitOptions(params));
+  CalibrationProblem problem(state, FitImuNoise(params), params.lidar(), FitOptions(params, *state));
   problem.AddImuResiduals(imu_samples, /*gyro=*/true, /*accel=*/false);
   const double sigma = params.init().odometry_rotation_sigma_deg() * M_PI / 180.0;
   Status status = problem.AddExtraResiduals([&](CalibrationState* s, ceres::Problem* p, int* added) {
@@ -262,7 +252,7 @@ double FitPositionSpline(const std::vector<double>& times_s,
   // lever arm r_b^{lb} (prior at its current value): a wrong one makes the
   // IMU positions p_l - C_ab r_b^{lb} swing with the heading, which the
   // accelerometer contradicts.
-  ProblemOptions fit = FitOptions(params);
+  ProblemOptions fit = FitOptions(params, *state);
   fit.estimate_biases = true;
   fit.estimate_gravity = true;
   fit.fix_first_knots = false;  // the position samples pin the gauge
@@ -299,7 +289,7 @@ double FitPositionSpline(const std::vector<double>& times_s,
 namespace {
 
 // Step 3: the odometry's poses and, per pose, its scan and C_ab at the scan
-// stamp (tau = 0).
+// stamp + tau (the state's).
 struct OdometryRun {
   std::vector<LidarOdometryPose> poses;
   std::vector<int> scan_of_pose;
@@ -331,10 +321,18 @@ bool DeskewScan(const CalibrationState& state, const LidarScan& scan, double nod
   return true;
 }
 
-// Odometry on scans deskewed with the rotation spline (positions are still
-// zero, so only rotation and the lever arm move the points).
+// Odometry on scans deskewed with the rotation spline at the state's tau
+// (positions are still zero, so only rotation and the lever arm move the
+// points) and a rotation prior from it; scans whose stamp + tau is outside
+// the spline are left out. Without gyro_aided: raw scans, no prior (the
+// gyro's speeds are then only compared with the LiDAR's, not trusted).
 OdometryRun RunOdometry(const std::vector<LidarScan>& scans, const CalibrationState& state,
-                        const proto::CalibrateParams& params, InitialisationReport* report) {
+                        const proto::CalibrateParams& params, bool gyro_aided,
+                        InitialisationReport* report) {
+  report->odometry_scans = 0;
+  report->odometry_registered = 0;
+  report->odometry_mean_fitness_m = 0.0;
+  const double tau = state.time_offset_s[0];
   LidarOdometry odometry(params.odometry(), params.scans());
   const spline::SplineTrajectory& traj = state.trajectory;
   const Eigen::Quaterniond c_bl = state.ImuFromLidarRotation();
@@ -348,8 +346,11 @@ OdometryRun RunOdometry(const std::vector<LidarScan>& scans, const CalibrationSt
     const LidarScan& scan = scans[k];
     if (scan.points.empty()) continue;
     spline::So3SplineSample rot;
-    if (!traj.Evaluate(scan.stamp_s, spline::kSo3Rotation, &rot, nullptr)) continue;
-    if (!DeskewScan(state, scan, params.init().deskew_node_spacing_s(), &table, &deskewed)) {
+    if (!traj.Evaluate(scan.stamp_s + tau, spline::kSo3Rotation, &rot, nullptr)) continue;
+    if (!gyro_aided) {
+      deskewed = scan.points;
+    } else if (!DeskewScan(state, scan, params.init().deskew_node_spacing_s(), &table,
+                           &deskewed)) {
       continue;
     }
     const Eigen::Quaterniond c_ab_k(rot.rotation);
@@ -357,7 +358,9 @@ OdometryRun RunOdometry(const std::vector<LidarScan>& scans, const CalibrationSt
       c_ab_first = c_ab_k;
       have_first = true;
     }
-    odometry.AddScan(scan.stamp_s, deskewed, LidarRotationPriorFromImu(c_ab_first, c_ab_k, c_bl));
+    std::optional<Eigen::Quaterniond> prior;
+    if (gyro_aided) prior = LidarRotationPriorFromImu(c_ab_first, c_ab_k, c_bl);
+    odometry.AddScan(scan.stamp_s, deskewed, prior);
     run.scan_of_pose.push_back(static_cast<int>(k));
     run.imu_rotations.push_back(c_ab_k);
   }
@@ -381,30 +384,45 @@ OdometryRun RunOdometry(const std::vector<LidarScan>& scans, const CalibrationSt
 }
 
 // Step 4: C_bl from the rig, or hand-eye when excited; without excitation
-// the rig's C_bl aligned to the motion's rotation axis.
-Eigen::Quaterniond InitialExtrinsicRotation(const OdometryRun& run,
-                                            const Eigen::Quaterniond& measured_imu_from_lidar,
-                                            const proto::CalibrateParams& params,
-                                            InitialisationReport* report) {
+// the rig's C_bl aligned to the motion's rotation axis. The rig's C_bl maps
+// the LiDAR's rotation axis within max_axis_alignment_deg of the IMU's, or
+// hand-eye replaces it; otherwise (planar motion: the rotation about the
+// axis is not determined) it is an error with the angle.
+Status InitialExtrinsicRotation(const OdometryRun& run,
+                                const Eigen::Quaterniond& measured_imu_from_lidar,
+                                const proto::CalibrateParams& params,
+                                InitialisationReport* report, Eigen::Quaterniond* c_bl) {
   const int pair_step = std::max(1, static_cast<int>(params.hand_eye().pair_step()));
-  report->hand_eye = EstimateHandEyeRotation(
-      MakeRotationPairs(run.imu_used, run.lidar_used, pair_step), params.hand_eye());
+  const std::vector<RotationPair> pairs =
+      MakeRotationPairs(run.imu_used, run.lidar_used, pair_step);
+  report->hand_eye = EstimateHandEyeRotation(pairs, params.hand_eye());
   Eigen::Quaterniond c_bl_init = ChooseInitialRotation(measured_imu_from_lidar, report->hand_eye);
   report->rotation_from_hand_eye = report->hand_eye.excited;
+  report->rig_axis_disagreement_deg = RotationAxisDisagreementDeg(pairs, measured_imu_from_lidar);
+  const double max_deg = params.init().max_axis_alignment_deg();
+  if (!report->rotation_from_hand_eye && report->rig_axis_disagreement_deg > max_deg) {
+    return Status::Error(fmt::format(
+        "the rig's imu_from_lidar rotation maps the LiDAR's rotation axis {:.1f} deg away from "
+        "the IMU's (180: one of them is upside down; at most init.max_axis_alignment_deg = {} "
+        "is corrected), and the motion (hand-eye excitation {:.4f} rad) does not determine "
+        "the rotation: fix imu_from_lidar.rotation in the rig",
+        report->rig_axis_disagreement_deg, max_deg, report->hand_eye.excitation_rad));
+  }
   if (!report->rotation_from_hand_eye && params.init().align_rotation_axis()) {
     // Planar motion: the rotation axis is still seen by both sensors.
-    const std::vector<RotationPair> pairs =
-        MakeRotationPairs(run.imu_used, run.lidar_used, pair_step);
     const Eigen::Quaterniond aligned = AlignRotationAxes(pairs, c_bl_init);
     const double correction_deg =
         Eigen::AngleAxisd(aligned * c_bl_init.conjugate()).angle() * 180.0 / M_PI;
-    if (correction_deg <= params.init().max_axis_alignment_deg()) {
+    if (correction_deg <= max_deg) {
       c_bl_init = aligned;
       report->axis_alignment_deg = correction_deg;
       report->axis_alignment_applied = true;
     }
   }
-  return c_bl_init;
+  report->rig_rotation_correction_deg =
+      Eigen::AngleAxisd(c_bl_init * measured_imu_from_lidar.conjugate()).angle() * 180.0 / M_PI;
+  *c_bl = c_bl_init;
+  return Status::Ok();
 }
 
 // Step 4c: the rotation spline refitted to the gyro and the odometry's
@@ -441,6 +459,151 @@ Eigen::Quaterniond RefineHeading(const OdometryRun& run, const std::vector<Lidar
   return anchor;
 }
 
+// Step 3b: tau over the wide window from the angular speeds of the gyro and
+// of the odometry (run at the state's tau), the gyro unit check, and the
+// centre of the later tau searches: the coarse tau when trusted (rounded to
+// the grid search's step, so that the grid keeps its points), else 0.
+Status EstimateCoarseTau(const OdometryRun& run, const std::vector<LidarScan>& scans,
+                         const std::vector<imu::ImuReading>& imu_samples,
+                         const proto::CalibrateParams& params, const CalibrationState& state,
+                         InitialisationReport* report) {
+  const proto::InitParams& init = params.init();
+  report->time_offset_center_s = 0.0;
+  if (init.coarse_time_offset_window_s() <= 0.0) return Status::Ok();
+  std::vector<double> times;
+  for (const size_t i : run.used) times.push_back(scans[run.scan_of_pose[i]].stamp_s);
+  CoarseTimeOffset coarse;
+  const Status status =
+      EstimateCoarseTimeOffset(GyroAngularSpeeds(imu_samples, state.GyroBias()),
+                               LidarAngularSpeeds(times, run.lidar_used), init, &coarse);
+  report->coarse = coarse;
+  if (!status.ok()) {
+    report->coarse.distrust_reason = status.message();
+    report->coarse.trusted = false;
+    return Status::Ok();
+  }
+  if (!coarse.trusted) return Status::Ok();
+  const double step = init.time_offset_search_step_s();
+  const double tau = coarse.alignment.time_offset_s;
+  report->time_offset_center_s = step > 0.0 ? std::round(tau / step) * step : tau;
+  return Status::Ok();
+}
+
+// Scans whose sweep at t_l + tau is not inside the IMU's spline.
+int CountScansOutsideImu(const std::vector<LidarScan>& scans, const CalibrationState& state) {
+  const spline::UniformKnotGrid& grid = state.trajectory.grid();
+  spline::KnotWindow w;
+  int outside = 0;
+  for (const LidarScan& scan : scans) {
+    const double t = scan.stamp_s + state.time_offset_s[0];
+    if (!grid.Locate(t + scan.min_time_s, &w) || !grid.Locate(t + scan.max_time_s, &w)) {
+      ++outside;
+    }
+  }
+  return outside;
+}
+
+// Step 4d: the acceleration check of the starting C_bl about the motion's
+// axis (rig_rotation_check.h); a yaw error beyond max_rig_rotation_error_deg
+// is an error.
+Status CheckRigYaw(const OdometryRun& run, const std::vector<LidarScan>& scans,
+                   const std::vector<imu::ImuReading>& imu_samples, const Eigen::Vector3d& axis_b,
+                   const proto::CalibrateParams& params, const CalibrationState& state,
+                   InitialisationReport* report) {
+  std::vector<double> times;
+  std::vector<Eigen::Vector3d> positions;
+  for (const size_t i : run.used) {
+    times.push_back(scans[run.scan_of_pose[i]].stamp_s);
+    positions.push_back(run.poses[i].l0_from_lidar.translation());
+  }
+  report->acceleration_check =
+      CheckRigYawByAccelerations(state, imu_samples, times, positions, axis_b, params.init());
+  const AccelerationCheck& check = report->acceleration_check;
+  const double max_deg = params.init().max_rig_rotation_error_deg();
+  if (!check.decided || std::abs(check.yaw_error_deg) <= max_deg) return Status::Ok();
+  return Status::Error(fmt::format(
+      "the LiDAR's accelerations mapped into the IMU frame by the {} C_bl are turned by {:.1f} "
+      "deg about the motion's rotation axis ({:.3f}, {:.3f}, {:.3f}) against the "
+      "accelerometer's (RMS horizontal acceleration {:.2f} m/s^2, {} samples; at most "
+      "init.max_rig_rotation_error_deg = {}): the rig's imu_from_lidar rotation is off by about "
+      "that angle about this axis; fix it in the rig",
+      report->rotation_from_hand_eye ? "hand-eye" : "rig's", check.yaw_error_deg, axis_b.x(),
+      axis_b.y(), axis_b.z(), check.rms_horizontal_acceleration_mps2, check.samples, max_deg));
+}
+
+// 99th percentile of |omega_m - b_g|, in the file's unit.
+double GyroSpeedPercentile99(const std::vector<imu::ImuReading>& imu_samples,
+                             const Eigen::Vector3d& gyro_bias) {
+  std::vector<double> speeds;
+  for (const imu::TimedValue& v : GyroAngularSpeeds(imu_samples, gyro_bias)) {
+    speeds.push_back(v.value);
+  }
+  if (speeds.empty()) return 0.0;
+  const size_t k = std::min(speeds.size() - 1, static_cast<size_t>(0.99 * speeds.size()));
+  std::nth_element(speeds.begin(), speeds.begin() + k, speeds.end());
+  return speeds[k];
+}
+
+// Step 3 with 3b: the odometry at tau = 0, the coarse tau and, when it is
+// beyond time_offset_bound_s, the odometry again at the coarse tau (its
+// deskew and gyro prior then come from the right instants).
+Status OdometryAndCoarseTau(const std::vector<LidarScan>& scans,
+                            const std::vector<imu::ImuReading>& imu_samples,
+                            const proto::CalibrateParams& params, CalibrationState* state,
+                            InitialisationReport* report, OdometryRun* run) {
+  auto start = std::chrono::steady_clock::now();
+  *run = RunOdometry(scans, *state, params, /*gyro_aided=*/true, report);
+  report->odometry_seconds = Seconds(start);
+  if (run->poses.size() < 2) {
+    return Status::Error("too few scans inside the IMU time range for the LiDAR odometry (" +
+                         std::to_string(run->poses.size()) + ")");
+  }
+  TILTCAL_RETURN_IF_ERROR(EstimateCoarseTau(*run, scans, imu_samples, params, *state, report));
+  const proto::InitParams& init = params.init();
+  const double scale = report->coarse.alignment.scale;
+  if (init.coarse_time_offset_window_s() > 0.0 &&
+      (!report->coarse.trusted || scale < init.min_gyro_to_lidar_rate_scale() ||
+       scale > init.max_gyro_to_lidar_rate_scale() ||
+       GyroSpeedPercentile99(imu_samples, state->GyroBias()) >
+           init.max_plausible_gyro_speed_radps())) {
+    // The gyro may have misled the odometry (deskew and prior from a gyro in
+    // another unit, or from instants far off): the LiDAR alone decides.
+    start = std::chrono::steady_clock::now();
+    const OdometryRun lidar_only = RunOdometry(scans, *state, params, false, report);
+    report->odometry_without_gyro = true;
+    report->odometry_seconds += Seconds(start);
+    TILTCAL_RETURN_IF_ERROR(
+        EstimateCoarseTau(lidar_only, scans, imu_samples, params, *state, report));
+    if (report->coarse.trusted) {
+      TILTCAL_RETURN_IF_ERROR(CheckGyroToLidarRateScale(report->coarse.alignment.scale, init));
+    }
+  }
+  if (std::abs(report->time_offset_center_s) > params.time_offset_bound_s() ||
+      report->odometry_without_gyro) {
+    start = std::chrono::steady_clock::now();
+    state->time_offset_s[0] = report->time_offset_center_s;
+    *run = RunOdometry(scans, *state, params, /*gyro_aided=*/true, report);
+    report->odometry_rerun = true;
+    report->odometry_seconds += Seconds(start);
+    if (run->poses.size() < 2) {
+      return Status::Error(fmt::format(
+          "too few scans inside the IMU time range at the coarse time offset {:.3f} s ({})",
+          report->time_offset_center_s, run->poses.size()));
+    }
+    // The first odometry's gyro prior came from instants tau off, which
+    // drags its rotations; the rerun's speeds give the better tau.
+    const InitialisationReport first = *report;
+    TILTCAL_RETURN_IF_ERROR(EstimateCoarseTau(*run, scans, imu_samples, params, *state, report));
+    if (!report->coarse.trusted) {
+      report->coarse = first.coarse;
+      report->time_offset_center_s = first.time_offset_center_s;
+    }
+  }
+  state->time_offset_s[0] = report->time_offset_center_s;
+  report->dropped_scans_outside_imu = CountScansOutsideImu(scans, *state);
+  return Status::Ok();
+}
+
 }  // namespace
 
 Status InitialiseState(const std::vector<imu::ImuReading>& imu_samples,
@@ -469,35 +632,35 @@ Status InitialiseState(const std::vector<imu::ImuReading>& imu_samples,
   report->gyro_fit_rms = FitRotationSplineToGyro(imu_samples, params, state);
   report->rotation_fit_seconds = Seconds(start);
 
-  // 3. Odometry.
-  start = std::chrono::steady_clock::now();
-  const OdometryRun run = RunOdometry(scans, *state, params, report);
-  report->odometry_seconds = Seconds(start);
-  if (run.poses.size() < 2) {
-    return Status::Error("too few scans inside the IMU time range for the LiDAR odometry (" +
-                         std::to_string(run.poses.size()) + ")");
-  }
+  // 3. Odometry and the wide-window tau.
+  OdometryRun run;
+  TILTCAL_RETURN_IF_ERROR(OdometryAndCoarseTau(scans, imu_samples, params, state, report, &run));
 
   // 4. Extrinsic rotation.
-  const Eigen::Quaterniond c_bl_init =
-      InitialExtrinsicRotation(run, measured_imu_from_lidar.rotation, params, report);
+  Eigen::Quaterniond c_bl_init;
+  TILTCAL_RETURN_IF_ERROR(
+      InitialExtrinsicRotation(run, measured_imu_from_lidar.rotation, params, report, &c_bl_init));
   state->SetImuFromLidarRotation(c_bl_init);
 
-  // 4b. Coarse tau from consecutive odometry rotations against the gyro spline.
+  // 4b. Tau from consecutive odometry rotations against the gyro spline,
+  // within time_offset_bound_s of the coarse tau.
+  report->time_offset_init_s = report->time_offset_center_s;
   if (params.time_offset_bound_s() > 0.0) {
     std::vector<double> times_used;
     for (const size_t i : run.used) times_used.push_back(scans[run.scan_of_pose[i]].stamp_s);
-    report->time_offset_init_s =
-        SearchTimeOffset(*state, times_used, run.lidar_used, params.time_offset_bound_s(),
-                         params.init().time_offset_search_step_s());
-    state->time_offset_s[0] = report->time_offset_init_s;
+    report->time_offset_init_s = SearchTimeOffset(
+        *state, times_used, run.lidar_used, report->time_offset_center_s,
+        params.time_offset_bound_s(), params.init().time_offset_search_step_s());
   }
+  state->time_offset_s[0] = report->time_offset_init_s;
 
-  // 4c. Heading.
+  // 4c. Heading; 4d. the starting C_bl against the accelerations.
   start = std::chrono::steady_clock::now();
   const Eigen::Quaterniond anchor =
       RefineHeading(run, scans, imu_samples, c_bl_init, params, state, report);
   report->rotation_fit_seconds += Seconds(start);
+  TILTCAL_RETURN_IF_ERROR(
+      CheckRigYaw(run, scans, imu_samples, axis.axis_b, params, *state, report));
 
   // 5. Position spline (and lever arm) from the odometry's LiDAR positions,
   // p_l(t_k) = C_ab(t_f + tau) C_bl r_{l0}^{lk l0} (the LiDAR at the first

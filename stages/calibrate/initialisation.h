@@ -10,17 +10,34 @@
 //     the bias held (rotation knot 0 held: gauge);
 //  3. LiDAR odometry (lidar_odometry.h, GICP or NDT) on scans deskewed with
 //     that rotation spline and the rig's C_bl (tau = 0), giving T_{l0 lk};
+//  3b. coarse tau over +-InitParams.coarse_time_offset_window_s from the
+//     angular speeds of gyro and odometry (coarse_time_offset.h), with the
+//     gyro/LiDAR rate scale checked (a gyro in deg/s is an error); an
+//     untrusted peak leaves tau at 0 (InitialisationReport::coarse says
+//     why). No trusted peak, a scale out of bounds or gyro speeds above
+//     max_plausible_gyro_speed_radps (99th percentile): the same on an
+//     odometry without the gyro (a gyro in another unit misleads the
+//     deskew and the prior), then the scale check. A coarse tau beyond
+//     time_offset_bound_s (or the gyro-free case) reruns the odometry at
+//     that tau. Scans whose sweep at t_l + tau is outside the IMU span are
+//     counted (dropped_scans_outside_imu) and take no further part;
 //  4. extrinsic: the rig's measured (C_bl, r_b^{lb}) (the paper's protocol);
 //     hand-eye rotation (hand_eye_rotation.h) replaces C_bl only when its
 //     excitation measure says the motion is rich enough; otherwise (planar
 //     motion) the rig's C_bl is only tilted so that the LiDAR's principal
 //     rotation axis maps onto the IMU's (AlignRotationAxes: fixes the two
-//     tilt angles, keeps the rig's angle about the axis);
-//  4b. coarse tau by a grid search of the odometry's scan-to-scan rotations
-//     against the gyro spline (SearchTimeOffset);
+//     tilt angles, keeps the rig's angle about the axis). A rig C_bl whose
+//     mapped axis is more than max_axis_alignment_deg off, without hand-eye
+//     excitation, is an error (rig_rotation_check.h);
+//  4b. tau by a grid search of the odometry's scan-to-scan rotations
+//     against the gyro spline within +-time_offset_bound_s of the coarse tau
+//     (SearchTimeOffset);
 //  4c. the rotation spline refitted to the gyro and the odometry's
 //     orientations carried to b (RefineRotationSpline), so that its heading
 //     follows the LiDAR instead of the integrated gyro bias error;
+//  4d. the starting C_bl checked about the motion's axis by the
+//     accelerations (rig_rotation_check.h): a yaw error beyond
+//     max_rig_rotation_error_deg is an error;
 //  5. position spline r_a^{ba}(t) and the lever arm r_b^{lb}: the odometry
 //     gives the LiDAR positions at the scan times (scan k at IMU time
 //     t_k + tau; the LiDAR at the first registered scan f as origin),
@@ -31,7 +48,8 @@
 // The odometry registers every LidarOdometryParams.scan_step-th scan. The
 // initialisation reads these CalibrateParams: init, imu_noise,
 // static_detection, odometry, hand_eye, scans (the odometry's range crop),
-// gravity_norm_mps2, time_offset_bound_s (the coarse tau search range),
+// gravity_norm_mps2, time_offset_bound_s (the tau search range around the
+// coarse tau),
 // extrinsic_translation_prior_sigma_m and num_threads.
 
 #include <vector>
@@ -41,9 +59,11 @@
 #include "common/io/eigen_proto.h"
 #include "common/status.h"
 #include "stages/calibrate/calibration_state.h"
+#include "stages/calibrate/coarse_time_offset.h"
 #include "stages/calibrate/hand_eye_rotation.h"
 #include "stages/calibrate/lidar_odometry.h"
 #include "stages/calibrate/lidar_scans.h"
+#include "stages/calibrate/rig_rotation_check.h"
 #include "tiltcal/proto/calibrate_params.pb.h"
 
 namespace tiltcal::calibrate {
@@ -60,7 +80,22 @@ struct InitialisationReport {
   double position_fit_rms = 0.0;  // RMS weighted residual of the position fit
   bool axis_alignment_applied = false;
   double axis_alignment_deg = 0.0;  // correction of the rig's C_bl by the axis alignment
-  double time_offset_init_s = 0.0;  // coarse tau
+  double time_offset_init_s = 0.0;  // tau after the grid search (step 4b), s
+  // Step 3b: the wide-window alignment, and the centre of the tau searches
+  // and of the solve's tau bound (the coarse tau when trusted, else 0), s.
+  CoarseTimeOffset coarse;
+  double time_offset_center_s = 0.0;
+  bool odometry_rerun = false;  // the odometry was run again at the coarse tau
+  // The gyro-aided odometry gave no trusted peak or a rate scale out of
+  // bounds, so tau and the scale were measured on an odometry without the
+  // gyro (raw scans, no rotation prior).
+  bool odometry_without_gyro = false;
+  int dropped_scans_outside_imu = 0;
+  // Steps 4 and 4d: the rig's C_bl against the motion, and how far the
+  // starting C_bl is from the rig's, deg.
+  double rig_axis_disagreement_deg = 0.0;
+  double rig_rotation_correction_deg = 0.0;
+  AccelerationCheck acceleration_check;
   // Principal rotation axis of the (bias-corrected) gyro, frame b, and the
   // share of sum omega omega^T along it (covariance_report.h).
   Eigen::Vector3d rotation_axis_b = Eigen::Vector3d::UnitZ();
@@ -88,12 +123,12 @@ Status InitialiseState(const std::vector<imu::ImuReading>& imu_samples,
 Eigen::Quaterniond AlignRotationAxes(const std::vector<RotationPair>& pairs,
                                      const Eigen::Quaterniond& imu_from_lidar);
 
-// Coarse tau: minimises sum_k |Log(C_ab(t_k+tau)^T C_ab(t_{k+1}+tau)) -
-// C_bl Log(C_{l0 lk}^T C_{l0 l(k+1)})|^2 over consecutive scans on a grid of
-// step_s over [-bound_s, bound_s], refined by a parabola.
+// Tau near center_s: minimises sum_k |Log(C_ab(t_k+tau)^T C_ab(t_{k+1}+tau))
+// - C_bl Log(C_{l0 lk}^T C_{l0 l(k+1)})|^2 over consecutive scans on a grid
+// of step_s over center_s + [-bound_s, bound_s], refined by a parabola.
 double SearchTimeOffset(const CalibrationState& state, const std::vector<double>& scan_times_s,
-                        const std::vector<Eigen::Quaterniond>& lidar_rotations, double bound_s,
-                        double step_s);
+                        const std::vector<Eigen::Quaterniond>& lidar_rotations, double center_s,
+                        double bound_s, double step_s);
 
 // Step 2 alone: knots from the integrated gyro (bias = state's b_g), then the
 // gyro-only LM fit. Returns the RMS weighted gyro residual.

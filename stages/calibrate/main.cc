@@ -4,6 +4,7 @@
 #include "common/cli/command_line.h"
 #include "stages/calibrate/calibrate.h"
 #include "stages/calibrate/calibrate_params_validation.h"
+#include "stages/calibrate/verdict.h"
 
 int main(int argc, char** argv) {
   using tiltcal::cli::kRequired;
@@ -22,6 +23,9 @@ int main(int argc, char** argv) {
       "tiltcal_calibrate --imu=out/run1/imu.binpb --scans=out/run1/scans.binpb.lz4 "
       "--ground=out/run1/ground.binpb --gravity=out/run1/gravity.txtpb "
       "--rig=datasets/husky/rig.txtpb --out=out/run1/calibration.txtpb");
+  cli.AddExitCode(tiltcal::cli::kExitSuspect,
+                  "result written but its verdict is SUSPECT (reasons in the file and on "
+                  "stderr; params verdict.allow_suspect: true exits 0)");
   if (const auto exit_code = cli.Parse(argc, argv)) return *exit_code;
   tiltcal::calibrate::CalibratePaths paths;
   paths.imu = cli.Get("imu");
@@ -34,8 +38,18 @@ int main(int argc, char** argv) {
   paths.command_line = cli.command_line();
   tiltcal::proto::CalibrateParams params;
   tiltcal::Status status = tiltcal::calibrate::LoadCalibrateParams(paths.params, &params);
+  tiltcal::proto::CalibrationResult result;
   if (status.ok()) {
-    status = tiltcal::calibrate::Run(paths, params, cli.GetSwitch("quiet") ? nullptr : &std::cerr);
+    status = tiltcal::calibrate::Run(paths, params, cli.GetSwitch("quiet") ? nullptr : &std::cerr,
+                                     &result);
   }
-  return cli.Finish(status);
+  if (!status.ok()) return cli.Finish(status);
+  std::cerr << "tiltcal_calibrate: " << tiltcal::calibrate::FormatVerdict(result, params.verdict())
+            << "\n";
+  if (result.verdict() == tiltcal::proto::CalibrationResult::SUSPECT &&
+      !params.verdict().allow_suspect()) {
+    std::cerr << "tiltcal_calibrate: " << paths.out << " is SUSPECT: read the reasons above\n";
+    return tiltcal::cli::kExitSuspect;
+  }
+  return tiltcal::cli::kExitOk;
 }

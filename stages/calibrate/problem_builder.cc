@@ -75,9 +75,11 @@ CalibrationProblem::CalibrationProblem(CalibrationState* state,
 
   // tau bounds around the binning value; tau clamped into them.
   const double bound = std::abs(options_.time_offset_bound_s);
-  const double tau_bin = std::clamp(state_->time_offset_s[0], -bound, bound);
-  tau_lower_ = std::max(-bound, tau_bin - options_.time_offset_step_bound_s);
-  tau_upper_ = std::min(bound, tau_bin + options_.time_offset_step_bound_s);
+  const double lowest = options_.time_offset_center_s - bound;
+  const double highest = options_.time_offset_center_s + bound;
+  const double tau_bin = std::clamp(state_->time_offset_s[0], lowest, highest);
+  tau_lower_ = std::max(lowest, tau_bin - options_.time_offset_step_bound_s);
+  tau_upper_ = std::min(highest, tau_bin + options_.time_offset_step_bound_s);
   state_->time_offset_s[0] = tau_bin;
   if (options_.estimate_time_offset && tau_upper_ > tau_lower_) {
     p.SetParameterLowerBound(state_->time_offset_s, 0, tau_lower_);

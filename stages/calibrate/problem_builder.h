@@ -37,8 +37,9 @@
 // ProblemCounts::prior_residuals.
 //
 // Time offset: tau is bounded to
-//   [max(-B, tau_bin - S), min(B, tau_bin + S)],
-// B = time_offset_bound_s (|tau| <= B overall), S = time_offset_step_bound_s
+//   [max(C - B, tau_bin - S), min(C + B, tau_bin + S)],
+// C = time_offset_center_s, B = time_offset_bound_s (|tau - C| <= B
+// overall), S = time_offset_step_bound_s
 // (how far tau may move from the value tau_bin that chose the frozen knot
 // windows of the LiDAR residuals in this build). The problem is rebuilt (and
 // the windows re-chosen) at every outer iteration.
@@ -81,6 +82,9 @@ struct ProblemOptions {
   // OuterLoopParams.time_offset_step_bound_s), s.
   double time_offset_bound_s = 0.0;
   double time_offset_step_bound_s = 0.0;
+  // C: the bound B is around C (|tau - C| <= B), the initialisation's coarse
+  // tau, s.
+  double time_offset_center_s = 0.0;
   // Which calibration blocks are free (constant otherwise).
   bool estimate_extrinsic = true;
   bool estimate_time_offset = true;

@@ -2,6 +2,9 @@
 #include <iostream>
 
 #include "common/cli/command_line.h"
+#include "common/io/params.h"
+#include "stages/inspect/check.h"
+#include "stages/inspect/default_params_text.h"
 #include "stages/inspect/ground_summary.h"
 #include "stages/inspect/inspect.h"
 #include "stages/inspect/pcd_export.h"
@@ -10,6 +13,14 @@ namespace {
 
 using tiltcal::Status;
 using tiltcal::cli::CommandLine;
+
+// `check --bag=... [--rig=...] [--params=...]`: the pre-flight check of a bag.
+Status RunCheckCommand(const CommandLine& cli) {
+  tiltcal::proto::CheckParams params;
+  TILTCAL_RETURN_IF_ERROR(tiltcal::LoadParamsOrDefaults(
+      cli.Get("params"), tiltcal::inspect::DefaultParamsText(), &params));
+  return tiltcal::inspect::RunCheck({cli.Get("bag"), cli.Get("rig")}, params, std::cout);
+}
 
 Status RunCommand(const CommandLine& cli, const std::string& command, const std::string& path) {
   namespace inspect = tiltcal::inspect;
@@ -34,10 +45,11 @@ Status RunCommand(const CommandLine& cli, const std::string& command, const std:
 
 int main(int argc, char** argv) {
   CommandLine cli("tiltcal_inspect", "looks into any file of the pipeline");
-  cli.SetPositional("info|cat|csv|pcd FILE",
+  cli.SetPositional("info|cat|csv|pcd FILE  or  check",
                     "info: what the file is; cat: its records as text; csv: a table; "
-                    "pcd: one scan as a PCD file",
-                    2, 2);
+                    "pcd: one scan as a PCD file; check: the pre-flight check of a bag "
+                    "(--bag, --rig, --params)",
+                    1, 2);
   cli.AddFlag("from", "cat: first record to print", tiltcal::cli::kOptional, "0");
   cli.AddFlag("count", "cat: number of records to print (-1: all)", tiltcal::cli::kOptional,
               "-1");
@@ -47,6 +59,13 @@ int main(int argc, char** argv) {
   cli.AddFlag("field", "csv of a text file: the repeated field to tabulate");
   cli.AddFlag("ground", "pcd: ground.binpb whose point masks label the points");
   cli.AddFlag("out", "pcd: the PCD file to write");
+  cli.AddFlag("bag", "check: the ROS1 bag to look at");
+  cli.AddFlag("rig", "check, optional: rig.txtpb (topics, extrinsic for up, imu_height_m)");
+  cli.AddFlag("params",
+              "check, optional: check params, text format (default: "
+              "stages/inspect/default_params.txtpb, compiled in)");
+  cli.AddExample("tiltcal_inspect check --bag=datasets/husky/run1.bag "
+                 "--rig=datasets/husky/rig.txtpb");
   cli.AddExample("tiltcal_inspect info out/run1/scans.binpb.lz4");
   cli.AddExample("tiltcal_inspect csv out/run1/ground.binpb > ground.csv");
   cli.AddExample("tiltcal_inspect csv out/run1/scans.binpb.lz4 --points --record=10");
@@ -55,13 +74,22 @@ int main(int argc, char** argv) {
       "--out=scan10.pcd");
   if (const auto exit_code = cli.Parse(argc, argv)) return *exit_code;
   const std::string& command = cli.positional()[0];
-  if (command != "info" && command != "cat" && command != "csv" && command != "pcd") {
+  if (command != "info" && command != "cat" && command != "csv" && command != "pcd" &&
+      command != "check") {
     std::cerr << "tiltcal_inspect: unknown command '" << command
-              << "' (info, cat, csv, pcd; see tiltcal_inspect --help)\n";
+              << "' (info, cat, csv, pcd, check; see tiltcal_inspect --help)\n";
+    return tiltcal::cli::kExitUsage;
+  }
+  const bool check = command == "check";
+  if (cli.positional().size() != (check ? 1u : 2u) || (check && cli.Get("bag").empty())) {
+    std::cerr << "tiltcal_inspect: " << command
+              << (check ? " takes --bag=FILE and no FILE argument" : " needs one FILE")
+              << " (see --help)\n";
     return tiltcal::cli::kExitUsage;
   }
   std::ios::sync_with_stdio(false);
-  const Status status = RunCommand(cli, command, cli.positional()[1]);
+  const Status status = check ? RunCheckCommand(cli)
+                                           : RunCommand(cli, command, cli.positional()[1]);
   std::cout.flush();
   return cli.Finish(status);
 }

@@ -68,6 +68,9 @@ Repeatability ComputeRepeatability(const std::vector<SequenceResult>& results,
     translations.push_back(row.translation_cm);
     others.push_back({row.time_offset_ms, row.rotation_error_deg, row.time_offset_error_ms});
     errors.push_back(row.translation_error_cm);
+    if (result.calibration.verdict() != proto::CalibrationResult::VERDICT_UNSET) {
+      row.verdict = proto::CalibrationResult::Verdict_Name(result.calibration.verdict());
+    }
     out.sequences.push_back(row);
   }
   out.mean.label = "mean";
@@ -116,6 +119,7 @@ std::string FormatTable(const Repeatability& r, const std::string& title) {
     header += "   |" + Pad("rot err", 9) + Pad("x err", 8) + Pad("y err", 8) + Pad("z err", 8) +
               Pad("tau err", 9);
   }
+  header += "  verdict";
   out += header + "\n" + std::string(header.size(), '-') + "\n";
   auto line = [&](const Row& row) {
     std::string text = Pad(row.label, label_width);
@@ -126,7 +130,10 @@ std::string FormatTable(const Repeatability& r, const std::string& title) {
       text += "   |" + Pad(Fixed(row.rotation_error_deg, 3), 9);
       for (int i = 0; i < 3; ++i) text += Pad(Fixed(row.translation_error_cm[i], 2), 8);
       text += Pad(Fixed(row.time_offset_error_ms, 3), 9);
+    } else if (errors && !row.verdict.empty()) {
+      text += "   |" + std::string(9 + 3 * 8 + 9, ' ');
     }
+    if (!row.verdict.empty()) text += "  " + row.verdict;
     out += text + "\n";
   };
   for (const Row& row : r.sequences) line(row);
@@ -135,13 +142,16 @@ std::string FormatTable(const Repeatability& r, const std::string& title) {
   line(r.sigma);
   if (r.measured) line(*r.measured);
   if (!r.rotation_mean_converged) out += "warning: the SO(3) mean did not converge\n";
+  for (const std::string& name : r.suspect_set_aside) {
+    out += "suspect, set aside (read its verdict_reasons): " + name + "\n";
+  }
   return out;
 }
 
 std::string FormatCsv(const Repeatability& r) {
   std::string out =
       "sequence,r_x_cm,r_y_cm,r_z_cm,euler_1_deg,euler_2_deg,euler_3_deg,time_offset_ms,"
-      "rotation_error_deg,error_x_cm,error_y_cm,error_z_cm,time_offset_error_ms\n";
+      "rotation_error_deg,error_x_cm,error_y_cm,error_z_cm,time_offset_error_ms,verdict\n";
   auto line = [&](const Row& row) {
     char buffer[512];
     std::snprintf(buffer, sizeof(buffer), "%s,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g",
@@ -158,7 +168,7 @@ std::string FormatCsv(const Repeatability& r) {
     } else {
       out += ",,,,,";
     }
-    out += "\n";
+    out += "," + row.verdict + "\n";
   };
   for (const Row& row : r.sequences) line(row);
   line(r.mean);
@@ -172,11 +182,17 @@ Status Run(const ReportPaths& paths, std::ostream* log) {
     return Status::Error("no sequence directories given");
   }
   std::vector<SequenceResult> results;
+  std::vector<std::string> suspect_set_aside;
   for (const std::string& dir : paths.sequence_dirs) {
     SequenceResult result;
     result.name = std::filesystem::path(dir).lexically_normal().filename().string();
     if (result.name.empty()) {
       result.name = std::filesystem::path(dir).lexically_normal().parent_path().filename();
+    }
+    if (!std::filesystem::exists(dir + "/calibration.txtpb") &&
+        std::filesystem::exists(dir + "/calibration.suspect.txtpb")) {
+      suspect_set_aside.push_back(dir + "/calibration.suspect.txtpb");
+      continue;
     }
     TILTCAL_RETURN_IF_ERROR(ReadTextProto(dir + "/calibration.txtpb", &result.calibration));
     if (std::filesystem::exists(dir + "/truth.txtpb")) {
@@ -187,8 +203,12 @@ Status Run(const ReportPaths& paths, std::ostream* log) {
   }
   proto::Rig rig;
   if (!paths.rig.empty()) TILTCAL_RETURN_IF_ERROR(LoadRig(paths.rig, &rig));
-  const Repeatability repeatability =
-      ComputeRepeatability(results, paths.rig.empty() ? nullptr : &rig);
+  if (results.empty()) {
+    return Status::Error("no usable calibration: every sequence was set aside as SUSPECT (" +
+                         suspect_set_aside.front() + " ...)");
+  }
+  Repeatability repeatability = ComputeRepeatability(results, paths.rig.empty() ? nullptr : &rig);
+  repeatability.suspect_set_aside = suspect_set_aside;
   const std::string table = FormatTable(repeatability, paths.title);
   TILTCAL_RETURN_IF_ERROR(WriteFileAtomically(paths.out, table));
   if (!paths.out_csv.empty()) {

@@ -33,6 +33,9 @@ struct Row {
   double rotation_error_deg = 0;                             // |Log(C_true^T C_est)|
   Eigen::Vector3d translation_error_cm = Eigen::Vector3d::Zero();  // est − true
   double time_offset_error_ms = 0;
+  // The calibration's verdict ("OK", "WEAK", "SUSPECT"; "" for files
+  // written before the verdict existed and for the mean, sigma and measured rows).
+  std::string verdict;
 };
 
 // Repeatability over the sequences of a dataset, as the paper's Metrics
@@ -44,6 +47,9 @@ struct Repeatability {
   Row sigma;  // euler123_deg holds σ of the deviations ξ (not an Euler triple)
   std::optional<Row> measured;  // the rig's measured extrinsic
   bool rotation_mean_converged = true;
+  // Sequences whose calibration was SUSPECT and set aside by the pipeline
+  // (only <dir>/calibration.suspect.txtpb): listed, not in the rows or the mean.
+  std::vector<std::string> suspect_set_aside;
 };
 
 Repeatability ComputeRepeatability(const std::vector<SequenceResult>& results,
@@ -63,7 +69,8 @@ struct ReportPaths {
 };
 
 // Reads <dir>/calibration.txtpb and <dir>/truth.txtpb (if present) for each
-// directory, computes the repeatability, writes the table and the CSV, and
+// directory (a directory with only calibration.suspect.txtpb, a SUSPECT
+// result Makefile.pipeline set aside, is listed as such and left out), computes the repeatability, writes the table and the CSV, and
 // prints the table to `log` (nullptr: silent).
 Status Run(const ReportPaths& paths, std::ostream* log);
 

@@ -32,6 +32,11 @@ for s in seq_1 seq_2; do
     [ -s "$DATA/out/$s/$f" ] || fail "no out/$s/$f"
   done
 done
+# Clean sequences: usable (OK, or WEAK naming what came from the rig).
+for s in seq_1 seq_2; do
+  grep -qE "^verdict: (OK|WEAK)$" "$DATA/out/$s/calibration.txtpb" ||
+    fail "$s: verdict $(grep "^verdict" "$DATA/out/$s/calibration.txtpb")"
+done
 table=$DATA/out/repeatability.txt
 [ -s "$table" ] && [ -s "$DATA/out/repeatability.csv" ] || fail "no repeatability report"
 cat "$table"

@@ -11,7 +11,8 @@ DATA=$WORK/data
 mkdir -p "$BIN" "$DATA/params"
 
 # A stub stage: writes every --out*=PATH it is given; fails when
-# TILTCAL_STUB_FAIL names it (after writing, as a crash midway would).
+# TILTCAL_STUB_FAIL names it (after writing, as a crash midway would); exits 3
+# (result written, verdict SUSPECT) when TILTCAL_STUB_SUSPECT names it.
 cat > "$BIN/stub" <<'STUB'
 #!/usr/bin/env bash
 name=$(basename "$0")
@@ -20,6 +21,7 @@ for arg in "$@"; do
 done
 [ "$name" = tiltcal_inspect ] && echo "stamp_ns,valid,normal_in_lidar.z,height_m"
 [ "${TILTCAL_STUB_FAIL:-}" = "$name" ] && exit 1
+[ "${TILTCAL_STUB_SUSPECT:-}" = "$name" ] && exit 3
 exit 0
 STUB
 chmod +x "$BIN/stub"
@@ -114,6 +116,22 @@ help_text=$("${MAKE[@]}" help); grep -q LAUNCH <<<"$help_text" || fail "help doe
 launched=$("${MAKE[@]}" LAUNCH="echo LAUNCHED" -n ground); grep -q "echo LAUNCHED .*tiltcal_ground" <<<"$launched" ||
   fail "LAUNCH does not prefix stage commands"
 echo "ok: help and LAUNCH"
+"${MAKE[@]}" all > /dev/null
+sleep_past; touch "$DATA/params/calibrate.txtpb"
+if TILTCAL_STUB_SUSPECT=tiltcal_calibrate "${MAKE[@]}" -k calibrate > /dev/null 2> "$WORK/suspect.log"; then
+  fail "a SUSPECT calibration did not fail make"
+fi
+[ ! -e "$DATA/out/seq_a/calibration.txtpb" ] || fail "a SUSPECT calibration was kept as done"
+[ -s "$DATA/out/seq_a/calibration.suspect.txtpb" ] || fail "a SUSPECT calibration was not kept aside"
+grep -q "SUSPECT calibration: read the verdict_reasons in .*/out/seq_a/calibration.suspect.txtpb" \
+  "$WORK/suspect.log" || fail "no message pointing to the suspect file: $(cat "$WORK/suspect.log")"
+expect "a SUSPECT calibration is re-evaluated by the next make" "$(planned calibrate)" \
+"tiltcal_calibrate seq_a;tiltcal_calibrate seq_b;"
+"${MAKE[@]}" calibrate > /dev/null
+[ -s "$DATA/out/seq_a/calibration.txtpb" ] && [ ! -e "$DATA/out/seq_a/calibration.suspect.txtpb" ] ||
+  fail "a good rerun did not replace the suspect file"
+echo "ok: a SUSPECT calibration fails its sequence, is kept aside and rerun"
+
 "${MAKE[@]}" clean > /dev/null
 [ ! -e "$DATA/out" ] || fail "clean left out/"
 echo "PASS"

@@ -93,6 +93,12 @@ TEST(CalibrateParamsTest, EachRuleNamesItsField) {
       {"ground { dist { sigma: 0 } }", "ground.dist.sigma"},
       {"ground { incl { sigma: 0 } }", "ground.incl.sigma"},
       {"ground { up { sigma: 0 } }", "ground.up.sigma"},
+      {"verdict { max_gyro_rms: 0 }", "verdict.max_gyro_rms"},
+      {"verdict { max_accel_rms: 0 }", "verdict.max_accel_rms"},
+      {"verdict { max_lidar_rms: 0 }", "verdict.max_lidar_rms"},
+      {"verdict { max_ground_rms: 0 }", "verdict.max_ground_rms"},
+      {"verdict { large_rotation_deg: 0 }", "verdict.large_rotation_deg"},
+      {"verdict { large_translation_m: 0 }", "verdict.large_translation_m"},
   };
   for (const auto& [override_text, field] : cases) {
     const std::string message = ErrorWith(override_text);

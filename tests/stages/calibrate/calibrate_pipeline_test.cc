@@ -23,7 +23,9 @@
 #include "stages/calibrate/calibrate.h"
 #include "stages/calibrate/calibration_state.h"
 #include "stages/calibrate/covariance_report.h"
+#include "stages/calibrate/default_params_text.h"
 #include "stages/calibrate/problem_builder.h"
+#include "stages/calibrate/verdict.h"
 #include "tests/stages/calibrate/calibrate_params_text.h"
 #include "tests/testing/test_env.h"
 #include "tiltcal/proto/truth.pb.h"
@@ -374,6 +376,13 @@ TEST(CalibratePipelineTest, ShortFlatSequenceAgainstTruth) {
   EXPECT_GT(result.solver().seconds_per_iteration(), 0.0);
   EXPECT_EQ(result.provenance().producer(), "tiltcal_calibrate");
   EXPECT_GE(result.timings_size(), 8);
+  // Clean data: usable, with the vertical translation (and, on 16 s of
+  // planar motion, perhaps the yaw) from the rig.
+  EXPECT_TRUE(result.verdict() == proto::CalibrationResult::OK ||
+              result.verdict() == proto::CalibrationResult::WEAK)
+      << FormatVerdict(result, params.verdict());
+  EXPECT_EQ(result.residual_statistics_size(), 3);  // gyro, accel, lidar
+  EXPECT_GT(result.map_sharpness_estimate().planar_surfels(), 100);
 
   // Observability: the translation direction closest to up.
   auto vertical_direction = [&](const proto::CalibrationResult& r) {
@@ -450,6 +459,46 @@ TEST(CalibratePipelineTest, ShortTiltedSequenceWithTheDefaultsAgainstTruth) {
   EXPECT_LT(rot_deg, 0.1);
   EXPECT_LT(dt_cm.cwiseAbs().maxCoeff(), 1.0);
   EXPECT_LT(tau_ms, 0.5);
+  EXPECT_TRUE(result.verdict() == proto::CalibrationResult::OK ||
+              result.verdict() == proto::CalibrationResult::WEAK)
+      << FormatVerdict(result, params.verdict());
+}
+
+// LiDAR stamps 80 ms off the IMU clock with the coarse tau search switched
+// off: tau cannot reach the truth within its bounds. The executable writes
+// the result, says SUSPECT with the bound as the reason, and exits 3.
+TEST(CalibratePipelineTest, TimeOffsetBeyondItsBoundIsSuspectWithExitCode3) {
+  TempDir dir;
+  ASSERT_TRUE(PrepareSequence("short_flat_vlp16.txtpb",
+                              {{"time_offset_s: 0.0125", "time_offset_s: 0.08"}},
+                              /*gravity=*/false, dir));
+  std::string params_text(DefaultParamsText());
+  const std::string search = "time_offset_search_step_s: 0.001";
+  ASSERT_NE(params_text.find(search), std::string::npos);
+  params_text.replace(params_text.find(search), search.size(), "time_offset_search_step_s: 0");
+  // Without the wide-window search (which would find the 80 ms) tau ends at
+  // the +-50 ms bound around 0.
+  const std::string wide = "coarse_time_offset_window_s: 5.0";
+  ASSERT_NE(params_text.find(wide), std::string::npos);
+  params_text.replace(params_text.find(wide), wide.size(), "coarse_time_offset_window_s: 0");
+  ASSERT_TRUE(WriteFileAtomically(dir.File("params.txtpb"), params_text).ok());
+  const CalibratePaths paths = SequencePaths(dir, /*gravity=*/false);
+  std::string output;
+  const int code = testing::RunCommand(
+      testing::ToolPath("tiltcal_calibrate") + " --quiet --imu=" + paths.imu +
+          " --scans=" + paths.scans + " --ground=" + paths.ground + " --rig=" + paths.rig +
+          " --params=" + dir.File("params.txtpb") + " --out=" + paths.out,
+      &output);
+  EXPECT_EQ(code, 3) << output;
+  EXPECT_NE(output.find("tiltcal_calibrate: verdict SUSPECT"), std::string::npos) << output;
+  EXPECT_NE(output.find("time offset at a bound of the solve"), std::string::npos) << output;
+  EXPECT_NE(output.find(paths.out + " is SUSPECT"), std::string::npos) << output;
+  proto::CalibrationResult result;
+  ASSERT_TRUE(ReadTextProto(paths.out, &result).ok()) << "the suspect result is kept";
+  EXPECT_EQ(result.verdict(), proto::CalibrationResult::SUSPECT);
+  ASSERT_GT(result.verdict_reasons_size(), 0);
+  EXPECT_NE(result.verdict_reasons(0).find("time offset at a bound"), std::string::npos)
+      << result.verdict_reasons(0);
 }
 
 }  // namespace

@@ -106,5 +106,52 @@ TEST(Repeatability, RunWritesTableAndCsvAndFailsOnMissingResult) {
   EXPECT_FALSE(testing::FileExists(dir.File("other.txt")));
 }
 
+// The verdict column, and a SUSPECT result the pipeline set aside
+// (calibration.suspect.txtpb only): listed below the table, not in the mean.
+TEST(Repeatability, VerdictColumnAndSuspectSequencesSetAside) {
+  testing::TempDir dir;
+  const std::pair<std::string, proto::CalibrationResult::Verdict> sequences[] = {
+      {"ok", proto::CalibrationResult::OK}, {"weak", proto::CalibrationResult::WEAK}};
+  for (const auto& [name, verdict] : sequences) {
+    std::filesystem::create_directory(dir.File(name));
+    SequenceResult s = Sequence(name, {180, 0, 10}, {0.1, 0, 0.2}, 0.005);
+    s.calibration.set_verdict(verdict);
+    ASSERT_TRUE(WriteTextProto(dir.File(name + "/calibration.txtpb"), s.calibration).ok());
+  }
+  std::filesystem::create_directory(dir.File("bad"));
+  SequenceResult bad = Sequence("bad", {0, 0, 90}, {1, 1, 1}, 0.05);
+  bad.calibration.set_verdict(proto::CalibrationResult::SUSPECT);
+  ASSERT_TRUE(WriteTextProto(dir.File("bad/calibration.suspect.txtpb"), bad.calibration).ok());
+  ReportPaths paths;
+  paths.sequence_dirs = {dir.File("ok"), dir.File("weak"), dir.File("bad")};
+  paths.out = dir.File("repeatability.txt");
+  paths.out_csv = dir.File("repeatability.csv");
+  std::ostringstream log;
+  const Status status = report::Run(paths, &log);
+  ASSERT_TRUE(status.ok()) << status.message();
+  const std::string table = log.str();
+  EXPECT_NE(table.find("verdict"), std::string::npos) << table;
+  EXPECT_NE(table.find("  OK\n"), std::string::npos) << table;
+  EXPECT_NE(table.find("  WEAK\n"), std::string::npos) << table;
+  EXPECT_NE(table.find("suspect, set aside (read its verdict_reasons): " +
+                       dir.File("bad/calibration.suspect.txtpb")),
+            std::string::npos)
+      << table;
+  std::string csv;
+  ASSERT_TRUE(ReadFileToString(dir.File("repeatability.csv"), &csv).ok());
+  EXPECT_NE(csv.find("time_offset_error_ms,verdict\n"), std::string::npos) << csv;
+  EXPECT_NE(csv.find(",,,,,,WEAK\n"), std::string::npos) << csv;
+  // The mean is over the two usable results only (r (10, 0, 20) cm, yaw
+  // 10 deg, tau 5 ms; the set-aside one has r (100, 100, 100) cm, tau 50 ms).
+  const size_t mean = csv.find("\nmean,10,0,20,180,");
+  ASSERT_NE(mean, std::string::npos) << csv;
+  EXPECT_EQ(csv.substr(csv.find('\n', mean + 1) - 11, 11), ",10,5,,,,,,") << csv;
+
+  paths.sequence_dirs = {dir.File("bad")};
+  const Status none = report::Run(paths, nullptr);
+  ASSERT_FALSE(none.ok());
+  EXPECT_NE(none.message().find("no usable calibration"), std::string::npos) << none.message();
+}
+
 }  // namespace
 }  // namespace tiltcal::report

@@ -1,0 +1,124 @@
+#include "stages/inspect/calibration_notes.h"
+
+#include <cmath>
+
+#include <fmt/format.h>
+
+namespace tiltcal::inspect {
+namespace {
+
+void AddImuNotes(const proto::CheckParams& params, CheckFindings* f) {
+  const ImuFindings& imu = f->imu;
+  if (imu.stamps.count < 2) return;
+  auto& notes = f->notes;
+  if (imu.accel.unit == imu::AccelUnit::kStandardGravity) {
+    notes.push_back("IMU accelerometer in g: it will be converted to m/s² (× 9.80665)");
+  }
+  if (imu.gyro_unit == imu::GyroUnit::kDegreesPerSecond) {
+    notes.push_back(fmt::format(
+        "IMU gyro in deg/s (95th percentile |ω| {:.1f}, more than a vehicle turns in rad/s): "
+        "it will be converted to rad/s (× π/180)",
+        imu.gyro_speed_p95));
+  }
+  if (!imu.static_start.found) {
+    notes.push_back(
+        "no static start: the gyro bias starts at zero and gravity comes from the mean of the "
+        "first seconds (calibrate params: init.fallback_window_s); start the recording with "
+        "the vehicle still for a few seconds if you can");
+  }
+  if (imu.stamps.num_gaps > 0) {
+    notes.push_back(
+        fmt::format("{} gap(s) in the IMU stamps (longest {:.3f} s): the "
+                    "trajectory has no IMU data there",
+                    imu.stamps.num_gaps, imu.stamps.longest_gap_s));
+  }
+  if (imu.stamps.num_duplicates > 0) {
+    notes.push_back(
+        fmt::format("{} repeated IMU stamp(s): tiltcal_decode keeps the first "
+                    "sample of each stamp",
+                    imu.stamps.num_duplicates));
+  }
+  if (imu.stamps.num_backwards > 0) {
+    notes.push_back(
+        fmt::format("{} IMU stamp(s) earlier than the one before: tiltcal_decode "
+                    "sorts the samples by stamp",
+                    imu.stamps.num_backwards));
+  }
+  const ImuExcitation& e = imu.excitation;
+  if (imu.stamps.count >= 2 && imu.accel.unit &&
+      e.rotation_speed_p95_radps < params.imu().min_rotation_radps()) {
+    f->problems.push_back(fmt::format(
+        "no rotation: 95th percentile of |ω| is {:.4f} rad/s (below {:.4f}); the extrinsic "
+        "rotation cannot be determined from this motion",
+        e.rotation_speed_p95_radps, params.imu().min_rotation_radps()));
+  } else if (imu.stamps.count >= 2 && imu.accel.unit &&
+             e.yaw_rate_sign_changes <
+                 static_cast<int>(params.excitation().min_yaw_rate_sign_changes())) {
+    notes.push_back(
+        fmt::format("only {} yaw-rate sign change(s): turns mostly one way; the rotation about the "
+                    "vertical and τ are weakly determined (drive both left and right turns)",
+                    e.yaw_rate_sign_changes));
+  }
+}
+
+void AddLidarNotes(const proto::CheckParams& params, CheckFindings* f) {
+  const LidarFindings& lidar = f->lidar;
+  auto& notes = f->notes;
+  if (lidar.stamps.count == 0) return;
+  if (lidar.layout.time_field.empty()) {
+    notes.push_back(
+        "no per-point time field: scans are not deskewed, motion within a sweep "
+        "becomes error (slow down, or use a driver that publishes point times)");
+  }
+  if (lidar.stamps.num_gaps > 0) {
+    notes.push_back(fmt::format("{} gap(s) between scans (longest {:.3f} s)", lidar.stamps.num_gaps,
+                                lidar.stamps.longest_gap_s));
+  }
+  if (lidar.stamps.num_duplicates + lidar.stamps.num_backwards > 0) {
+    notes.push_back(
+        fmt::format("{} scan stamp(s) not after the one before: tiltcal_decode drops "
+                    "them (drop_non_monotonic)",
+                    lidar.stamps.num_duplicates + lidar.stamps.num_backwards));
+  }
+  if (lidar.sampled_scans > 0) {
+    const double share = static_cast<double>(lidar.scans_with_ground) / lidar.sampled_scans;
+    if (share < params.excitation().min_ground_scan_share()) {
+      notes.push_back(
+          fmt::format("ground in only {:.0f} % of the scans: few ground residuals; the vertical "
+                      "translation and the roll/pitch of the extrinsic rest on the motion alone",
+                      100.0 * share));
+    }
+  }
+  if (!f->have_rig) {
+    notes.push_back(
+        "no --rig: topics found by type, and up taken as the LiDAR z axis for the "
+        "ground statistics");
+  } else if (f->rig_imu_height_m <= 0.0) {
+    notes.push_back(
+        "translation along the vertical will come from the rig (no imu_height_m: "
+        "the ground distance residual is off, and planar motion does not "
+        "determine it)");
+  }
+}
+
+void AddClockNotes(const proto::CheckParams& params, CheckFindings* f) {
+  const ClockFindings& c = f->clock;
+  if (!c.both || c.overlap_s < params.clock().min_overlap_s()) return;
+  if (std::abs(c.stamp_offset_difference_s) > params.clock().time_offset_window_s()) {
+    f->notes.push_back(fmt::format(
+        "τ may be beyond ±{:.3g} s: LiDAR stamp − record time differs from the IMU's by "
+        "{:+.3f} s (τ ≈ {:.3f} s); set the calibrate params' time_offset_bound_s to cover it",
+        params.clock().time_offset_window_s(), c.stamp_offset_difference_s,
+        -c.stamp_offset_difference_s));
+  }
+}
+
+}  // namespace
+
+void AddCalibrationNotes(const proto::CheckParams& params, CheckFindings* f) {
+  AddImuNotes(params, f);
+  AddLidarNotes(params, f);
+  AddClockNotes(params, f);
+}
+
+}  // namespace tiltcal::inspect

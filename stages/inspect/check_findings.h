@@ -1,0 +1,78 @@
+#ifndef TILTCAL_STAGES_INSPECT_CHECK_FINDINGS_H_
+#define TILTCAL_STAGES_INSPECT_CHECK_FINDINGS_H_
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "common/imu/imu_units.h"
+#include "common/imu/static_detection.h"
+#include "stages/inspect/bag_survey.h"
+#include "stages/inspect/excitation.h"
+#include "stages/inspect/stamp_statistics.h"
+#include "tiltcal/proto/check_params.pb.h"
+#include "tiltcal/proto/rig.pb.h"
+
+namespace tiltcal::inspect {
+
+struct ImuFindings {
+  StampStatistics stamps;
+  imu::AccelUnitEvidence accel;  // in the published unit
+  // Gyro unit from the rates alone: deg/s when the 95th percentile of |ω|
+  // (published unit) exceeds ImuCheckParams.max_vehicle_rate_radps.
+  imu::GyroUnit gyro_unit = imu::GyroUnit::kRadiansPerSecond;
+  double gyro_speed_p95 = 0.0;       // published unit
+  imu::StaticInterval static_start;  // SI; times from the first IMU stamp
+  Eigen::Vector3d specific_force_at_rest_mps2 = Eigen::Vector3d::Zero();
+  ImuExcitation excitation;
+  double stamp_minus_record_s = 0.0;  // median header stamp − record time
+};
+
+struct LidarFindings {
+  StampStatistics stamps;
+  int64_t median_points = 0, min_points = 0, max_points = 0;  // per scan (width · height)
+  CloudLayout layout;
+  bool has_time_offsets = false;
+  double min_time_offset_s = 0.0, max_time_offset_s = 0.0;  // over the sampled scans
+  int sampled_scans = 0;
+  int scans_with_ground = 0;
+  double structure_fraction = 0.0;  // mean over the sampled scans
+  double structure_max_range_m = 0.0;
+  bool up_from_rig = false;  // up = C_bl^T f_rest/|f_rest|, else the LiDAR z
+  double stamp_minus_record_s = 0.0;
+};
+
+struct ClockFindings {
+  bool both = false;       // both streams have stamps
+  double overlap_s = 0.0;  // negative: the spans are apart by −overlap_s
+  // median(LiDAR stamp − record) − median(IMU stamp − record): with both
+  // streams received promptly, τ ≈ −this (a LiDAR stamp t_l happened at IMU
+  // time t_l + τ).
+  double stamp_offset_difference_s = 0.0;
+};
+
+// Everything the check says. `problems` make the bag uncalibratable (exit
+// 1); `notes` say what the data mean for the calibration.
+struct CheckFindings {
+  std::string bag;
+  uint64_t file_size = 0;
+  bool indexed = true;
+  std::string imu_topic, lidar_topic;
+  bool have_rig = false;
+  double rig_imu_height_m = 0.0;
+  ImuFindings imu;
+  LidarFindings lidar;
+  ClockFindings clock;
+  std::vector<std::string> problems;
+  std::vector<std::string> notes;
+};
+
+// The analysis of a survey (no I/O). `rig` may be null (no --rig).
+CheckFindings AnalyseSurvey(const BagSurvey& survey, const proto::Rig* rig,
+                            const proto::CheckParams& params);
+
+}  // namespace tiltcal::inspect
+
+#endif  // TILTCAL_STAGES_INSPECT_CHECK_FINDINGS_H_

@@ -1,0 +1,94 @@
+// Faults of real recordings that the calibrator's initialisation refuses,
+// on the short simulated sequence (short_sequence_fixture.h) changed in
+// memory: a gyro in deg/s labelled rad/s, a rig rotation wrong in yaw by
+// 90 deg, an IMU upside down that the rig does not declare. Each ends with
+// an error saying what the data show, never a result.
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+#include "common/io/eigen_proto.h"
+#include "common/io/text_proto.h"
+#include "tests/stages/calibrate/short_sequence_fixture.h"
+
+namespace tiltcal::calibrate {
+namespace {
+
+using CalibrateFaultsTest = ShortSequenceTest;
+
+TEST_F(CalibrateFaultsTest, GyroInDegreesPerSecondIsAnErrorNamingTheRatioAndTheRigField) {
+  for (imu::ImuReading& r : inputs_.imu) r.angular_velocity_radps *= kDegPerRad;
+  proto::CalibrationResult result;
+  std::string log;
+  const Status status = Run(&result, &log);
+  ASSERT_FALSE(status.ok()) << log;
+  std::printf("%s\n", status.message().c_str());
+  EXPECT_NE(status.message().find("deg/s"), std::string::npos) << status.message();
+  EXPECT_NE(status.message().find("imu_gyro_unit: DEGPS"), std::string::npos) << status.message();
+  // The ratio, printed with one decimal, is within 10 % of 57.3.
+  EXPECT_NE(status.message().find("times faster than the LiDAR"), std::string::npos)
+      << status.message();
+  const double ratio = std::stod(status.message().substr(status.message().find("turns ") + 6));
+  EXPECT_NEAR(ratio, kDegPerRad, 0.1 * kDegPerRad) << status.message();
+}
+
+TEST_F(CalibrateFaultsTest, RigYawOffBy90DegreesIsRefusedWithTheAngle) {
+  RotateRig(Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ())));
+  proto::CalibrationResult result;
+  std::string log;
+  const Status status = Run(&result, &log);
+  ASSERT_FALSE(status.ok()) << log;
+  std::printf("%s\n", status.message().c_str());
+  const std::string& m = status.message();
+  EXPECT_NE(m.find("about the motion's rotation axis"), std::string::npos) << m;
+  EXPECT_NE(m.find("fix it in the rig"), std::string::npos) << m;
+  // The angle the data show: 90 deg, either sign (the axis may point down).
+  const double angle = std::stod(m.substr(m.find("turned by ") + 10));
+  EXPECT_NEAR(std::abs(angle), 90.0, 15.0) << m;
+}
+
+TEST_F(CalibrateFaultsTest, UndeclaredUpsideDownImuIsRefusedWithTheAxisAngle) {
+  RotateRig(Eigen::Quaterniond(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX())));
+  proto::CalibrationResult result;
+  std::string log;
+  const Status status = Run(&result, &log);
+  ASSERT_FALSE(status.ok()) << log;
+  std::printf("%s\n", status.message().c_str());
+  const std::string& m = status.message();
+  EXPECT_NE(m.find("rotation axis"), std::string::npos) << m;
+  EXPECT_NE(m.find("fix imu_from_lidar.rotation in the rig"), std::string::npos) << m;
+  const double angle = std::stod(m.substr(m.find("axis ") + 5));
+  EXPECT_GT(angle, 170.0) << m;
+}
+
+// Through the executable: exit code 1, one error line, no output left.
+TEST_F(CalibrateFaultsTest, WrongRigRotationExitsWithOneAndLeavesNoOutput) {
+  proto::Rig rig = inputs_.rig;
+  Rigid3d extrinsic = ToEigen(rig.imu_from_lidar());
+  extrinsic.rotation =
+      Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ())) *
+      extrinsic.rotation;
+  *rig.mutable_imu_from_lidar() = ToProto(extrinsic);
+  const std::string rig_path = dir_->File("rig_yaw90.txtpb");
+  ASSERT_TRUE(WriteTextProto(rig_path, rig).ok());
+  const std::string out = dir_->File("calibration_yaw90.txtpb");
+  const std::string params = dir_->File("lidar_imu.txtpb");
+  ASSERT_TRUE(WriteTextProto(params, LidarImuParams()).ok());
+  std::string output;
+  const int exit_code = testing::RunCommand(
+      testing::ToolPath("tiltcal_calibrate") + " --imu=" + dir_->File("imu.binpb") +
+          " --scans=" + dir_->File("scans.binpb.lz4") + " --rig=" + rig_path + " --params=" +
+          params + " --out=" + out,
+      &output);
+  EXPECT_EQ(exit_code, 1) << output;
+  EXPECT_NE(output.find("fix it in the rig"), std::string::npos) << output;
+  EXPECT_FALSE(testing::FileExists(out));
+}
+
+}  // namespace
+}  // namespace tiltcal::calibrate
