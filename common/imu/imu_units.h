@@ -54,7 +54,7 @@ struct AccelUnitEvidence {
 };
 AccelUnitEvidence DetectAccelUnit(const std::vector<ImuReading>& samples,
                                   const std::vector<StaticInterval>& static_intervals,
-                                  const UnitBand& band);
+                                  const UnitBand& band = UnitBand());
 
 // What the rates alone say about the gyro's unit. A ground vehicle never
 // turns faster than a few rad/s (max_vehicle_turn_rate_radps), so a high
