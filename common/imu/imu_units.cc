@@ -1,24 +1,37 @@
 #include "common/imu/imu_units.h"
 
 #include <algorithm>
+#include <cmath>
 
 namespace tiltcal::imu {
 
 namespace {
 
-// Accepted band around an expected magnitude, as factors.
-constexpr double kBandLow = 0.8;
-constexpr double kBandHigh = 1.25;
-
-bool WithinBand(double value, double expected) {
-  return value >= kBandLow * expected && value <= kBandHigh * expected;
+bool WithinBand(double value, double expected, const UnitBand& band) {
+  return value >= band.min_ratio * expected && value <= band.max_ratio * expected;
 }
 
-double Median(std::vector<double> values) {
+// The value at `percentile` (0–100) of `values`: the element of rank
+// round(percentile/100 · (n − 1)) in increasing order; 0 when empty.
+double Percentile(std::vector<double> values, double percentile) {
   if (values.empty()) return 0.0;
-  const auto middle = values.begin() + static_cast<long>(values.size() / 2);
-  std::nth_element(values.begin(), middle, values.end());
-  return *middle;
+  const double fraction = std::clamp(percentile, 0.0, 100.0) / 100.0;
+  const auto at =
+      values.begin() + std::lround(fraction * static_cast<double>(values.size() - 1));
+  std::nth_element(values.begin(), at, values.end());
+  return *at;
+}
+
+// Indices of the static intervals' samples, in time order.
+std::vector<size_t> StaticSampleIndices(size_t num_samples,
+                                        const std::vector<StaticInterval>& static_intervals) {
+  std::vector<size_t> indices;
+  for (const StaticInterval& interval : static_intervals) {
+    for (size_t i = interval.begin_index; i < interval.end_index && i < num_samples; ++i) {
+      indices.push_back(i);
+    }
+  }
+  return indices;
 }
 
 }  // namespace
@@ -40,13 +53,12 @@ std::string UnitName(GyroUnit unit) {
 }
 
 AccelUnitEvidence DetectAccelUnit(const std::vector<ImuReading>& samples,
-                                  const std::vector<StaticInterval>& static_intervals) {
+                                  const std::vector<StaticInterval>& static_intervals,
+                                  const UnitBand& band) {
   AccelUnitEvidence evidence;
   std::vector<double> norms;
-  for (const StaticInterval& interval : static_intervals) {
-    for (size_t i = interval.begin_index; i < interval.end_index && i < samples.size(); ++i) {
-      norms.push_back(samples[i].linear_acceleration_mps2.norm());
-    }
+  for (size_t i : StaticSampleIndices(samples.size(), static_intervals)) {
+    norms.push_back(samples[i].linear_acceleration_mps2.norm());
   }
   evidence.from_static_samples = !norms.empty();
   if (norms.empty()) {
@@ -54,19 +66,55 @@ AccelUnitEvidence DetectAccelUnit(const std::vector<ImuReading>& samples,
       norms.push_back(sample.linear_acceleration_mps2.norm());
     }
   }
-  evidence.median_norm = Median(std::move(norms));
-  if (WithinBand(evidence.median_norm, kStandardGravityMps2)) {
+  evidence.num_samples = norms.size();
+  evidence.median_norm = Percentile(std::move(norms), 50.0);
+  if (evidence.num_samples == 0) return evidence;
+  if (WithinBand(evidence.median_norm, kStandardGravityMps2, band)) {
     evidence.unit = AccelUnit::kMetresPerSecond2;
-  } else if (WithinBand(evidence.median_norm, 1.0)) {
+  } else if (WithinBand(evidence.median_norm, 1.0, band)) {
     evidence.unit = AccelUnit::kStandardGravity;
   }
   return evidence;
 }
 
-std::optional<GyroUnit> GyroUnitFromScale(double gyro_over_reference) {
-  if (WithinBand(gyro_over_reference, 1.0)) return GyroUnit::kRadiansPerSecond;
-  if (WithinBand(gyro_over_reference, 1.0 / kRadiansPerDegree)) return GyroUnit::kDegreesPerSecond;
+GyroRateEvidence DetectGyroUnitFromRates(const std::vector<ImuReading>& samples,
+                                         double percentile, double max_vehicle_turn_rate_radps) {
+  GyroRateEvidence evidence;
+  evidence.percentile = percentile;
+  std::vector<double> rates;
+  rates.reserve(samples.size());
+  for (const ImuReading& sample : samples) rates.push_back(sample.angular_velocity_radps.norm());
+  evidence.rate_at_percentile = Percentile(std::move(rates), percentile);
+  if (evidence.rate_at_percentile <= max_vehicle_turn_rate_radps) {
+    evidence.unit = GyroUnit::kRadiansPerSecond;
+  } else if (evidence.rate_at_percentile * kRadiansPerDegree <= max_vehicle_turn_rate_radps) {
+    evidence.unit = GyroUnit::kDegreesPerSecond;
+  }
+  return evidence;
+}
+
+std::optional<GyroUnit> GyroUnitFromScale(double gyro_over_reference, const UnitBand& band) {
+  if (WithinBand(gyro_over_reference, 1.0, band)) return GyroUnit::kRadiansPerSecond;
+  if (WithinBand(gyro_over_reference, 1.0 / kRadiansPerDegree, band)) {
+    return GyroUnit::kDegreesPerSecond;
+  }
   return std::nullopt;
+}
+
+RestForce MeanRestForce(const std::vector<ImuReading>& samples,
+                        const std::vector<StaticInterval>& static_intervals) {
+  RestForce rest;
+  for (size_t i : StaticSampleIndices(samples.size(), static_intervals)) {
+    rest.mean += samples[i].linear_acceleration_mps2;
+    ++rest.num_samples;
+  }
+  rest.from_static_samples = rest.num_samples > 0;
+  if (!rest.from_static_samples) {
+    for (const ImuReading& sample : samples) rest.mean += sample.linear_acceleration_mps2;
+    rest.num_samples = samples.size();
+  }
+  if (rest.num_samples > 0) rest.mean /= static_cast<double>(rest.num_samples);
+  return rest;
 }
 
 void ConvertToSi(AccelUnit accel, GyroUnit gyro, std::vector<ImuReading>* samples) {

@@ -15,6 +15,20 @@ bool IsFinite(const proto::Vector3& v) {
   return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z());
 }
 
+// Text format accepts any number for a proto3 enum; only the named values
+// mean a unit.
+Status CheckUnits(const proto::Rig& rig) {
+  if (!proto::AccelUnit::Unit_IsValid(rig.imu_accel_unit())) {
+    return Status::Error(fmt::format("imu_accel_unit = {} is not one of AUTO, MPS2, G",
+                                     static_cast<int>(rig.imu_accel_unit())));
+  }
+  if (!proto::GyroUnit::Unit_IsValid(rig.imu_gyro_unit())) {
+    return Status::Error(fmt::format("imu_gyro_unit = {} is not one of AUTO, RADPS, DEGPS",
+                                     static_cast<int>(rig.imu_gyro_unit())));
+  }
+  return Status::Ok();
+}
+
 }  // namespace
 
 Status ValidateRig(proto::Rig* rig) {
@@ -54,7 +68,7 @@ Status ValidateRig(proto::Rig* rig) {
           kRigMinGravityMps2, kRigMaxGravityMps2));
     }
   }
-  return Status::Ok();
+  return CheckUnits(*rig);
 }
 
 Status LoadRig(const std::string& path, proto::Rig* rig) {

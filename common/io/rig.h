@@ -21,7 +21,8 @@ inline constexpr double kRigMaxGravityMps2 = 11.0;
 // Checks a rig (the dataset's rig.txtpb): imu_from_lidar present with a unit
 // quaternion (within kRigQuaternionNormTolerance; normalised in place),
 // every value finite, the translation, imu_height_m and gravity_flat_in_imu
-// (when set) within the bounds above. The error names the field.
+// (when set) within the bounds above, imu_accel_unit and imu_gyro_unit
+// named values of their enums. The error names the field.
 Status ValidateRig(proto::Rig* rig);
 
 // Reads rig.txtpb (a regular, non-empty file) and validates it; every error

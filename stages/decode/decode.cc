@@ -16,6 +16,9 @@
 #include "common/io/provenance.h"
 #include "common/io/rig.h"
 #include "stages/decode/async_record_writer.h"
+#include "stages/decode/clock_domains.h"
+#include "stages/decode/decode_params.h"
+#include "stages/decode/imu_units_resolution.h"
 #include "stages/decode/message_sinks.h"
 #include "tiltcal/proto/rig.pb.h"
 #include "tiltcal/proto/scan.pb.h"
@@ -92,7 +95,8 @@ std::string TopicLine(const char* label, const std::string& topic, int64_t messa
                      static_cast<double>(last_ns - first_ns) * 1e-9, dropped);
 }
 
-void PrintSummary(std::ostream* log, const DecodePaths& paths, const DecodeSummary& s) {
+void PrintSummary(std::ostream* log, const DecodePaths& paths, double shift_s,
+                  const DecodeSummary& s) {
   if (log == nullptr) return;
   const double mb = static_cast<double>(s.bag_bytes) * 1e-6;
   *log << fmt::format("tiltcal_decode: {}: {:.1f} MB, {}\n", paths.bag, mb,
@@ -112,6 +116,16 @@ void PrintSummary(std::ostream* log, const DecodePaths& paths, const DecodeSumma
                                 s.scans_non_monotonic_dropped, s.scans_empty_dropped));
   *log << fmt::format("  points: {} written; dropped {} NaN/Inf, {} zero/short range\n",
                       s.points_written, s.points_dropped_invalid, s.points_dropped_range);
+  *log << fmt::format("  clocks: IMU and LiDAR stamps overlap for {:.3f} s{}\n", s.stamp_overlap_s,
+                      shift_s != 0.0
+                          ? fmt::format(" (LiDAR stamps shifted by {:.3f} s, lidar_stamp_shift_s)",
+                                        shift_s)
+                          : "");
+  for (const std::string& note : s.imu_notes) {
+    const bool warning =
+        std::find(s.imu_warnings.begin(), s.imu_warnings.end(), note) != s.imu_warnings.end();
+    *log << (warning ? "  WARNING: imu: " : "  imu: ") << note << "\n";
+  }
   if (s.scans_without_point_time > 0) {
     *log << fmt::format(
         "  WARNING: {} scans have no per-point time field (time_source POINT_TIME_NONE): "
@@ -224,6 +238,26 @@ Status CheckSomethingWritten(const std::string& bag, const ImuSink& imu, const D
   return Status::Ok();
 }
 
+// The clocks (the LiDAR and IMU stamps overlap) and the IMU's units and
+// sign, once every message is read and before anything is written.
+Status CheckStampsAndUnits(const DecodePaths& paths, const proto::DecodeParams& params,
+                           const proto::Rig& rig, const ImuSink& imu, const ScanSink& scans,
+                           DecodeSummary* s) {
+  const decode::StampSpan imu_span = imu.Span();
+  const decode::StampSpan lidar_span = scans.Span(*s);
+  TILTCAL_RETURN_IF_ERROR(decode::CheckClockDomains(paths.bag, imu_span, lidar_span,
+                                                    params.lidar_stamp_shift_s()));
+  s->stamp_overlap_s = decode::StampOverlapSeconds(imu_span, lidar_span);
+  decode::ImuUnitsResolution units;
+  TILTCAL_RETURN_IF_ERROR(decode::ResolveImuUnits(imu.Readings(), rig, {paths.bag, paths.rig},
+                                                  params.imu_units(), &units));
+  s->accel_to_si = units.accel_to_si;
+  s->gyro_to_si = units.gyro_to_si;
+  s->imu_notes = units.notes;
+  s->imu_warnings = units.warnings;
+  return Status::Ok();
+}
+
 }  // namespace
 
 Status Decode(const DecodePaths& paths, const proto::DecodeParams& params, std::ostream* log,
@@ -231,6 +265,8 @@ Status Decode(const DecodePaths& paths, const proto::DecodeParams& params, std::
   const Clock::time_point t0 = Clock::now();
   DecodeSummary s;
   TILTCAL_RETURN_IF_ERROR(CheckPaths(paths));
+  TILTCAL_RETURN_IF_ERROR(decode::ValidateDecodeParams(params).WithContext(
+      paths.params.empty() ? "decode params" : paths.params));
   proto::Rig rig;
   if (!paths.rig.empty()) TILTCAL_RETURN_IF_ERROR(LoadRig(paths.rig, &rig));
   ros1::BagReader reader;
@@ -260,14 +296,19 @@ Status Decode(const DecodePaths& paths, const proto::DecodeParams& params, std::
         }));
   }
   TILTCAL_RETURN_IF_ERROR(CheckSomethingWritten(paths.bag, imu, s));
-  TILTCAL_RETURN_IF_ERROR(imu.Write(paths.out_imu, provenance, &s));
+  imu.SortAndDropRepeatedStamps(&s);
+  TILTCAL_RETURN_IF_ERROR(CheckStampsAndUnits(paths, params, rig, imu, scans, &s));
+  proto::Provenance imu_provenance = provenance;
+  for (const std::string& note : s.imu_notes) imu_provenance.add_notes(note);
+  TILTCAL_RETURN_IF_ERROR(
+      imu.Write(paths.out_imu, imu_provenance, s.accel_to_si, s.gyro_to_si, &s));
   if (Status status = scans_writer.Close(); !status.ok()) {
     std::remove(paths.out_imu.c_str());  // both outputs or none
     return status;
   }
   s.chunks_decompressed = reader.stats().chunks_decompressed;
   s.wall_s = std::chrono::duration<double>(Clock::now() - t0).count();
-  PrintSummary(log, paths, s);
+  PrintSummary(log, paths, params.lidar_stamp_shift_s(), s);
   if (summary != nullptr) *summary = s;
   return Status::Ok();
 }

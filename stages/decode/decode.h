@@ -1,13 +1,14 @@
 #ifndef TILTCAL_STAGES_DECODE_DECODE_H_
 #define TILTCAL_STAGES_DECODE_DECODE_H_
 
-// The decode stage: a ROS1 bag -> imu.binpb (tiltcal.proto.ImuSample records)
-// and scans.binpb.lz4 (tiltcal.proto.Scan records, LZ4-framed), both with
-// provenance, both strictly increasing in stamp_ns.
+// The decode stage: a ROS1 bag -> imu.binpb (tiltcal.proto.ImuSample records,
+// always in m/s² and rad/s) and scans.binpb.lz4 (tiltcal.proto.Scan records,
+// LZ4-framed), both with provenance, both strictly increasing in stamp_ns.
 
 #include <cstdint>
 #include <ostream>
 #include <string>
+#include <vector>
 
 #include "common/status.h"
 #include "tiltcal/proto/decode_params.pb.h"
@@ -17,7 +18,7 @@ namespace tiltcal {
 // Every path of one decode run.
 struct DecodePaths {
   std::string bag;
-  std::string rig;  // optional: imu_topic / lidar_topic from rig.txtpb
+  std::string rig;  // optional rig.txtpb: topics, IMU units, the up direction for the sign check
   std::string out_imu;
   std::string out_scans;
   std::string params;        // the params file ("" = the stage defaults), for the provenance
@@ -44,15 +45,23 @@ struct DecodeSummary {
   int64_t points_dropped_invalid = 0;
   int64_t points_dropped_range = 0;
   int64_t imu_first_stamp_ns = 0, imu_last_stamp_ns = 0;
-  int64_t scan_first_stamp_ns = 0, scan_last_stamp_ns = 0;
+  int64_t scan_first_stamp_ns = 0, scan_last_stamp_ns = 0;  // after lidar_stamp_shift_s
+  double stamp_overlap_s = 0.0;  // time covered by both the IMU and the LiDAR stamps
+  double accel_to_si = 1.0;      // factors applied to the published IMU values
+  double gyro_to_si = 1.0;
+  std::vector<std::string> imu_notes;     // units and sign: what was decided and why
+  std::vector<std::string> imu_warnings;  // the notes that need the user's attention
   uint64_t bag_bytes = 0;
   uint64_t chunks_decompressed = 0;
   double wall_s = 0.0;
 };
 
-// Decodes the bag into the two streams and fills *summary. `log` receives
-// the progress (only when it is a terminal) and the final summary; nullptr
-// = silent. Errors are one line naming the file and the record. Outputs
+// Decodes the bag into the two streams and fills *summary. The IMU's units
+// are resolved (decode/imu_units_resolution.h) and its values converted to
+// SI; LiDAR stamps are shifted by params.lidar_stamp_shift_s and must overlap
+// the IMU's (decode/clock_domains.h). `log` receives the progress (only when
+// it is a terminal) and the final summary with the unit notes; nullptr =
+// silent. Errors are one line naming the file and the record. Outputs
 // appear only when the whole run succeeded.
 Status Decode(const DecodePaths& paths, const proto::DecodeParams& params, std::ostream* log,
               DecodeSummary* summary);

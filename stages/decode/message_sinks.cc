@@ -19,6 +19,14 @@ std::string MessageContext(const std::string& bag, const ros1::MessageView& m, i
          std::to_string(m.chunk_pos) + ")";
 }
 
+// The median of `values` (the upper one of an even count); 0 when empty.
+int64_t Median(std::vector<int64_t> values) {
+  if (values.empty()) return 0;
+  const auto middle = values.begin() + static_cast<long>(values.size() / 2);
+  std::nth_element(values.begin(), middle, values.end());
+  return *middle;
+}
+
 }  // namespace
 
 std::string FormatSeconds(int64_t ns) {
@@ -63,50 +71,92 @@ bool ImuSink::SameValues(const Record& a, const Record& b) {
   return true;
 }
 
-void ImuSink::ToSample(const Record& r, proto::ImuSample* sample) {
+void ImuSink::ToSample(const Record& r, double accel_to_si, double gyro_to_si,
+                       proto::ImuSample* sample) {
   sample->set_stamp_ns(r.stamp_ns);
   sample->set_record_stamp_ns(r.record_ns);
   auto* w = sample->mutable_angular_velocity_radps();
-  w->set_x(r.angular_velocity[0]);
-  w->set_y(r.angular_velocity[1]);
-  w->set_z(r.angular_velocity[2]);
+  w->set_x(r.angular_velocity[0] * gyro_to_si);
+  w->set_y(r.angular_velocity[1] * gyro_to_si);
+  w->set_z(r.angular_velocity[2] * gyro_to_si);
   auto* a = sample->mutable_linear_acceleration_mps2();
-  a->set_x(r.linear_acceleration[0]);
-  a->set_y(r.linear_acceleration[1]);
-  a->set_z(r.linear_acceleration[2]);
+  a->set_x(r.linear_acceleration[0] * accel_to_si);
+  a->set_y(r.linear_acceleration[1] * accel_to_si);
+  a->set_z(r.linear_acceleration[2] * accel_to_si);
+}
+
+void ImuSink::SortAndDropRepeatedStamps(DecodeSummary* s) {
+  std::stable_sort(samples_.begin(), samples_.end(),
+                   [](const Record& a, const Record& b) { return a.stamp_ns < b.stamp_ns; });
+  size_t kept = 0;  // samples_[0, kept) are the first samples of their stamps
+  for (size_t i = 0; i < samples_.size(); ++i) {
+    if (kept > 0 && samples_[i].stamp_ns == samples_[kept - 1].stamp_ns) {
+      ++(SameValues(samples_[i], samples_[kept - 1]) ? s->imu_duplicates_dropped
+                                                     : s->imu_conflicting_dropped);
+      continue;
+    }
+    samples_[kept++] = samples_[i];
+  }
+  samples_.resize(kept);
+  if (!samples_.empty()) {
+    s->imu_first_stamp_ns = samples_.front().stamp_ns;
+    s->imu_last_stamp_ns = samples_.back().stamp_ns;
+  }
+}
+
+std::vector<imu::ImuReading> ImuSink::Readings() const {
+  std::vector<imu::ImuReading> readings(samples_.size());
+  for (size_t i = 0; i < samples_.size(); ++i) {
+    const Record& r = samples_[i];
+    readings[i].time_s = static_cast<double>(r.stamp_ns - samples_.front().stamp_ns) * 1e-9;
+    readings[i].angular_velocity_radps = Eigen::Map<const Eigen::Vector3d>(r.angular_velocity);
+    readings[i].linear_acceleration_mps2 = Eigen::Map<const Eigen::Vector3d>(r.linear_acceleration);
+  }
+  return readings;
+}
+
+decode::StampSpan ImuSink::Span() const {
+  decode::StampSpan span;
+  if (samples_.empty()) return span;
+  std::vector<int64_t> delays_ns;
+  delays_ns.reserve(samples_.size());
+  for (const Record& r : samples_) delays_ns.push_back(r.record_ns - r.stamp_ns);
+  span.first_ns = samples_.front().stamp_ns;
+  span.last_ns = samples_.back().stamp_ns;
+  span.median_record_delay_ns = Median(std::move(delays_ns));
+  return span;
 }
 
 Status ImuSink::Write(const std::string& path, const proto::Provenance& provenance,
-                      DecodeSummary* s) {
-  std::stable_sort(samples_.begin(), samples_.end(),
-                   [](const Record& a, const Record& b) { return a.stamp_ns < b.stamp_ns; });
+                      double accel_to_si, double gyro_to_si, DecodeSummary* s) {
   RecordWriter writer;
   TILTCAL_RETURN_IF_ERROR(writer.Open(path, proto::ImuSample::descriptor()->full_name(),
                                       provenance, /*compress=*/false));
   proto::ImuSample sample;
-  size_t first_of_stamp = 0;
-  for (size_t i = 0; i < samples_.size(); ++i) {
-    const Record& r = samples_[i];
-    if (i > 0 && r.stamp_ns == samples_[i - 1].stamp_ns) {
-      // Compared with the kept sample of this stamp.
-      ++(SameValues(r, samples_[first_of_stamp]) ? s->imu_duplicates_dropped
-                                                 : s->imu_conflicting_dropped);
-      continue;
-    }
-    first_of_stamp = i;
-    ToSample(r, &sample);
+  for (const Record& r : samples_) {
+    ToSample(r, accel_to_si, gyro_to_si, &sample);
     TILTCAL_RETURN_IF_ERROR(writer.Write(sample));
-    if (s->imu_written == 0) s->imu_first_stamp_ns = r.stamp_ns;
-    s->imu_last_stamp_ns = r.stamp_ns;
-    ++s->imu_written;
   }
-  return writer.Close();
+  TILTCAL_RETURN_IF_ERROR(writer.Close());
+  s->imu_written = static_cast<int64_t>(samples_.size());
+  return Status::Ok();
 }
 
 ScanSink::ScanSink(const std::string& bag, const proto::DecodeParams& params,
                    AsyncRecordWriter* writer)
-    : bag_(bag), params_(params), writer_(writer) {
+    : bag_(bag),
+      params_(params),
+      writer_(writer),
+      stamp_shift_ns_(std::llround(params.lidar_stamp_shift_s() * 1e9)) {
   conversion_.min_range_m = params.min_range_m();
+}
+
+decode::StampSpan ScanSink::Span(const DecodeSummary& s) const {
+  decode::StampSpan span;
+  span.first_ns = s.scan_first_stamp_ns;
+  span.last_ns = s.scan_last_stamp_ns;
+  span.median_record_delay_ns = Median(record_delays_ns_);
+  return span;
 }
 
 Status ScanSink::Add(const ros1::MessageView& m, DecodeSummary* s) {
@@ -129,6 +179,7 @@ Status ScanSink::Convert(const ros1::MessageView& m, int64_t index, proto::Scan*
   if (!status.ok()) {
     return status.WithContext(MessageContext(bag_, m, index) + ": sensor_msgs/PointCloud2");
   }
+  scan->set_stamp_ns(scan->stamp_ns() + stamp_shift_ns_);
   s->points_dropped_invalid += scan->num_dropped_invalid();
   s->points_dropped_range += scan->num_dropped_zero_range();
   if (scan->time_source() == proto::POINT_TIME_NONE) {
@@ -157,6 +208,7 @@ Status ScanSink::Convert(const ros1::MessageView& m, int64_t index, proto::Scan*
   last_stamp_ns_ = scan->stamp_ns();
   scan->set_index(static_cast<uint32_t>(s->scans_written));
   scan->set_record_stamp_ns(m.time_ns);
+  record_delays_ns_.push_back(m.time_ns - scan->stamp_ns());
   if (s->scans_written == 0) s->scan_first_stamp_ns = scan->stamp_ns();
   s->scan_last_stamp_ns = scan->stamp_ns();
   ++s->scans_written;

@@ -12,8 +12,10 @@
 
 #include "bag/ros1/bag_reader.h"
 #include "bag/ros1/messages.h"
+#include "common/imu/imu_reading.h"
 #include "common/status.h"
 #include "stages/decode/async_record_writer.h"
+#include "stages/decode/clock_domains.h"
 #include "stages/decode/decode.h"
 #include "stages/decode/point_cloud_conversion.h"
 #include "tiltcal/proto/decode_params.pb.h"
@@ -27,7 +29,7 @@ namespace tiltcal {
 std::string FormatSeconds(int64_t ns);
 
 // The sensor_msgs/Imu messages: kept in memory, then sorted by stamp,
-// cleared of repeated stamps and written.
+// cleared of repeated stamps, converted to SI and written.
 class ImuSink {
  public:
   ImuSink(const std::string& bag, int64_t expected_messages);
@@ -37,9 +39,19 @@ class ImuSink {
 
   bool empty() const { return samples_.empty(); }
 
-  // Sorts by stamp (stable: record order among equal stamps), drops repeated
-  // stamps (the first sample of a stamp is kept) and writes the stream.
-  Status Write(const std::string& path, const proto::Provenance& provenance, DecodeSummary* s);
+  // Sorts by stamp (stable: record order among equal stamps) and drops
+  // repeated stamps (the first sample of a stamp is kept), counting them.
+  void SortAndDropRepeatedStamps(DecodeSummary* s);
+
+  // After SortAndDropRepeatedStamps: the samples as published (time_s from
+  // the first stamp) and their stamp span.
+  std::vector<imu::ImuReading> Readings() const;
+  decode::StampSpan Span() const;
+
+  // After SortAndDropRepeatedStamps: writes the stream with the specific
+  // force multiplied by accel_to_si and the angular velocity by gyro_to_si.
+  Status Write(const std::string& path, const proto::Provenance& provenance, double accel_to_si,
+               double gyro_to_si, DecodeSummary* s);
 
  private:
   // One IMU sample kept until the end.
@@ -50,21 +62,26 @@ class ImuSink {
     double linear_acceleration[3];
   };
   static bool SameValues(const Record& a, const Record& b);
-  static void ToSample(const Record& r, proto::ImuSample* sample);
+  static void ToSample(const Record& r, double accel_to_si, double gyro_to_si,
+                       proto::ImuSample* sample);
 
   std::string bag_;
   std::vector<Record> samples_;
   ros1::ImuMessage message_;
 };
 
-// The sensor_msgs/PointCloud2 messages: each converted to a Scan and handed
-// to the writer thread, unless it has no valid point or its stamp does not
-// advance (an error unless params.drop_non_monotonic).
+// The sensor_msgs/PointCloud2 messages: each converted to a Scan, its stamp
+// shifted by params.lidar_stamp_shift_s, and handed to the writer thread,
+// unless it has no valid point or its stamp does not advance (an error
+// unless params.drop_non_monotonic).
 class ScanSink {
  public:
   ScanSink(const std::string& bag, const proto::DecodeParams& params, AsyncRecordWriter* writer);
 
   Status Add(const ros1::MessageView& m, DecodeSummary* s);
+
+  // The (shifted) stamp span of the scans written so far.
+  decode::StampSpan Span(const DecodeSummary& s) const;
 
  private:
   // Converts the message into *scan; *keep says whether it is written.
@@ -76,7 +93,9 @@ class ScanSink {
   AsyncRecordWriter* writer_;
   PointConversionOptions conversion_;
   ros1::PointCloud2View cloud_;
+  int64_t stamp_shift_ns_ = 0;
   int64_t last_stamp_ns_ = INT64_MIN;
+  std::vector<int64_t> record_delays_ns_;  // record time − shifted stamp, per written scan
 };
 
 }  // namespace tiltcal

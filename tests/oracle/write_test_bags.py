@@ -68,7 +68,9 @@ def make_imu(rng, stamp_ns):
     msg.header.frame_id = "imu_link"
     msg.orientation.w = 1.0
     w = [rng.uniform(-2, 2) for _ in range(3)]
-    a = [rng.uniform(-12, 12) for _ in range(3)]
+    # Specific force of an IMU that is roughly level and z-up (|f| near 9.81):
+    # the decode stage checks the accelerometer's unit and sign on it.
+    a = [rng.uniform(-2, 2), rng.uniform(-2, 2), 9.81 + rng.uniform(-2, 2)]
     msg.angular_velocity.x, msg.angular_velocity.y, msg.angular_velocity.z = w
     msg.linear_acceleration.x, msg.linear_acceleration.y, msg.linear_acceleration.z = a
     msg.orientation_covariance[0] = -1.0

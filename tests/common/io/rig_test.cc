@@ -74,6 +74,30 @@ TEST(LoadRig, NonFiniteAndOutOfBoundValuesNameTheField) {
             std::string::npos);
 }
 
+TEST(LoadRig, ImuUnitsByName) {
+  proto::Rig rig;
+  Status status = LoadFromText(std::string(kRig) + "imu_accel_unit: G imu_gyro_unit: DEGPS", &rig);
+  ASSERT_TRUE(status.ok()) << status.message();
+  EXPECT_EQ(rig.imu_accel_unit(), proto::AccelUnit::G);
+  EXPECT_EQ(rig.imu_gyro_unit(), proto::GyroUnit::DEGPS);
+  status = LoadFromText(kRig, &rig);  // not stated: AUTO
+  ASSERT_TRUE(status.ok()) << status.message();
+  EXPECT_EQ(rig.imu_accel_unit(), proto::AccelUnit::AUTO);
+  EXPECT_EQ(rig.imu_gyro_unit(), proto::GyroUnit::AUTO);
+}
+
+TEST(LoadRig, UnknownImuUnitIsAnError) {
+  EXPECT_NE(LoadError(std::string(kRig) + "imu_accel_unit: MPS").find("imu_accel_unit"),
+            std::string::npos);
+  // Text format takes any number for a proto3 enum; the rig does not.
+  EXPECT_NE(LoadError(std::string(kRig) + "imu_accel_unit: 7")
+                .find("imu_accel_unit = 7 is not one of AUTO, MPS2, G"),
+            std::string::npos);
+  EXPECT_NE(LoadError(std::string(kRig) + "imu_gyro_unit: 3")
+                .find("imu_gyro_unit = 3 is not one of AUTO, RADPS, DEGPS"),
+            std::string::npos);
+}
+
 TEST(LoadRig, DirectoryAndEmptyFileAreErrors) {
   testing::TempDir dir;
   proto::Rig rig;

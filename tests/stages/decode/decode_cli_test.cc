@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "tests/bag/ros1/bag_test_util.h"
+#include "tests/stages/decode/vehicle_bag.h"
 #include "tests/testing/test_env.h"
 
 namespace tiltcal {
@@ -58,13 +59,29 @@ class DecodeCli : public ::testing::Test {
     out << contents;
   }
 
-  // A valid rig.txtpb naming the topics of the written velodyne bags.
-  std::string WriteRigWithTopics() {
+  // A valid rig.txtpb naming the topics of the written velodyne bags (and
+  // of the vehicle bags), with `extra` fields.
+  std::string WriteRigWithTopics(const std::string& extra = "") {
     const std::string rig = tmp_.File("rig.txtpb");
     WriteFile(rig,
               "imu_from_lidar { rotation { w: 1 } translation { x: 0.1 } }\nimu_height_m: 0.3\n"
-              "imu_topic: \"/imu/data\"\nlidar_topic: \"/points\"\n");
+              "imu_topic: \"/imu/data\"\nlidar_topic: \"/points\"\n" +
+                  extra);
     return rig;
+  }
+
+  // A vehicle bag (tests/stages/decode/vehicle_bag.h) in tmp_.
+  std::string VehicleBag(const std::string& name, const testing::VehicleBagOptions& options) {
+    const std::string bag = tmp_.File(name);
+    EXPECT_TRUE(testing::WriteVehicleBag(bag, options));
+    return bag;
+  }
+
+  // The default params with `extra` appended, as a file in tmp_.
+  std::string ParamsWith(const std::string& extra) {
+    const std::string params = tmp_.File("params.txtpb");
+    WriteFile(params, testing::ReadFileOrEmpty(params_) + "\n" + extra + "\n");
+    return params;
   }
 
   testing::TempDir tmp_;
@@ -243,6 +260,148 @@ TEST_F(DecodeCli, MissingBag) {
   std::string output;
   const int rc = Decode(tmp_.File("missing.bag"), params_, &output);
   ExpectCleanFailure(rc, output, {tmp_.File("missing.bag"), "cannot open"});
+}
+
+testing::VehicleBagOptions InGAndDegrees() {
+  testing::VehicleBagOptions options;
+  options.accel_scale = 1.0 / 9.80665;
+  options.gyro_scale = 180.0 / M_PI;
+  return options;
+}
+
+// AUTO converts an IMU in g and deg/s, says so on stderr, one line per
+// sensor, and in the provenance of imu.binpb that tiltcal_inspect shows.
+TEST_F(DecodeCli, ImuInGAndDegreesIsConvertedAndSaid) {
+  ASSERT_TRUE(testing::FileExists(testing::ToolPath("tiltcal_inspect")));
+  const std::string bag = VehicleBag("g_deg.bag", InGAndDegrees());
+  std::string output;
+  ASSERT_EQ(Decode(bag, params_, &output, "--rig=" + WriteRigWithTopics()), 0) << output;
+  const std::string accel_line =
+      "  imu: accelerometer in g, detected: median |f| 1.0003 over 400 static samples; "
+      "converted to m/s² (× 9.80665)\n";
+  const std::string gyro_line =
+      "  imu: gyro in deg/s, detected: |ω| at percentile 99 is 34.6, above 5 rad/s, the fastest "
+      "turn of a ground vehicle; converted to rad/s (× π/180)\n";
+  EXPECT_NE(output.find(accel_line), std::string::npos) << output;
+  EXPECT_NE(output.find(gyro_line), std::string::npos) << output;
+  EXPECT_NE(output.find("  imu: accelerometer sign checked: the mean specific force over 400 "
+                        "static samples, (0.002, 0.003, 9.810) m/s² in the IMU frame, points "
+                        "0.0 deg from the LiDAR's +z"),
+            std::string::npos)
+      << output;
+  EXPECT_EQ(output.find("WARNING"), std::string::npos) << output;
+  std::string info;
+  ASSERT_EQ(testing::RunCommand(
+                testing::ToolPath("tiltcal_inspect") + " info " + tmp_.File("out/imu.binpb"),
+                &info),
+            0)
+      << info;
+  EXPECT_NE(info.find("notes: \"accelerometer in g, detected: median |f| 1.0003"),
+            std::string::npos)
+      << info;
+  EXPECT_NE(info.find("notes: \"gyro in deg/s, detected:"), std::string::npos) << info;
+}
+
+TEST_F(DecodeCli, RigStatingTheWrongAccelerometerUnit) {
+  const std::string bag = VehicleBag("g_deg.bag", InGAndDegrees());
+  const std::string rig = WriteRigWithTopics("imu_accel_unit: MPS2\n");
+  std::string output;
+  const int rc = Decode(bag, params_, &output, "--rig=" + rig);
+  EXPECT_EQ(rc, 1);
+  EXPECT_EQ(output, "tiltcal_decode: " + rig + ": imu_accel_unit is MPS2 but the accelerometer of " +
+                        bag +
+                        " reads in g: median |f| 1.0003 over 400 static samples (one g is 9.81 "
+                        "in m/s², 1 in g)\n");
+  ExpectCleanFailure(rc, output, {});
+}
+
+TEST_F(DecodeCli, RigStatingTheWrongGyroUnit) {
+  const std::string bag = VehicleBag("g_deg.bag", InGAndDegrees());
+  const std::string rig = WriteRigWithTopics("imu_accel_unit: G\nimu_gyro_unit: RADPS\n");
+  std::string output;
+  const int rc = Decode(bag, params_, &output, "--rig=" + rig);
+  EXPECT_EQ(rc, 1);
+  EXPECT_EQ(output, "tiltcal_decode: " + rig + ": imu_gyro_unit is RADPS but the gyro of " + bag +
+                        " reads in deg/s: |ω| at percentile 99 is 34.6, above 5 rad/s, the "
+                        "fastest turn of a ground vehicle\n");
+  ExpectCleanFailure(rc, output, {});
+}
+
+// LiDAR stamps 10 min after the IMU's: one line with both spans and the
+// field to set; with the field set the bag decodes.
+TEST_F(DecodeCli, ClockDomainsTenMinutesApart) {
+  testing::VehicleBagOptions late;
+  late.lidar_stamp_offset_ns = 600LL * 1000000000LL;
+  const std::string bag = VehicleBag("late.bag", late);
+  std::string output;
+  const int rc = Decode(bag, params_, &output);
+  EXPECT_EQ(rc, 1);
+  EXPECT_EQ(output,
+            "tiltcal_decode: " + bag +
+                ": the LiDAR and IMU stamps do not overlap (two clocks?): IMU stamps "
+                "1700000000.000 .. 1700000012.000 s (2023-11-14 22:13:20 UTC .. 2023-11-14 "
+                "22:13:32 UTC), LiDAR stamps 1700000600.000 .. 1700000611.900 s (2023-11-14 "
+                "22:23:20 UTC .. 2023-11-14 22:23:31 UTC), the LiDAR 588.000 s after the IMU; "
+                "set lidar_stamp_shift_s in the decode params (added to every LiDAR stamp, s) "
+                "to decode anyway: the bag's record times suggest lidar_stamp_shift_s: "
+                "-599.981\n");
+  ExpectCleanFailure(rc, output, {});
+
+  ASSERT_EQ(Decode(bag, ParamsWith("lidar_stamp_shift_s: -599.981"), &output), 0) << output;
+  EXPECT_NE(output.find("  clocks: IMU and LiDAR stamps overlap for 11.900 s (LiDAR stamps "
+                        "shifted by -599.981 s, lidar_stamp_shift_s)\n"),
+            std::string::npos)
+      << output;
+}
+
+// A driver publishing gravity instead of the specific force: against the
+// rig's g_f an error, against its rotation alone a warning (exit 0).
+TEST_F(DecodeCli, SignFlippedAccelerometer) {
+  testing::VehicleBagOptions flipped;
+  flipped.accel_scale = -1.0;
+  const std::string bag = VehicleBag("flipped.bag", flipped);
+  const std::string rig = WriteRigWithTopics("gravity_flat_in_imu { z: -9.81 }\n");
+  std::string output;
+  const int rc = Decode(bag, params_, &output, "--rig=" + rig);
+  EXPECT_EQ(rc, 1);
+  EXPECT_EQ(output,
+            "tiltcal_decode: " + rig +
+                ": the mean specific force over 400 static samples, (-0.002, -0.003, -9.810) "
+                "m/s² in the IMU frame, points 180.0 deg from up (−gravity_flat_in_imu of the "
+                "rig; more than 90): the accelerometer of " +
+                bag +
+                " publishes gravity instead of specific force (sign-flipped), or "
+                "gravity_flat_in_imu has the wrong sign (g_f points down: it is minus the mean "
+                "accelerometer reading at rest on flat ground)\n");
+  ExpectCleanFailure(rc, output, {});
+
+  ASSERT_EQ(Decode(bag, params_, &output, "--rig=" + WriteRigWithTopics()), 0) << output;
+  const std::string warning =
+      "  WARNING: imu: the mean specific force over 400 static samples, (-0.002, -0.003, "
+      "-9.810) m/s² in the IMU frame, points 180.0 deg from the LiDAR's +z (through "
+      "imu_from_lidar of the rig; more than 90): the accelerometer publishes gravity instead of "
+      "specific force (sign-flipped), or the rig's rotation is wrong (an IMU mounted upside "
+      "down and not declared), or the LiDAR is mounted upside down; imu.binpb keeps the "
+      "published sign\n";
+  EXPECT_NE(output.find(warning), std::string::npos) << output;
+  EXPECT_EQ(output.find("WARNING"), output.rfind("WARNING")) << output;  // said once
+}
+
+TEST_F(DecodeCli, ImuUnitsParamsAreValidated) {
+  std::string text = testing::ReadFileOrEmpty(params_);
+  for (const std::string field : {"accel_norm_ratio_min: 0.8", "accel_norm_ratio_max: 1.25"}) {
+    ASSERT_NE(text.find(field), std::string::npos) << field;
+    text.replace(text.find(field), field.size(), field.substr(0, field.find(':')) + ": 1");
+  }
+  const std::string params = tmp_.File("params.txtpb");
+  WriteFile(params, text);
+  std::string output;
+  const int rc = Decode(VehicleBag("si.bag", {}), params, &output);
+  EXPECT_EQ(rc, 1);
+  EXPECT_EQ(output, "tiltcal_decode: " + params +
+                        ": field imu_units.accel_norm_ratio_max must be greater than "
+                        "imu_units.accel_norm_ratio_min\n");
+  ExpectCleanFailure(rc, output, {});
 }
 
 }  // namespace
