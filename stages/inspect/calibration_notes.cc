@@ -107,7 +107,7 @@ void AddClockNotes(const proto::CheckParams& params, CheckFindings* f) {
   if (std::abs(c.stamp_offset_difference_s) > params.clock().time_offset_window_s()) {
     f->notes.push_back(fmt::format(
         "τ may be beyond ±{:.3g} s: LiDAR stamp − record time differs from the IMU's by "
-        "{:+.3f} s (τ ≈ {:.3f} s); set the calibrate params' time_offset_bound_s to cover it",
+        "{:+.3f} s (τ ≈ {:.3f} s); set the calibrate params' init.coarse_time_offset_window_s to cover it",
         params.clock().time_offset_window_s(), c.stamp_offset_difference_s,
         -c.stamp_offset_difference_s));
   }

@@ -168,8 +168,8 @@ void AnalyseClock(const BagSurvey& survey, const proto::CheckParams& params, Che
   if (c.overlap_s < params.clock().min_overlap_s()) {
     f->problems.push_back(fmt::format(
         "clock: the IMU stamps ({:.3f} .. {:.3f} s) and the LiDAR stamps ({:.3f} .. {:.3f} s) "
-        "{} (different clock domains?): restamp one stream, or set the calibrate params' "
-        "time_offset_bound_s to cover the offset",
+        "{} (different clock domains?): restamp one stream, or set the decode params' "
+        "lidar_stamp_shift_s (s added to every LiDAR stamp) to cover the offset",
         1e-9 * i.first_ns, 1e-9 * i.last_ns, 1e-9 * l.first_ns, 1e-9 * l.last_ns,
         c.overlap_s < 0.0 ? fmt::format("do not overlap (apart by {:.3f} s)", -c.overlap_s)
                           : fmt::format("overlap only {:.3f} s", c.overlap_s)));
