@@ -1,5 +1,7 @@
 #include "common/cli/command_line.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cerrno>
 #include <cstdlib>
@@ -10,6 +12,10 @@
 #include "common/io/provenance.h"
 
 namespace tiltcal::cli {
+
+bool IsTerminalLog(const std::ostream* log) {
+  return (log == &std::cerr || log == &std::clog) && ::isatty(STDERR_FILENO);
+}
 
 CommandLine::CommandLine(std::string tool, std::string purpose)
     : tool_(std::move(tool)), purpose_(std::move(purpose)) {}

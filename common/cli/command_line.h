@@ -13,6 +13,10 @@
 
 namespace tiltcal::cli {
 
+// True when `log` is the standard error stream and that is a terminal: where
+// progress lines rewritten in place belong.
+bool IsTerminalLog(const std::ostream* log);
+
 // Exit codes of every tiltcal executable.
 inline constexpr int kExitOk = 0;       // done, outputs written
 inline constexpr int kExitFailure = 1;  // the run failed (bad input, failed solve); no output left

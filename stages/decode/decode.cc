@@ -1,7 +1,5 @@
 #include "stages/decode/decode.h"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -13,6 +11,7 @@
 
 #include "bag/ros1/bag_reader.h"
 #include "bag/ros1/messages.h"
+#include "common/cli/command_line.h"
 #include "common/io/provenance.h"
 #include "common/io/rig.h"
 #include "stages/decode/async_record_writer.h"
@@ -136,17 +135,12 @@ void PrintSummary(std::ostream* log, const DecodePaths& paths, double shift_s,
                       s.wall_s > 0 ? mb / s.wall_s : 0.0, s.chunks_decompressed);
 }
 
-// True when `log` is the standard error stream and that is a terminal.
-bool IsTerminal(const std::ostream* log) {
-  return (log == &std::cerr || log == &std::clog) && ::isatty(STDERR_FILENO);
-}
-
 // "tiltcal_decode:  42% (…)" rewritten in place at most every 250 ms, only
 // on a terminal.
 class ProgressLine {
  public:
   ProgressLine(std::ostream* log, int64_t total)
-      : log_(IsTerminal(log) ? log : nullptr), total_(total), last_(Clock::now()) {}
+      : log_(cli::IsTerminalLog(log) ? log : nullptr), total_(total), last_(Clock::now()) {}
   ~ProgressLine() {
     if (log_ != nullptr) *log_ << "\r\033[K" << std::flush;
   }

@@ -1,7 +1,5 @@
 #include "stages/simulate/simulate.h"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -16,6 +14,7 @@
 #include "bag/ros1/message_encoding.h"
 #include "common/geometry/euler_angles.h"
 #include "common/imu/imu_units.h"
+#include "common/cli/command_line.h"
 #include "common/io/eigen_proto.h"
 #include "common/io/provenance.h"
 #include "common/io/text_proto.h"
@@ -268,11 +267,6 @@ struct SimulateSummary {
   double raycast_seconds = 0.0;  // wall time in ray casting + serialization
   double total_seconds = 0.0;
 };
-
-// True when `log` is the standard error stream and that is a terminal.
-bool IsTerminal(const std::ostream* log) {
-  return (log == &std::cerr || log == &std::clog) && ::isatty(STDERR_FILENO);
-}
 
 // The units the IMU messages are published in (SimFaultParams).
 imu::AccelUnit PublishedAccelUnit(const proto::SimFaultParams& faults) {
@@ -589,7 +583,7 @@ Status Run(const SimulatePaths& paths, const proto::SimulateParams& params, std:
   proto::SimulationTruth truth;
   ScanWriter scans(params, scenario, threads);
   TILTCAL_RETURN_IF_ERROR(scans.WriteAll(&writer, lidar_conn, imu_conn, &imu, frames, &truth,
-                                         IsTerminal(log) ? log : nullptr, &summary));
+                                         cli::IsTerminalLog(log) ? log : nullptr, &summary));
   TILTCAL_RETURN_IF_ERROR(imu.WriteUpTo(INT64_MAX, imu_conn, &writer));
   TILTCAL_RETURN_IF_ERROR(writer.Close());
 
