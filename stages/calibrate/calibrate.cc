@@ -290,6 +290,13 @@ void FillCovariance(const CalibrateInputs& inputs, const proto::CalibrateParams&
     const Status cs = ComputeExtrinsicCovariance(problem->problem(), state,
                                                  static_cast<int>(params.num_threads()), &cov);
     if (cs.ok()) {
+      const VarianceFactor factor = ComputeVarianceFactor(problem->problem());
+      result->set_variance_factor(factor.sigma0_squared);
+      result->set_redundancy(factor.redundancy);
+      if (params.observability().scale_by_variance_factor() && factor.redundancy > 0) {
+        cov *= factor.sigma0_squared;
+        result->set_covariance_scaled_by_variance_factor(true);
+      }
       FillCovarianceReport(cov, state->ImuFromLidarRotation().toRotationMatrix(),
                            PrincipalRotationAxis(inputs.imu, state->GyroBias()),
                            params.observability(), result);

@@ -58,6 +58,27 @@ Status ComputeExtrinsicCovariance(ceres::Problem* problem, CalibrationState* sta
   return Status::Ok();
 }
 
+VarianceFactor ComputeVarianceFactor(ceres::Problem* problem) {
+  VarianceFactor out;
+  std::vector<double*> blocks;
+  problem->GetParameterBlocks(&blocks);
+  int64_t free_parameters = 0;
+  for (double* b : blocks) {
+    if (!problem->IsParameterBlockConstant(b)) free_parameters += problem->ParameterBlockTangentSize(b);
+  }
+  const int64_t redundancy = problem->NumResiduals() - free_parameters;
+  double cost = 0.0;
+  ceres::Problem::EvaluateOptions options;
+  options.apply_loss_function = true;
+  if (redundancy <= 0 || !problem->Evaluate(options, &cost, nullptr, nullptr, nullptr) ||
+      !std::isfinite(cost)) {
+    return out;
+  }
+  out.redundancy = redundancy;
+  out.sigma0_squared = 2.0 * cost / static_cast<double>(redundancy);
+  return out;
+}
+
 std::string DescribeDirection(const Eigen::Vector3d& v) {
   int k = 0;
   v.cwiseAbs().maxCoeff(&k);

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include <ceres/problem.h>
+#include <ceres/sized_cost_function.h>
 #include <ceres/solver.h>
 #include <gtest/gtest.h>
 
@@ -213,6 +214,53 @@ TEST(CovarianceReportTest, SigmasDirectionsAndWeakNames) {
       << t0.description();
   EXPECT_FALSE(result.observability(4).weak());
   EXPECT_NE(result.observability(4).description().find("plane of rotation"), std::string::npos);
+}
+
+// r_i = (x - y_i) / sigma_model: the least-squares x is the mean of y and
+// 2 F / (m - n) = sum (y_i - mean)^2 / (sigma_model^2 (N - 1)), the sample
+// variance over the model's; a constant block adds no free parameter.
+class OffsetResidual final : public ceres::SizedCostFunction<1, 1, 1> {
+ public:
+  OffsetResidual(double y, double sigma) : y_(y), sigma_(sigma) {}
+  bool Evaluate(double const* const* p, double* r, double** j) const override {
+    r[0] = (p[0][0] + p[1][0] - y_) / sigma_;
+    if (j != nullptr && j[0] != nullptr) j[0][0] = 1.0 / sigma_;
+    if (j != nullptr && j[1] != nullptr) j[1][0] = 1.0 / sigma_;
+    return true;
+  }
+
+ private:
+  double y_;
+  double sigma_;
+};
+
+TEST(CovarianceReportTest, VarianceFactorIsTheSampleVarianceOverTheModels) {
+  const std::vector<double> y = {0.3, -0.2, 0.5, 0.1, -0.4, 0.25, 0.0, -0.15};
+  const double sigma_model = 0.5;
+  double mean = 0.0;
+  for (double v : y) mean += v / static_cast<double>(y.size());
+  double sum_squares = 0.0;
+  for (double v : y) sum_squares += (v - mean) * (v - mean);
+  double x = mean;  // the least-squares solution
+  double constant_offset = 0.0;
+  ceres::Problem problem;
+  for (double v : y) {
+    problem.AddResidualBlock(new OffsetResidual(v, sigma_model), nullptr, &x, &constant_offset);
+  }
+  problem.SetParameterBlockConstant(&constant_offset);
+  const VarianceFactor factor = ComputeVarianceFactor(&problem);
+  EXPECT_EQ(factor.redundancy, static_cast<int64_t>(y.size()) - 1);
+  EXPECT_NEAR(factor.sigma0_squared,
+              sum_squares / (sigma_model * sigma_model * static_cast<double>(y.size() - 1)),
+              1e-12);
+
+  // No redundancy: no factor.
+  double z = 0.0;
+  ceres::Problem one;
+  one.AddResidualBlock(new OffsetResidual(1.0, sigma_model), nullptr, &z, &constant_offset);
+  one.SetParameterBlockConstant(&constant_offset);
+  EXPECT_EQ(ComputeVarianceFactor(&one).redundancy, 0);
+  EXPECT_DOUBLE_EQ(ComputeVarianceFactor(&one).sigma0_squared, 1.0);
 }
 
 TEST(CovarianceReportTest, PrincipalAxisOfAYawingMotion) {
@@ -499,6 +547,24 @@ TEST(CalibratePipelineTest, TimeOffsetBeyondItsBoundIsSuspectWithExitCode3) {
   ASSERT_GT(result.verdict_reasons_size(), 0);
   EXPECT_NE(result.verdict_reasons(0).find("time offset at a bound"), std::string::npos)
       << result.verdict_reasons(0);
+
+  // verdict.allow_suspect: the same SUSPECT result, exit 0.
+  const std::string allow = "allow_suspect: false";
+  ASSERT_NE(params_text.find(allow), std::string::npos);
+  params_text.replace(params_text.find(allow), allow.size(), "allow_suspect: true");
+  ASSERT_TRUE(WriteFileAtomically(dir.File("params_allow.txtpb"), params_text).ok());
+  const std::string allowed_out = dir.File("calibration_allowed.txtpb");
+  const int allowed_code = testing::RunCommand(
+      testing::ToolPath("tiltcal_calibrate") + " --quiet --imu=" + paths.imu +
+          " --scans=" + paths.scans + " --ground=" + paths.ground + " --rig=" + paths.rig +
+          " --params=" + dir.File("params_allow.txtpb") + " --out=" + allowed_out,
+      &output);
+  EXPECT_EQ(allowed_code, 0) << output;
+  EXPECT_NE(output.find("tiltcal_calibrate: verdict SUSPECT"), std::string::npos) << output;
+  proto::CalibrationResult allowed;
+  ASSERT_TRUE(ReadTextProto(allowed_out, &allowed).ok());
+  EXPECT_EQ(allowed.verdict(), proto::CalibrationResult::SUSPECT);
+  EXPECT_NEAR(allowed.time_offset_s(), result.time_offset_s(), 1e-6);
 }
 
 }  // namespace
