@@ -25,7 +25,7 @@ done
 exit 0
 STUB
 chmod +x "$BIN/stub"
-for stage in decode ground gravity calibrate report inspect; do
+for stage in decode ground gravity gravity_reference calibrate report inspect; do
   ln -s stub "$BIN/tiltcal_$stage"
 done
 # A stub interpreter for the plot scripts.
@@ -103,6 +103,34 @@ sleep_past; printf 'imu_height_m: 0.3\ngravity_reference: "flat/gravity.txtpb"\n
 sleep_past; touch "$DATA/flat/gravity.txtpb"
 expect "a changed gravity reference reruns gravity and downstream" "$(planned calibrate)" \
 "tiltcal_calibrate seq_a;tiltcal_calibrate seq_b;tiltcal_gravity seq_a;tiltcal_gravity seq_b;"
+"${MAKE[@]}" all > /dev/null
+
+# ... or from a flat dataset folder: its out/gravity_reference.txtpb, from
+# its calibrations, brought up to date by make on the tilted dataset.
+FLAT=$WORK/flat_dataset
+mkdir -p "$FLAT"; echo 'imu_height_m: 0.3' > "$FLAT/rig.txtpb"; touch "$FLAT/run_1.bag" "$FLAT/run_2.bag"
+sleep_past; printf 'imu_height_m: 0.3\ngravity_reference: "../flat_dataset"\n' > "$DATA/rig.txtpb"
+"${MAKE[@]}" all > /dev/null
+for f in run_1/calibration.txtpb run_2/calibration.txtpb gravity_reference.txtpb; do
+  [ -s "$FLAT/out/$f" ] || fail "make on the tilted dataset did not make the flat dataset's out/$f"
+done
+grep -q -- "tiltcal_gravity_reference .*--out=$FLAT/out/gravity_reference.txtpb" \
+  <(make --no-print-directory -n -B -f "$SRC/Makefile.pipeline" DATASET="$FLAT" BIN="$BIN" \
+  gravity-reference) || fail "no gravity-reference target on the flat dataset"
+mtime() { stat -c %Y.%y "$1"; }
+before=$(mtime "$DATA/out/seq_a/gravity.txtpb")
+sleep_past; "${MAKE[@]}" all > /dev/null
+[ "$(mtime "$DATA/out/seq_a/gravity.txtpb")" = "$before" ] ||
+  fail "an up-to-date flat dataset reference reran the tilted gravity stage"
+echo "ok: a flat dataset folder as the gravity reference, up to date"
+sleep_past; echo 'edited' >> "$FLAT/run_2.bag"
+"${MAKE[@]}" all > /dev/null
+[ "$FLAT/out/gravity_reference.txtpb" -nt "$FLAT/run_2.bag" ] ||
+  fail "a changed flat bag did not rebuild the flat dataset's reference"
+[ "$(mtime "$DATA/out/seq_a/gravity.txtpb")" != "$before" ] ||
+  fail "a rebuilt flat dataset reference did not rerun the tilted gravity stage"
+echo "ok: a changed flat dataset rebuilds its reference and the tilted gravity stage"
+printf 'imu_height_m: 0.3\ngravity_reference: "flat/gravity.txtpb"\n' > "$DATA/rig.txtpb"
 "${MAKE[@]}" all > /dev/null
 
 sleep_past; touch "$DATA/params/ground.txtpb"
