@@ -297,8 +297,9 @@ void FillCovariance(const CalibrateInputs& inputs, const proto::CalibrateParams&
         cov *= factor.sigma0_squared;
         result->set_covariance_scaled_by_variance_factor(true);
       }
-      FillCovarianceReport(cov, state->ImuFromLidarRotation().toRotationMatrix(),
-                           PrincipalRotationAxis(inputs.imu, state->GyroBias()),
+      const MotionAxis motion = PrincipalRotationAxis(inputs.imu, state->GyroBias());
+      *result->mutable_motion_rotation_axis_b() = ToProto(motion.axis_b);
+      FillCovarianceReport(cov, state->ImuFromLidarRotation().toRotationMatrix(), motion,
                            params.observability(), result);
     } else {
       proto::ObservabilityDirection* d = result->add_observability();
@@ -433,6 +434,8 @@ Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& pa
   problem_options.translation_prior_m = ToEigen(inputs.rig.imu_from_lidar()).translation;
   problem_options.translation_prior_sigma_m = params.extrinsic_translation_prior_sigma_m();
   problem_options.translation_prior_axis_b = init.rotation_axis_b;
+  result->set_translation_prior_sigma_m(problem_options.translation_prior_sigma_m);
+  *result->mutable_translation_prior_axis_b() = ToProto(init.rotation_axis_b.normalized());
   OuterLoop loop;
   bool settled = false;
   const int max_rounds = static_cast<int>(params.outer_loop().iterations());
