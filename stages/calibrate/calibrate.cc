@@ -294,7 +294,10 @@ void FillCovariance(const CalibrateInputs& inputs, const proto::CalibrateParams&
       result->set_variance_factor(factor.sigma0_squared);
       result->set_redundancy(factor.redundancy);
       if (params.observability().scale_by_variance_factor() && factor.redundancy > 0) {
-        cov *= factor.sigma0_squared;
+        Matrix7d prior_information = Matrix7d::Zero();
+        prior_information.block<3, 3>(3, 3) = TranslationPriorInformation(
+            result->translation_prior_sigma_m(), ToEigen(result->translation_prior_axis_b()));
+        cov = ScaleDataInformation(cov, prior_information, factor.sigma0_squared);
         result->set_covariance_scaled_by_variance_factor(true);
       }
       const MotionAxis motion = PrincipalRotationAxis(inputs.imu, state->GyroBias());

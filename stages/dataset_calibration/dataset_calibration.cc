@@ -40,22 +40,12 @@ std::string ReasonNotUsable(const SequenceCalibration& s,
   return "";
 }
 
-// Information of the translation prior of one solve, n x n (zero: none):
-// a a^T / sigma^2 (I / sigma^2 without an axis), divided by the variance
-// factor when the solve scaled its covariance by it.
-Eigen::MatrixXd TranslationPriorInformation(const proto::CalibrationResult& r, int n,
-                                            bool as_scaled) {
+// Information of the translation prior of one solve, n x n (zero: none);
+// the solve's covariance holds it unscaled.
+Eigen::MatrixXd PriorInformation(const proto::CalibrationResult& r, int n) {
   Eigen::MatrixXd information = Eigen::MatrixXd::Zero(n, n);
-  const double sigma = r.translation_prior_sigma_m();
-  if (sigma <= 0.0) return information;
-  const Eigen::Vector3d axis = ToEigen(r.translation_prior_axis_b());
-  const Eigen::Matrix3d w = axis.norm() > 0.0
-                                ? Eigen::Matrix3d(axis.normalized() * axis.normalized().transpose())
-                                : Eigen::Matrix3d::Identity();
-  information.block<3, 3>(3, 3) = w / (sigma * sigma);
-  if (as_scaled && r.covariance_scaled_by_variance_factor() && r.variance_factor() > 0.0) {
-    information /= r.variance_factor();
-  }
+  information.block<3, 3>(3, 3) = calibrate::TranslationPriorInformation(
+      r.translation_prior_sigma_m(), ToEigen(r.translation_prior_axis_b()));
   return information;
 }
 
@@ -68,12 +58,12 @@ ExtrinsicEstimate ToEstimate(const proto::CalibrationResult& r, int n) {
   e.rest.head<3>() = extrinsic.translation;
   if (n == 7) e.rest[3] = r.time_offset_s();
   e.covariance = covariance.topLeftCorner(n, n);
-  e.prior_information = TranslationPriorInformation(r, n, /*as_scaled=*/true);
+  e.prior_information = PriorInformation(r, n);
   return e;
 }
 
 // The prior counted once: centred on the rig, the mean of the solves' own
-// (unscaled) prior information.
+// prior information (their axes differ slightly with each motion).
 geometry::ExtrinsicPrior JointPrior(const std::vector<const proto::CalibrationResult*>& used,
                                     int n) {
   geometry::ExtrinsicPrior prior;
@@ -81,8 +71,7 @@ geometry::ExtrinsicPrior JointPrior(const std::vector<const proto::CalibrationRe
   prior.rest.head<3>() = ToEigen(used.front()->rig_imu_from_lidar()).translation;
   prior.information = Eigen::MatrixXd::Zero(n, n);
   for (const proto::CalibrationResult* r : used) {
-    prior.information += TranslationPriorInformation(*r, n, /*as_scaled=*/false) /
-                         static_cast<double>(used.size());
+    prior.information += PriorInformation(*r, n) / static_cast<double>(used.size());
   }
   return prior;
 }

@@ -263,6 +263,21 @@ TEST(CovarianceReportTest, VarianceFactorIsTheSampleVarianceOverTheModels) {
   EXPECT_DOUBLE_EQ(ComputeVarianceFactor(&one).sigma0_squared, 1.0);
 }
 
+// P = (S + L)^{-1}: scaling the data's information S by 1/s keeps L.
+TEST(CovarianceReportTest, ScalingTheDataKeepsThePrior) {
+  Matrix7d a = Matrix7d::Random();
+  const Matrix7d data = a * a.transpose() + Matrix7d::Identity();
+  Matrix7d prior = Matrix7d::Zero();
+  prior.block<3, 3>(3, 3) = TranslationPriorInformation(0.05, Eigen::Vector3d(0, 0, 2));
+  EXPECT_DOUBLE_EQ(prior(5, 5), 400.0);
+  EXPECT_DOUBLE_EQ(prior(3, 3), 0.0);
+  const Matrix7d scaled = ScaleDataInformation((data + prior).inverse(), prior, 0.25);
+  EXPECT_LT((scaled - (data / 0.25 + prior).inverse()).norm(), 1e-12 * scaled.norm());
+  EXPECT_EQ(TranslationPriorInformation(0.0, Eigen::Vector3d::UnitZ()), Eigen::Matrix3d::Zero());
+  EXPECT_EQ(TranslationPriorInformation(0.5, Eigen::Vector3d::Zero()),
+            Eigen::Matrix3d::Identity() * 4.0);
+}
+
 TEST(CovarianceReportTest, PrincipalAxisOfAYawingMotion) {
   std::vector<imu::ImuReading> imu(100);
   for (size_t i = 0; i < imu.size(); ++i) {

@@ -24,14 +24,16 @@ proto::GravityParams Params(const std::string& overrides = "") {
   return testing::DefaultParamsWith<proto::GravityParams>(DefaultParamsText(), overrides);
 }
 
-// A level calibration that started still, with g_a = R(axis, angle) g0.
+// A level calibration that started still, with g_a = R(a, angle) g0, a the
+// unit vector of `axis` perpendicular to g0 (so g_a is `angle` from g0).
 FlatCalibration Level(const std::string& path, const Eigen::Vector3d& axis, double angle_deg,
                       double norm_mps2 = 9.81) {
-  const Eigen::Vector3d g0(0.05, -0.02, -1.0);
+  const Eigen::Vector3d g0 = Eigen::Vector3d(0.05, -0.02, -1.0).normalized();
+  const Eigen::Vector3d a = (axis - axis.dot(g0) * g0).normalized();
   FlatCalibration c;
   c.path = path;
-  *c.result.mutable_gravity_in_world() = ToProto(
-      Eigen::AngleAxisd(angle_deg / kDegPerRad, axis.normalized()) * g0.normalized() * norm_mps2);
+  *c.result.mutable_gravity_in_world() =
+      ToProto(Eigen::AngleAxisd(angle_deg / kDegPerRad, a) * g0 * norm_mps2);
   c.result.set_static_start(true);
   c.result.add_ground_residuals_used("flat");
   c.result.add_ground_residuals_used("dist");
