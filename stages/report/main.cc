@@ -15,6 +15,9 @@ int main(int argc, char** argv) {
   cli.AddFlag("out_html", "output: the dataset's page (self-contained HTML)");
   cli.AddFlag("rig", "input: the dataset's rig.txtpb, for the measured extrinsic row");
   cli.AddFlag("title", "first line of the table");
+  cli.AddFlag("dataset_calibration",
+              "input: the dataset's calibration.txtpb (tiltcal_dataset_calibration), for the joint "
+              "row and the consistency column");
   cli.AddExample(
       "tiltcal_report --out=out/repeatability.txt --out_csv=out/repeatability.csv "
       "--out_html=out/report.html "
@@ -27,5 +30,6 @@ int main(int argc, char** argv) {
   paths.out_csv = cli.Get("out_csv");
   paths.out_html = cli.Get("out_html");
   paths.title = cli.Get("title");
+  paths.dataset_calibration = cli.Get("dataset_calibration");
   return cli.Finish(tiltcal::report::Run(paths, &std::cout));
 }

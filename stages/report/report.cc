@@ -137,6 +137,27 @@ Repeatability ComputeRepeatability(const std::vector<SequenceResult>& results,
   return out;
 }
 
+void AddDatasetCalibration(const proto::CalibrationResult& dataset,
+                           const std::vector<SequenceResult>& results, Repeatability* r) {
+  Row joint = MakeRow("joint", dataset.imu_from_lidar(), dataset.time_offset_s());
+  for (const SequenceResult& result : results) {
+    if (!result.truth) continue;
+    AddErrors(*result.truth, dataset, &joint);
+    break;
+  }
+  if (dataset.verdict() != proto::CalibrationResult::VERDICT_UNSET) {
+    joint.verdict = proto::CalibrationResult::Verdict_Name(dataset.verdict());
+  }
+  r->joint = joint;
+  for (Row& row : r->sequences) {
+    for (const proto::DatasetSequence& s : dataset.sequences()) {
+      if (s.name() != row.label) continue;
+      row.consistency = "chi2 " + Fixed(s.consistency_chi2(), 1) + " / " +
+                        Fixed(s.consistency_limit(), 1) + (s.used() ? "" : " left out");
+    }
+  }
+}
+
 std::string FormatTable(const Repeatability& r, const std::string& title) {
   const bool errors = r.mean.has_errors ||
                       std::any_of(r.sequences.begin(), r.sequences.end(),
@@ -154,6 +175,8 @@ std::string FormatTable(const Repeatability& r, const std::string& title) {
               Pad("tau err", 9);
   }
   header += "  verdict";
+  const bool consistency = r.joint.has_value();
+  if (consistency) header += "   consistency with the joint value";
   out += header + "\n" + std::string(header.size(), '-') + "\n";
   auto line = [&](const Row& row) {
     std::string text = Pad(row.label, label_width);
@@ -167,7 +190,10 @@ std::string FormatTable(const Repeatability& r, const std::string& title) {
     } else if (errors && !row.verdict.empty()) {
       text += "   |" + std::string(9 + 3 * 8 + 9, ' ');
     }
-    if (!row.verdict.empty()) text += "  " + row.verdict;
+    std::string verdict = row.verdict;
+    if (!row.consistency.empty()) verdict.resize(std::max<size_t>(verdict.size(), 7), ' ');
+    if (!verdict.empty()) text += "  " + verdict;
+    if (!row.consistency.empty()) text += "   " + row.consistency;
     out += text + "\n";
   };
   for (const Row& row : r.sequences) line(row);
@@ -175,6 +201,7 @@ std::string FormatTable(const Repeatability& r, const std::string& title) {
   line(r.mean);
   line(r.sigma);
   if (r.measured) line(*r.measured);
+  if (r.joint) line(*r.joint);
   if (!r.rotation_mean_converged) out += "warning: the SO(3) mean did not converge\n";
   for (const std::string& name : r.suspect_set_aside) {
     out += "suspect, set aside (read its verdict_reasons): " + name + "\n";
@@ -240,6 +267,11 @@ Status Run(const ReportPaths& paths, std::ostream* log) {
   }
   Repeatability repeatability = ComputeRepeatability(results, paths.rig.empty() ? nullptr : &rig);
   repeatability.suspect_set_aside = suspect_set_aside;
+  if (!paths.dataset_calibration.empty()) {
+    proto::CalibrationResult dataset;
+    TILTCAL_RETURN_IF_ERROR(ReadTextProto(paths.dataset_calibration, &dataset));
+    AddDatasetCalibration(dataset, results, &repeatability);
+  }
   const std::string table = FormatTable(repeatability, paths.title);
   TILTCAL_RETURN_IF_ERROR(WriteFileAtomically(paths.out, table));
   if (!paths.out_csv.empty()) {

@@ -36,6 +36,9 @@ struct Row {
   // The calibration's verdict ("OK", "WEAK", "SUSPECT"; "" for files
   // written before the verdict existed and for the mean, sigma and measured rows).
   std::string verdict;
+  // With a dataset calibration: the sequence's consistency with the joint
+  // value, "chi2 12.7 / 22.7" (or "... left out" when it was not used).
+  std::string consistency;
 };
 
 // Repeatability over the sequences of a dataset, as the paper's Metrics
@@ -46,6 +49,7 @@ struct Repeatability {
   Row mean;   // rotation: Euler of the SO(3) mean; errors: mean of the errors
   Row sigma;  // euler123_deg holds σ of the deviations ξ (not an Euler triple)
   std::optional<Row> measured;  // the rig's measured extrinsic
+  std::optional<Row> joint;     // the dataset's calibration (tiltcal_dataset_calibration)
   bool rotation_mean_converged = true;
   // Sequences whose calibration was SUSPECT and set aside by the pipeline
   // (only <dir>/calibration.suspect.txtpb): listed, not in the rows or the mean.
@@ -54,6 +58,12 @@ struct Repeatability {
 
 Repeatability ComputeRepeatability(const std::vector<SequenceResult>& results,
                                    const proto::Rig* rig);
+
+// The dataset's calibration as the "joint" row (errors against the truth of
+// the first sequence that has one) and each sequence's consistency column,
+// matched by name.
+void AddDatasetCalibration(const proto::CalibrationResult& dataset,
+                           const std::vector<SequenceResult>& results, Repeatability* r);
 
 // Text table for people and CSV for scripts.
 std::string FormatTable(const Repeatability& repeatability, const std::string& title);
@@ -68,6 +78,7 @@ struct ReportPaths {
   // Optional: the dataset's page (report_page.h), with links relative to it.
   std::string out_html;
   std::string title;                       // first line of the table
+  std::string dataset_calibration;         // optional: out/calibration.txtpb of the dataset
 };
 
 // Reads <dir>/calibration.txtpb and <dir>/truth.txtpb (if present) for each

@@ -153,5 +153,42 @@ TEST(Repeatability, VerdictColumnAndSuspectSequencesSetAside) {
   EXPECT_NE(none.message().find("no usable calibration"), std::string::npos) << none.message();
 }
 
+// The dataset's calibration: a "joint" row with its errors and verdict, and
+// each sequence's consistency with it.
+TEST(Repeatability, JointRowAndConsistencyColumn) {
+  std::vector<SequenceResult> results = {Sequence("run1", {180, 0, 10}, {0.1, 0, 0.2}, 0.005),
+                                         Sequence("run2", {180, 0, 12}, {0.1, 0, 0.2}, 0.005)};
+  results[0].truth.emplace();
+  *results[0].truth->mutable_imu_from_lidar() = Extrinsic({180, 0, 11}, {0.1, 0, 0.2});
+  results[0].truth->set_time_offset_s(0.005);
+  proto::CalibrationResult dataset;
+  *dataset.mutable_imu_from_lidar() = Extrinsic({180, 0, 11.5}, {0.1, 0, 0.2});
+  dataset.set_time_offset_s(0.005);
+  dataset.set_verdict(proto::CalibrationResult::OK);
+  proto::DatasetSequence* s1 = dataset.add_sequences();
+  s1->set_name("run1");
+  s1->set_used(true);
+  s1->set_consistency_chi2(3.31);
+  s1->set_consistency_limit(22.7);
+  proto::DatasetSequence* s2 = dataset.add_sequences();
+  s2->set_name("run2");
+  s2->set_used(false);
+  s2->set_consistency_chi2(412.0);
+  s2->set_consistency_limit(22.7);
+  Repeatability r = ComputeRepeatability(results, nullptr);
+  AddDatasetCalibration(dataset, results, &r);
+  ASSERT_TRUE(r.joint.has_value());
+  EXPECT_TRUE(r.joint->has_errors);
+  EXPECT_NEAR(r.joint->rotation_error_deg, 0.5, 1e-9);
+  EXPECT_EQ(r.sequences[0].consistency, "chi2 3.3 / 22.7");
+  EXPECT_EQ(r.sequences[1].consistency, "chi2 412.0 / 22.7 left out");
+  const std::string table = FormatTable(r, "t");
+  EXPECT_NE(table.find("consistency with the joint value"), std::string::npos) << table;
+  EXPECT_NE(table.find("chi2 412.0 / 22.7 left out\n"), std::string::npos) << table;
+  const size_t joint = table.find("\n     joint");
+  ASSERT_NE(joint, std::string::npos) << table;
+  EXPECT_NE(table.find("OK", joint), std::string::npos) << table;
+}
+
 }  // namespace
 }  // namespace tiltcal::report
