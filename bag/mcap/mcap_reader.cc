@@ -380,7 +380,7 @@ Status McapReader::ReadMessages(const bag::MessageSelection& selection,
     return a->offset < b->offset;
   });
   bag::Message m;
-  m.file = &path_;
+  m.file = nullptr;  // one file: the caller names it
   std::vector<uint8_t> record;
   for (const Entry* e : items) {
     const uint8_t* data = nullptr;
