@@ -2,9 +2,9 @@
 #define TILTCAL_BAG_MCAP_CHUNK_DECOMPRESSOR_H_
 
 // The records of an MCAP chunk, decompressed: compression "" (stored), "lz4"
-// (one LZ4 frame, liblz4) or "zstd" (one zstd frame, libzstd). The result
-// must be exactly the chunk's uncompressed_size, and match its
-// uncompressed_crc when that is not 0. Errors say what differed (the caller
+// (one LZ4 frame, liblz4; its own content checksum is skipped) or "zstd" (one
+// zstd frame, libzstd). The result must be exactly the chunk's
+// uncompressed_size, and match its uncompressed_crc when that is not 0. Errors say what differed (the caller
 // adds file and chunk offset).
 
 #include <cstddef>

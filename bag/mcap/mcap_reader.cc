@@ -152,11 +152,15 @@ Status McapReader::ReadSummary(bool* usable) {
     }
     offset += kRecordPrefixBytes + content.size();
   }
-  // Without chunk indexes, or with chunks whose message indexes are not
-  // listed, the data section must be scanned.
+  // Without chunk indexes, with chunks whose message indexes are not
+  // listed, or with channels the summary does not describe, the data
+  // section must be scanned.
   if (chunk_indexes.empty()) return Status::Ok();
   for (const ChunkIndexRecord& index : chunk_indexes) {
     if (index.message_index_offsets.empty()) return Status::Ok();
+    for (const auto& [channel, offset] : index.message_index_offsets) {
+      if (channel >= channels_.size() || channels_[channel] == nullptr) return Status::Ok();
+    }
   }
   std::sort(chunk_indexes.begin(), chunk_indexes.end(),
             [](const ChunkIndexRecord& a, const ChunkIndexRecord& b) {

@@ -33,6 +33,7 @@
 import fs from "node:fs";
 import path from "node:path";
 import { open } from "node:fs/promises";
+import readline from "node:readline";
 
 import Database from "better-sqlite3";
 import { CdrWriter, EncapsulationKind } from "@foxglove/cdr";
@@ -194,18 +195,19 @@ function deterministicMessages() {
     .map(([m]) => m);
 }
 
-function messagesFromJsonl(file) {
-  const out = [];
-  for (const line of fs.readFileSync(file, "utf8").split("\n")) {
+// The messages of a JSON-lines file, one at a time (the file may be larger
+// than memory).
+async function* messagesFromJsonl(file) {
+  const lines = readline.createInterface({ input: fs.createReadStream(file), crlfDelay: Infinity });
+  for await (const line of lines) {
     if (line.trim() === "") continue;
     const j = JSON.parse(line);
     if (j.msg.data_b64 !== undefined) {
       j.msg.data = new Uint8Array(Buffer.from(j.msg.data_b64, "base64"));
       delete j.msg.data_b64;
     }
-    out.push({ topic: j.topic, type: j.type, recordNs: BigInt(j.record_ns), msg: j.msg });
+    yield { topic: j.topic, type: j.type, recordNs: BigInt(j.record_ns), msg: j.msg };
   }
-  return out;
 }
 
 // Big-endian CDR with the CdrWriter; alignment is the library's.
@@ -265,7 +267,7 @@ function expectedLine(m) {
   return `string ${m.topic} ${m.recordNs} ${m.msg.data}`;
 }
 
-async function writeMcap(args, messages, serialize) {
+async function writeMcap(args, messages, serialize, onMessage) {
   let compressChunk;
   if (args.compression === "lz4") {
     compressChunk = (data) => ({ compression: "lz4", compressedData: lz4.compress(data) });
@@ -285,7 +287,8 @@ async function writeMcap(args, messages, serialize) {
   await writer.start({ profile: "ros2", library: "tiltcal tests/oracle/write_ros2_bags.mjs" });
   const channels = new Map();
   const sequences = new Map();
-  for (const m of messages) {
+  for await (const m of messages) {
+    onMessage(m);
     if (!channels.has(m.topic)) {
       const schemaId = await writer.registerSchema({
         name: m.type, encoding: "ros2msg", data: new TextEncoder().encode(DEFINITIONS[m.type]) });
@@ -306,19 +309,13 @@ const QOS = "- history: 3\n  depth: 0\n  reliability: 1\n  durability: 2\n  dead
   "    nsec: 0\n  lifespan:\n    sec: 0\n    nsec: 0\n  liveliness: 1\n  liveliness_lease_duration:\n" +
   "    sec: 0\n    nsec: 0\n  avoid_ros_namespace_conventions: false";
 
-function writeSqlite(args, messages, serialize) {
-  fs.rmSync(args.out, { recursive: true, force: true });
-  fs.mkdirSync(args.out, { recursive: true });
-  const base = path.basename(args.out);
-  const topics = [];  // in order of first message
-  for (const m of messages) if (!topics.some((t) => t.name === m.topic)) topics.push({ name: m.topic, type: m.type, count: 0 });
-  const perFile = args.split > 0 ? args.split : messages.length;
-  const files = [];
-  for (let start = 0, k = 0; start < messages.length || k === 0; start += perFile, ++k) {
-    const name = `${base}_${k}.db3`;
-    files.push(name);
-    const db = new Database(path.join(args.out, name));
-    db.exec("CREATE TABLE schema(schema_version INTEGER PRIMARY KEY, ros_distro TEXT NOT NULL);" +
+// One .db3 of a rosbag2 folder: the rosbag2 schema, topics added as their
+// first message comes, ids counted down from 100 so that they do not line up
+// with the order of the names.
+class Db3File {
+  constructor(file) {
+    this.db = new Database(file);
+    this.db.exec("CREATE TABLE schema(schema_version INTEGER PRIMARY KEY, ros_distro TEXT NOT NULL);" +
       "INSERT INTO schema VALUES (3, 'humble');" +
       "CREATE TABLE metadata(id INTEGER PRIMARY KEY, metadata_version INTEGER NOT NULL, metadata TEXT NOT NULL);" +
       "CREATE TABLE topics(id INTEGER PRIMARY KEY, name TEXT NOT NULL, type TEXT NOT NULL, " +
@@ -326,28 +323,57 @@ function writeSqlite(args, messages, serialize) {
       "CREATE TABLE messages(id INTEGER PRIMARY KEY, topic_id INTEGER NOT NULL, " +
       "timestamp INTEGER NOT NULL, data BLOB NOT NULL);" +
       "CREATE INDEX timestamp_idx ON messages (timestamp ASC);");
-    // Topic ids in reverse order of first appearance, so that ids and names do not line up.
-    const insertTopic = db.prepare("INSERT INTO topics VALUES (?, ?, ?, 'cdr', ?)");
-    topics.forEach((t, i) => insertTopic.run(topics.length - i, t.name, t.type, QOS));
-    const insert = db.prepare("INSERT INTO messages(topic_id, timestamp, data) VALUES (?, ?, ?)");
-    db.transaction(() => {
-      for (const m of messages.slice(start, start + perFile)) {
-        const id = topics.length - topics.findIndex((t) => t.name === m.topic);
-        topics.find((t) => t.name === m.topic).count++;
-        insert.run(id, m.recordNs, Buffer.from(serialize(m.type, m.msg)));
-      }
-    })();
-    db.close();
-    if (messages.length === 0) break;
+    this.insertTopic = this.db.prepare("INSERT INTO topics VALUES (?, ?, ?, 'cdr', ?)");
+    this.insertMessage = this.db.prepare("INSERT INTO messages(topic_id, timestamp, data) VALUES (?, ?, ?)");
+    this.ids = new Map();
+    this.db.exec("BEGIN");
   }
-  const first = messages.length ? messages[0].recordNs : 0n;
-  const last = messages.length ? messages[messages.length - 1].recordNs : 0n;
+  add(m, data) {
+    if (!this.ids.has(m.topic)) {
+      this.ids.set(m.topic, 100 - this.ids.size);
+      this.insertTopic.run(this.ids.get(m.topic), m.topic, m.type, QOS);
+    }
+    this.insertMessage.run(this.ids.get(m.topic), m.recordNs, Buffer.from(data));
+  }
+  close() {
+    this.db.exec("COMMIT");
+    this.db.close();
+  }
+}
+
+async function writeSqlite(args, messages, serialize, onMessage) {
+  fs.rmSync(args.out, { recursive: true, force: true });
+  fs.mkdirSync(args.out, { recursive: true });
+  const base = path.basename(args.out);
+  const topics = new Map();  // name -> {type, count}, in order of first message
+  const files = [];
+  let db = null;
+  let inFile = 0;
+  let count = 0;
+  let first = 0n;
+  let last = 0n;
+  for await (const m of messages) {
+    onMessage(m);
+    if (db === null || (args.split > 0 && inFile === args.split)) {
+      if (db !== null) db.close();
+      files.push(`${base}_${files.length}.db3`);
+      db = new Db3File(path.join(args.out, files[files.length - 1]));
+      inFile = 0;
+    }
+    db.add(m, serialize(m.type, m.msg));
+    ++inFile;
+    if (count++ === 0) first = m.recordNs;
+    last = m.recordNs;
+    if (!topics.has(m.topic)) topics.set(m.topic, { type: m.type, count: 0 });
+    topics.get(m.topic).count++;
+  }
+  if (db !== null) db.close();
   const yaml = ["rosbag2_bagfile_information:", "  version: 5", "  storage_identifier: sqlite3",
     "  relative_file_paths:", ...files.map((f) => `    - ${f}`),
     "  duration:", `    nanoseconds: ${last - first}`,
     "  starting_time:", `    nanoseconds_since_epoch: ${first}`,
-    `  message_count: ${messages.length}`, "  topics_with_message_count:",
-    ...topics.flatMap((t) => ["    - topic_metadata:", `        name: ${t.name}`,
+    `  message_count: ${count}`, "  topics_with_message_count:",
+    ...[...topics].flatMap(([name, t]) => ["    - topic_metadata:", `        name: ${name}`,
       `        type: ${t.type}`, "        serialization_format: cdr",
       `        offered_qos_profiles: ${JSON.stringify(QOS)}`, `      message_count: ${t.count}`]),
     '  compression_format: ""', '  compression_mode: ""', ""];
@@ -358,11 +384,11 @@ async function main() {
   const args = parseArgs(process.argv.slice(2));
   const messages = args.messages ? messagesFromJsonl(args.messages) : deterministicMessages();
   const serialize = makeSerializer(args.bigEndian);
-  if (args.format === "mcap") await writeMcap(args, messages, serialize);
-  else writeSqlite(args, messages, serialize);
-  if (args.expected) {
-    fs.writeFileSync(args.expected, messages.map(expectedLine).join("\n") + "\n");
-  }
+  const expected = args.expected ? fs.openSync(args.expected, "w") : null;
+  const onMessage = (m) => { if (expected !== null) fs.writeSync(expected, expectedLine(m) + "\n"); };
+  if (args.format === "mcap") await writeMcap(args, messages, serialize, onMessage);
+  else await writeSqlite(args, messages, serialize, onMessage);
+  if (expected !== null) fs.closeSync(expected);
 }
 
 main().catch((e) => {
