@@ -1,13 +1,15 @@
 #!/usr/bin/env bash
-# Installs every build and test dependency of tiltcal from Debian packages.
-# Idempotent: does nothing when everything is present. Needs root (or sudo).
+# Installs every build and test dependency of tiltcal from Debian packages,
+# then the test oracles of tests/package.json (npm ci into tests/node_modules).
+# Idempotent: does nothing when everything is present. Needs root (or sudo)
+# for the Debian packages.
 set -euo pipefail
 
 PACKAGES=(
   build-essential cmake ninja-build pkg-config git
   libeigen3-dev libceres-dev libgoogle-glog-dev
   libpcl-dev libprotobuf-dev protobuf-compiler
-  liblz4-dev lz4 libbz2-dev libfmt-dev
+  liblz4-dev lz4 libbz2-dev libfmt-dev libsqlite3-dev libzstd-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   python3-rosbag python3-sensor-msgs python3-numpy python3-matplotlib python3-yaml
   chromium
@@ -18,14 +20,24 @@ for package in "${PACKAGES[@]}"; do
   dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed" ||
     missing+=("$package")
 done
-if [ ${#missing[@]} -eq 0 ]; then
-  exit 0
+if [ ${#missing[@]} -ne 0 ]; then
+  SUDO=""
+  if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+  echo "setup: installing ${#missing[@]} Debian packages: ${missing[*]}" >&2
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -qq
+  $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+  echo "setup: Debian packages done" >&2
 fi
 
-SUDO=""
-if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
-echo "setup: installing ${#missing[@]} Debian packages: ${missing[*]}" >&2
-export DEBIAN_FRONTEND=noninteractive
-$SUDO apt-get update -qq
-$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
-echo "setup: done" >&2
+# The npm packages of the ROS 2 test oracles (tests/oracle/write_ros2_bags.mjs),
+# pinned by tests/package-lock.json. npm ci only when the lock file changed
+# since the last install (npm records it as node_modules/.package-lock.json).
+TESTS_DIR="$(cd "$(dirname "${BASH_SOURCE[0]}")/../tests" && pwd)"
+if ! command -v npm >/dev/null; then
+  echo "setup: no npm (Node 20): the ROS 2 bag tests will be skipped" >&2
+elif [ ! -f "$TESTS_DIR/node_modules/.package-lock.json" ] ||
+   [ "$TESTS_DIR/package-lock.json" -nt "$TESTS_DIR/node_modules/.package-lock.json" ]; then
+  echo "setup: npm ci in $TESTS_DIR" >&2
+  (cd "$TESTS_DIR" && npm ci --no-audit --no-fund --loglevel=error)
+fi

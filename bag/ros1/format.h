@@ -23,6 +23,7 @@
 #include <utility>
 #include <vector>
 
+#include "bag/sensor_messages.h"
 #include "common/status.h"
 
 namespace tiltcal::ros1 {
@@ -73,14 +74,9 @@ inline void AppendU32Le(std::string* out, uint32_t value) { AppendLe(out, value)
 inline void AppendU64Le(std::string* out, uint64_t value) { AppendLe(out, value); }
 
 // ---- ROS time (u32 sec, u32 nsec) <-> int64 ns since epoch. ----
-struct RosTime {
-  uint32_t sec = 0;
-  uint32_t nsec = 0;
-};
-// sec * 1e9 + nsec. nsec >= 1e9 (not normalized) is accepted as it adds up.
-inline int64_t RosTimeToNs(RosTime t) {
-  return static_cast<int64_t>(t.sec) * 1000000000 + static_cast<int64_t>(t.nsec);
-}
+// RosTime and RosTimeToNs are shared with ROS 2 (bag/sensor_messages.h).
+using bag::RosTime;
+using bag::RosTimeToNs;
 // False when `ns` is negative or beyond u32 seconds.
 bool NsToRosTime(int64_t ns, RosTime* t);
 // Decodes / encodes the 8 bytes of a time value.

@@ -24,6 +24,7 @@
 #   --python_max_bytes N read_points on a prefix carrying N bytes of point
 #                        data only (default 0 = whole bag)
 #   --build_dir DIR      (default <repo>/build-bench)
+#   --ros2 0|1           the MCAP and sqlite3 rows (default 1)
 #   --clean              delete the generated bags at the end
 # Exit status is non-zero when a step fails; the table is still printed for
 # the steps that ran.
@@ -38,6 +39,7 @@ PYTHON_POINTS=both
 PYTHON_MAX_BYTES=0
 BUILD_DIR="$REPO/build-bench"
 CLEAN=0
+ROS2=1
 while [ $# -gt 0 ]; do
   case "$1" in
     --scratch) SCRATCH=$2; shift 2 ;;
@@ -47,6 +49,7 @@ while [ $# -gt 0 ]; do
     --python_points) PYTHON_POINTS=$2; shift 2 ;;
     --python_max_bytes) PYTHON_MAX_BYTES=$2; shift 2 ;;
     --build_dir) BUILD_DIR=$2; shift 2 ;;
+    --ros2) ROS2=$2; shift 2 ;;
     --clean) CLEAN=1; shift ;;
     -h|--help) sed -n '2,/^set -euo/p' "$0" | sed '$d'; exit 0 ;;
     *) echo "run_decode_bench: unknown argument $1" >&2; exit 2 ;;
@@ -200,6 +203,49 @@ for ((r = 1; r <= REPEATS && HAVE_DECODE; ++r)); do
   run_decode tiltcal_decode "$SMALL_BAG" "$r"
 done
 
+# ---- ROS 2 rows: the small bag as MCAP and as a rosbag2 .db3. ----
+# The same messages (python3-rosbag reads them, the npm libraries write
+# them), so the rows compare the formats; the converted files are reused
+# like the bags, with a copy of the bag's .meta.
+ros2_convert() {  # FORMAT OUT
+  if [ -e "$2" ] && [ -f "$2.meta" ]; then log "reusing $2"; return 0; fi
+  local jsonl="$WORK/$(basename "$SMALL_BAG" .bag).jsonl"
+  if [ ! -s "$jsonl" ]; then
+    log "converting $(basename "$SMALL_BAG") to ROS 2 messages"
+    "$DEBIAN_PYTHON" "$REPO/tests/oracle/ros1_bag_to_ros2_jsonl.py" "$SMALL_BAG" >"$jsonl.tmp" &&
+      mv "$jsonl.tmp" "$jsonl" || return 1
+  fi
+  log "writing $2"
+  if [ "$1" = mcap ]; then
+    node "$REPO/tests/oracle/write_ros2_bags.mjs" "$2" --format=mcap --compression=lz4 \
+      --messages="$jsonl" || return 1
+  else
+    node "$REPO/tests/oracle/write_ros2_bags.mjs" "$2.dir" --format=sqlite3 \
+      --messages="$jsonl" && mv "$2.dir/$(basename "$2").dir_0.db3" "$2" && rm -rf "$2.dir" ||
+      return 1
+  fi
+  cp "$SMALL_BAG.meta" "$2.meta"
+}
+if [ "$ROS2" = 1 ] && [ $HAVE_DECODE = 1 ]; then
+  if [ -f "$REPO/tests/node_modules/@mcap/core/package.json" ] && command -v node >/dev/null; then
+    small_base="$WORK/$(basename "$SMALL_BAG" .bag)"
+    for format in mcap db3; do
+      ros2_bag="$small_base.$format"
+      if ros2_convert "$format" "$ros2_bag"; then
+        warm "$ros2_bag"
+        for ((r = 1; r <= REPEATS; ++r)); do
+          log "run $r/$REPEATS on $(basename "$ros2_bag")"
+          run_decode "tiltcal_decode_$format" "$ros2_bag" "$r"
+        done
+      else
+        log "could not convert the bag to $format: no $format row"
+      fi
+    done
+  else
+    log "no tests/node_modules (scripts/setup.sh) or node: no MCAP / sqlite3 rows"
+  fi
+fi
+
 # ---- Table. ----
 echo
 echo "Decode benchmark, $(date -u '+%Y-%m-%d %H:%M UTC'), $(nproc) cores," \
@@ -259,6 +305,8 @@ status=0
 awk '$6 != 0 { bad = 1 } END { exit bad }' "$RESULTS" || status=1
 if [ $CLEAN = 1 ]; then
   rm -f "$BAG" "$BAG.meta" "$SMALL_BAG" "$SMALL_BAG.meta"
+  small_base="$WORK/$(basename "$SMALL_BAG" .bag)"
+  rm -f "$small_base".{mcap,db3}{,.meta} "$small_base.jsonl"
   log "removed the generated bags"
 fi
 exit $status

@@ -5,16 +5,17 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <memory>
 #include <vector>
 
 #include <fmt/format.h>
 
-#include "bag/ros1/bag_reader.h"
-#include "bag/ros1/messages.h"
+#include "bag/message_reader.h"
 #include "common/cli/command_line.h"
 #include "common/io/provenance.h"
 #include "common/io/rig.h"
 #include "stages/decode/async_record_writer.h"
+#include "stages/decode/bag_input.h"
 #include "stages/decode/clock_domains.h"
 #include "stages/decode/decode_params.h"
 #include "stages/decode/imu_units_resolution.h"
@@ -36,7 +37,7 @@ std::string Join(const std::vector<std::string>& items) {
 
 // Chooses the topic of message type `type`: the params' topic, else the
 // rig's, else the only topic of that type in the bag.
-Status ChooseTopic(const ros1::BagReader& reader, const std::string& type,
+Status ChooseTopic(const bag::MessageReader& reader, const std::string& type,
                    const std::string& params_topic, const std::string& rig_topic,
                    const char* params_field, std::string* topic) {
   const std::vector<std::string> candidates = reader.TopicsOfType(type);
@@ -66,7 +67,7 @@ Status ChooseTopic(const ros1::BagReader& reader, const std::string& type,
   }
   if (candidates.empty()) {
     return Status::Error(reader.path() + ": no " + type + " topic in the bag (topics: " +
-                         Join(reader.Topics()) + ")");
+                         Join(reader.TopicNames()) + ")");
   }
   if (candidates.size() > 1) {
     return Status::Error(reader.path() + ": several " + type + " topics: " +
@@ -175,9 +176,11 @@ Status CheckPaths(const DecodePaths& paths) {
 // Opens the bag and chooses its IMU and LiDAR topics (params, else rig, else
 // the only topic of the type).
 Status OpenBag(const DecodePaths& paths, const proto::DecodeParams& params, const proto::Rig& rig,
-               ros1::BagReader* reader, DecodeSummary* s) {
-  TILTCAL_RETURN_IF_ERROR(reader->Open(paths.bag));
-  s->bag_bytes = reader->file_size();
+               std::unique_ptr<bag::MessageReader>* input, DecodeSummary* s) {
+  TILTCAL_RETURN_IF_ERROR(decode::OpenBagInput(
+      paths.bag, std::max<uint32_t>(params.chunk_cache_size(), 1), input));
+  const bag::MessageReader* reader = input->get();
+  s->bag_bytes = reader->size_bytes();
   s->indexed = reader->indexed();
   s->salvaged_messages = reader->num_salvaged_messages();
   s->salvage_note = reader->salvage_note();
@@ -185,9 +188,10 @@ Status OpenBag(const DecodePaths& paths, const proto::DecodeParams& params, cons
     return Status::Error(paths.bag + ": the bag holds no messages" +
                          (s->salvage_note.empty() ? "" : " (" + s->salvage_note + ")"));
   }
-  TILTCAL_RETURN_IF_ERROR(ChooseTopic(*reader, ros1::kImuType, params.imu_topic(),
+  const decode::SensorTypes types = decode::SensorTypesOf(*reader);
+  TILTCAL_RETURN_IF_ERROR(ChooseTopic(*reader, types.imu, params.imu_topic(),
                                       rig.imu_topic(), "imu_topic", &s->imu_topic));
-  TILTCAL_RETURN_IF_ERROR(ChooseTopic(*reader, ros1::kPointCloud2Type, params.lidar_topic(),
+  TILTCAL_RETURN_IF_ERROR(ChooseTopic(*reader, types.point_cloud2, params.lidar_topic(),
                                       rig.lidar_topic(), "lidar_topic", &s->lidar_topic));
   if (s->imu_topic == s->lidar_topic) {
     return Status::Error(paths.bag + ": imu and lidar topic are the same: " + s->imu_topic);
@@ -197,10 +201,9 @@ Status OpenBag(const DecodePaths& paths, const proto::DecodeParams& params, cons
 
 // The two topics inside the time window of the params, on record time,
 // relative to the bag's first message.
-Status MakeReadOptions(const ros1::BagReader& reader, const proto::DecodeParams& params,
-                       const DecodeSummary& s, ros1::ReadOptions* options) {
+Status MakeReadOptions(const bag::MessageReader& reader, const proto::DecodeParams& params,
+                       const DecodeSummary& s, bag::MessageSelection* options) {
   options->topics = {s.imu_topic, s.lidar_topic};
-  options->chunk_cache_size = std::max<uint32_t>(params.chunk_cache_size(), 1);
   int64_t bag_start_ns = 0;
   int64_t bag_end_ns = 0;
   (void)reader.TimeRange(&bag_start_ns, &bag_end_ns);
@@ -263,9 +266,10 @@ Status Decode(const DecodePaths& paths, const proto::DecodeParams& params, std::
       paths.params.empty() ? "decode params" : paths.params));
   proto::Rig rig;
   if (!paths.rig.empty()) TILTCAL_RETURN_IF_ERROR(LoadRig(paths.rig, &rig));
-  ros1::BagReader reader;
-  TILTCAL_RETURN_IF_ERROR(OpenBag(paths, params, rig, &reader, &s));
-  ros1::ReadOptions options;
+  std::unique_ptr<bag::MessageReader> input;
+  TILTCAL_RETURN_IF_ERROR(OpenBag(paths, params, rig, &input, &s));
+  bag::MessageReader& reader = *input;
+  bag::MessageSelection options;
   TILTCAL_RETURN_IF_ERROR(MakeReadOptions(reader, params, s, &options));
 
   std::vector<InputPath> input_paths = {{"bag", paths.bag}};
@@ -284,9 +288,9 @@ Status Decode(const DecodePaths& paths, const proto::DecodeParams& params, std::
     ProgressLine progress(log, reader.MessageCount(s.imu_topic) +
                                    reader.MessageCount(s.lidar_topic));
     TILTCAL_RETURN_IF_ERROR(
-        reader.ReadMessages(options, [&](const ros1::MessageView& m) -> Status {
+        reader.ReadMessages(options, [&](const bag::Message& m) -> Status {
           progress.Update(m.sequence);
-          return m.connection->topic == s.imu_topic ? imu.Add(m, &s) : scans.Add(m, &s);
+          return *m.topic == s.imu_topic ? imu.Add(m, &s) : scans.Add(m, &s);
         }));
   }
   TILTCAL_RETURN_IF_ERROR(CheckSomethingWritten(paths.bag, imu, s));
@@ -300,7 +304,7 @@ Status Decode(const DecodePaths& paths, const proto::DecodeParams& params, std::
     std::remove(paths.out_imu.c_str());  // both outputs or none
     return status;
   }
-  s.chunks_decompressed = reader.stats().chunks_decompressed;
+  s.chunks_decompressed = reader.chunks_decompressed();
   s.wall_s = std::chrono::duration<double>(Clock::now() - t0).count();
   PrintSummary(log, paths, params.lidar_stamp_shift_s(), s);
   if (summary != nullptr) *summary = s;

@@ -5,6 +5,8 @@
 
 #include <fmt/format.h>
 
+#include "bag/ros1/messages.h"
+#include "bag/ros2/messages.h"
 #include "common/io/record_stream.h"
 #include "tiltcal/proto/imu.pb.h"
 
@@ -13,10 +15,27 @@ namespace tiltcal {
 namespace {
 
 // Where a message came from, for its errors.
-std::string MessageContext(const std::string& bag, const ros1::MessageView& m, int64_t index) {
-  return bag + ": topic '" + m.connection->topic + "' message " + std::to_string(index) +
-         " (record time " + FormatSeconds(m.time_ns) + " s, chunk at byte " +
-         std::to_string(m.chunk_pos) + ")";
+std::string MessageContext(const std::string& bag, const bag::Message& m, int64_t index) {
+  return bag + ": topic '" + *m.topic + "' message " + std::to_string(index) +
+         " (record time " + FormatSeconds(m.time_ns) + " s, " + bag::DescribePosition(m) + ")";
+}
+
+// The message's type name in its own format, for errors.
+const char* ImuTypeName(const bag::Message& m) {
+  return m.encoding == bag::Encoding::kCdr ? ros2::kImuType : ros1::kImuType;
+}
+const char* PointCloud2TypeName(const bag::Message& m) {
+  return m.encoding == bag::Encoding::kCdr ? ros2::kPointCloud2Type : ros1::kPointCloud2Type;
+}
+
+Status DecodeImu(const bag::Message& m, bag::ImuMessage* imu) {
+  return m.encoding == bag::Encoding::kCdr ? ros2::DecodeImu(m.data, m.size, imu)
+                                           : ros1::DecodeImu(m.data, m.size, imu);
+}
+
+Status DecodePointCloud2(const bag::Message& m, bag::PointCloud2View* cloud) {
+  return m.encoding == bag::Encoding::kCdr ? ros2::DecodePointCloud2(m.data, m.size, cloud)
+                                           : ros1::DecodePointCloud2(m.data, m.size, cloud);
 }
 
 // The median of `values` (the upper one of an even count); 0 when empty.
@@ -39,22 +58,21 @@ ImuSink::ImuSink(const std::string& bag, int64_t expected_messages) : bag_(bag) 
   samples_.reserve(static_cast<size_t>(std::max<int64_t>(expected_messages, 0)));
 }
 
-Status ImuSink::Add(const ros1::MessageView& m, DecodeSummary* s) {
+Status ImuSink::Add(const bag::Message& m, DecodeSummary* s) {
   const int64_t index = s->imu_messages++;
-  Status status = ros1::DecodeImu(m.data, m.size, &message_);
+  Status status = DecodeImu(m, &message_);
   if (!status.ok()) {
-    return status.WithContext(MessageContext(bag_, m, index) + ": sensor_msgs/Imu");
+    return status.WithContext(MessageContext(bag_, m, index) + ": " + ImuTypeName(m));
   }
   Record r;
-  r.stamp_ns = ros1::RosTimeToNs(message_.header.stamp);
+  r.stamp_ns = bag::RosTimeToNs(message_.header.stamp);
   r.record_ns = m.time_ns;
   for (int i = 0; i < 3; ++i) {
     r.angular_velocity[i] = message_.angular_velocity[i];
     r.linear_acceleration[i] = message_.linear_acceleration[i];
     if (!std::isfinite(r.angular_velocity[i]) || !std::isfinite(r.linear_acceleration[i])) {
-      return Status::Error(MessageContext(bag_, m, index) +
-                           ": sensor_msgs/Imu has a NaN or Inf angular velocity or linear "
-                           "acceleration");
+      return Status::Error(MessageContext(bag_, m, index) + ": " + ImuTypeName(m) +
+                           " has a NaN or Inf angular velocity or linear acceleration");
     }
   }
   samples_.push_back(r);
@@ -159,7 +177,7 @@ decode::StampSpan ScanSink::Span(const DecodeSummary& s) const {
   return span;
 }
 
-Status ScanSink::Add(const ros1::MessageView& m, DecodeSummary* s) {
+Status ScanSink::Add(const bag::Message& m, DecodeSummary* s) {
   const int64_t index = s->scan_messages++;
   auto* scan = static_cast<proto::Scan*>(writer_->Acquire());
   bool keep = false;
@@ -171,21 +189,21 @@ Status ScanSink::Add(const ros1::MessageView& m, DecodeSummary* s) {
   return writer_->Submit(scan);
 }
 
-Status ScanSink::Convert(const ros1::MessageView& m, int64_t index, proto::Scan* scan,
+Status ScanSink::Convert(const bag::Message& m, int64_t index, proto::Scan* scan,
                          bool* keep, DecodeSummary* s) {
   *keep = false;
-  Status status = ros1::DecodePointCloud2(m.data, m.size, &cloud_);
+  Status status = DecodePointCloud2(m, &cloud_);
   if (status.ok()) status = ConvertPointCloud2ToScan(cloud_, conversion_, scan);
   if (!status.ok()) {
-    return status.WithContext(MessageContext(bag_, m, index) + ": sensor_msgs/PointCloud2");
+    return status.WithContext(MessageContext(bag_, m, index) + ": " + PointCloud2TypeName(m));
   }
   scan->set_stamp_ns(scan->stamp_ns() + stamp_shift_ns_);
   s->points_dropped_invalid += scan->num_dropped_invalid();
   s->points_dropped_range += scan->num_dropped_zero_range();
   if (scan->time_source() == proto::POINT_TIME_NONE) {
     if (params_.require_point_time()) {
-      return Status::Error(MessageContext(bag_, m, index) +
-                           ": sensor_msgs/PointCloud2 has no per-point time field (fields: " +
+      return Status::Error(MessageContext(bag_, m, index) + ": " + PointCloud2TypeName(m) +
+                           " has no per-point time field (fields: " +
                            DescribeFields(cloud_) + ") and require_point_time is set");
     }
     ++s->scans_without_point_time;

@@ -2,7 +2,8 @@
 #define TILTCAL_STAGES_DECODE_MESSAGE_SINKS_H_
 
 // Where the decode stage puts the messages of its two topics, one message at
-// a time in record-time order: the IMU sink keeps the samples to sort them
+// a time in record-time order, decoded from the ROS 1 wire format or CDR as
+// the message says (bag::Message::encoding): the IMU sink keeps the samples to sort them
 // by stamp at the end, the scan sink converts each cloud and hands it to the
 // writer thread. Both count what they keep and drop in the DecodeSummary.
 
@@ -10,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "bag/ros1/bag_reader.h"
-#include "bag/ros1/messages.h"
+#include "bag/message_reader.h"
+#include "bag/sensor_messages.h"
 #include "common/imu/imu_reading.h"
 #include "common/status.h"
 #include "stages/decode/async_record_writer.h"
@@ -35,7 +36,7 @@ class ImuSink {
   ImuSink(const std::string& bag, int64_t expected_messages);
 
   // Decodes one message and keeps its sample. A NaN or Inf value is an error.
-  Status Add(const ros1::MessageView& m, DecodeSummary* s);
+  Status Add(const bag::Message& m, DecodeSummary* s);
 
   bool empty() const { return samples_.empty(); }
 
@@ -67,7 +68,7 @@ class ImuSink {
 
   std::string bag_;
   std::vector<Record> samples_;
-  ros1::ImuMessage message_;
+  bag::ImuMessage message_;
 };
 
 // The sensor_msgs/PointCloud2 messages: each converted to a Scan, its stamp
@@ -78,21 +79,21 @@ class ScanSink {
  public:
   ScanSink(const std::string& bag, const proto::DecodeParams& params, AsyncRecordWriter* writer);
 
-  Status Add(const ros1::MessageView& m, DecodeSummary* s);
+  Status Add(const bag::Message& m, DecodeSummary* s);
 
   // The (shifted) stamp span of the scans written so far.
   decode::StampSpan Span(const DecodeSummary& s) const;
 
  private:
   // Converts the message into *scan; *keep says whether it is written.
-  Status Convert(const ros1::MessageView& m, int64_t index, proto::Scan* scan, bool* keep,
+  Status Convert(const bag::Message& m, int64_t index, proto::Scan* scan, bool* keep,
                  DecodeSummary* s);
 
   std::string bag_;
   const proto::DecodeParams& params_;
   AsyncRecordWriter* writer_;
   PointConversionOptions conversion_;
-  ros1::PointCloud2View cloud_;
+  bag::PointCloud2View cloud_;
   int64_t stamp_shift_ns_ = 0;
   int64_t last_stamp_ns_ = INT64_MIN;
   std::vector<int64_t> record_delays_ns_;  // record time − shifted stamp, per written scan

@@ -164,4 +164,18 @@ echo "ok: a SUSPECT calibration fails its sequence, is kept aside and rerun"
 
 "${MAKE[@]}" clean > /dev/null
 [ ! -e "$DATA/out" ] || fail "clean left out/"
+
+# ROS 2 sequences: an MCAP file and a rosbag2 folder are sequences beside the
+# ROS 1 bags; decode gets the file or the folder, and a changed .db3 of a
+# folder reruns that sequence only.
+touch "$DATA/seq_c.mcap"
+mkdir -p "$DATA/seq_d"
+touch "$DATA/seq_d/metadata.yaml" "$DATA/seq_d/seq_d_0.db3" "$DATA/seq_d/seq_d_1.db3"
+expect "MCAP files and ROS 2 bag folders are sequences" "$(planned decode)" \
+"tiltcal_decode seq_a;tiltcal_decode seq_b;tiltcal_decode seq_c;tiltcal_decode seq_d;"
+"${MAKE[@]}" -n decode | grep -q -- "--bag=$DATA/seq_c.mcap " || fail "decode not given seq_c.mcap"
+"${MAKE[@]}" -n decode | grep -q -- "--bag=$DATA/seq_d " || fail "decode not given the folder seq_d"
+"${MAKE[@]}" decode > /dev/null
+sleep_past; touch "$DATA/seq_d/seq_d_1.db3"
+expect "a changed .db3 reruns its folder's sequence only" "$(planned decode)" "tiltcal_decode seq_d;"
 echo "PASS"

@@ -1,0 +1,96 @@
+#include "bag/mcap/chunk_decompressor.h"
+
+#include <lz4frame.h>
+#include <zstd.h>
+
+#include <cstring>
+
+namespace tiltcal::mcap {
+
+namespace {
+
+// No chunk of a sane recording is this large; refuse before allocating.
+constexpr uint64_t kMaxChunkBytes = uint64_t{4} << 30;
+
+}  // namespace
+
+ChunkDecompressor::ChunkDecompressor() = default;
+
+ChunkDecompressor::~ChunkDecompressor() {
+  if (lz4_ != nullptr) LZ4F_freeDecompressionContext(lz4_);
+  if (zstd_ != nullptr) ZSTD_freeDCtx(zstd_);
+}
+
+Status ChunkDecompressor::Decompress(const ChunkRecord& chunk, std::vector<uint8_t>* out) {
+  if (chunk.uncompressed_size > kMaxChunkBytes) {
+    return Status::Error("chunk uncompressed_size " + std::to_string(chunk.uncompressed_size) +
+                         " bytes is beyond 4 GiB");
+  }
+  if (chunk.compression != "" && chunk.compression != "lz4" && chunk.compression != "zstd") {
+    return Status::Error("unknown chunk compression '" + chunk.compression +
+                         "' (known: none, lz4, zstd)");
+  }
+  out->resize(chunk.uncompressed_size);
+  if (chunk.compression.empty()) {
+    if (chunk.records_size != chunk.uncompressed_size) {
+      return Status::Error("uncompressed chunk of " + std::to_string(chunk.records_size) +
+                           " bytes says uncompressed_size " +
+                           std::to_string(chunk.uncompressed_size));
+    }
+    if (chunk.records_size > 0) std::memcpy(out->data(), chunk.records, chunk.records_size);
+  } else if (chunk.compression == "lz4") {
+    TILTCAL_RETURN_IF_ERROR(Lz4(chunk, out->data()));
+  } else {
+    TILTCAL_RETURN_IF_ERROR(Zstd(chunk, out->data()));
+  }
+  if (chunk.uncompressed_crc != 0) {
+    const uint32_t crc = Crc32(out->data(), out->size());
+    if (crc != chunk.uncompressed_crc) {
+      return Status::Error("chunk CRC mismatch (records have CRC-32 " + std::to_string(crc) +
+                           ", the chunk says " + std::to_string(chunk.uncompressed_crc) + ")");
+    }
+  }
+  return Status::Ok();
+}
+
+Status ChunkDecompressor::Lz4(const ChunkRecord& chunk, uint8_t* dst) {
+  if (lz4_ == nullptr) {
+    const size_t rc = LZ4F_createDecompressionContext(&lz4_, LZ4F_VERSION);
+    if (LZ4F_isError(rc)) return Status::Error("lz4: cannot create a decompression context");
+  }
+  LZ4F_resetDecompressionContext(lz4_);
+  size_t src_used = static_cast<size_t>(chunk.records_size);
+  size_t dst_used = static_cast<size_t>(chunk.uncompressed_size);
+  // The frame's own content checksum is not verified: the chunk's CRC-32 of
+  // the same bytes is (Decompress), and liblz4's XXH32 is slow here.
+  LZ4F_decompressOptions_t options = {};
+  options.skipChecksums = 1;
+  const size_t rc = LZ4F_decompress(lz4_, dst, &dst_used, chunk.records, &src_used, &options);
+  if (LZ4F_isError(rc)) {
+    return Status::Error(std::string("lz4 chunk does not decompress: ") + LZ4F_getErrorName(rc));
+  }
+  if (rc != 0 || dst_used != chunk.uncompressed_size || src_used != chunk.records_size) {
+    return Status::Error("lz4 chunk decompresses to " + std::to_string(dst_used) +
+                         " bytes from " + std::to_string(src_used) + " of " +
+                         std::to_string(chunk.records_size) + ", the chunk says " +
+                         std::to_string(chunk.uncompressed_size) + (rc != 0 ? " (frame incomplete)" : ""));
+  }
+  return Status::Ok();
+}
+
+Status ChunkDecompressor::Zstd(const ChunkRecord& chunk, uint8_t* dst) {
+  if (zstd_ == nullptr) zstd_ = ZSTD_createDCtx();
+  if (zstd_ == nullptr) return Status::Error("zstd: cannot create a decompression context");
+  const size_t n = ZSTD_decompressDCtx(zstd_, dst, chunk.uncompressed_size, chunk.records,
+                                       chunk.records_size);
+  if (ZSTD_isError(n)) {
+    return Status::Error(std::string("zstd chunk does not decompress: ") + ZSTD_getErrorName(n));
+  }
+  if (n != chunk.uncompressed_size) {
+    return Status::Error("zstd chunk decompresses to " + std::to_string(n) +
+                         " bytes, the chunk says " + std::to_string(chunk.uncompressed_size));
+  }
+  return Status::Ok();
+}
+
+}  // namespace tiltcal::mcap

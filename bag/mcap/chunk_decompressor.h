@@ -1,0 +1,43 @@
+#ifndef TILTCAL_BAG_MCAP_CHUNK_DECOMPRESSOR_H_
+#define TILTCAL_BAG_MCAP_CHUNK_DECOMPRESSOR_H_
+
+// The records of an MCAP chunk, decompressed: compression "" (stored), "lz4"
+// (one LZ4 frame, liblz4; its own content checksum is skipped) or "zstd" (one
+// zstd frame, libzstd). The result must be exactly the chunk's
+// uncompressed_size, and match its uncompressed_crc when that is not 0. Errors say what differed (the caller
+// adds file and chunk offset).
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "bag/mcap/format.h"
+#include "common/status.h"
+
+struct LZ4F_dctx_s;
+struct ZSTD_DCtx_s;
+
+namespace tiltcal::mcap {
+
+class ChunkDecompressor {
+ public:
+  ChunkDecompressor();
+  ~ChunkDecompressor();
+  ChunkDecompressor(const ChunkDecompressor&) = delete;
+  ChunkDecompressor& operator=(const ChunkDecompressor&) = delete;
+
+  // Decompresses the records of `chunk` into *out (resized).
+  Status Decompress(const ChunkRecord& chunk, std::vector<uint8_t>* out);
+
+ private:
+  Status Lz4(const ChunkRecord& chunk, uint8_t* dst);
+  Status Zstd(const ChunkRecord& chunk, uint8_t* dst);
+
+  LZ4F_dctx_s* lz4_ = nullptr;
+  ZSTD_DCtx_s* zstd_ = nullptr;
+};
+
+}  // namespace tiltcal::mcap
+
+#endif  // TILTCAL_BAG_MCAP_CHUNK_DECOMPRESSOR_H_

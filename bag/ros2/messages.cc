@@ -1,0 +1,67 @@
+#include "bag/ros2/messages.h"
+
+#include "bag/ros2/cdr_reader.h"
+
+namespace tiltcal::ros2 {
+
+namespace {
+
+Status ReadHeader(CdrReader* r, bag::Header* h) {
+  int32_t sec = 0;
+  TILTCAL_RETURN_IF_ERROR(r->I32("header.stamp.sec", &sec));
+  if (sec < 0) {
+    return Status::Error("header.stamp.sec is negative (" + std::to_string(sec) +
+                         "): a stamp before 1970");
+  }
+  h->seq = 0;
+  h->stamp.sec = static_cast<uint32_t>(sec);
+  TILTCAL_RETURN_IF_ERROR(r->U32("header.stamp.nanosec", &h->stamp.nsec));
+  return r->String("header.frame_id", &h->frame_id);
+}
+
+}  // namespace
+
+Status DecodeImu(const uint8_t* data, size_t size, bag::ImuMessage* imu) {
+  CdrReader r;
+  TILTCAL_RETURN_IF_ERROR(r.Open(data, size));
+  TILTCAL_RETURN_IF_ERROR(ReadHeader(&r, &imu->header));
+  TILTCAL_RETURN_IF_ERROR(r.F64s("orientation", imu->orientation, 4));
+  TILTCAL_RETURN_IF_ERROR(r.F64s("orientation_covariance", imu->orientation_covariance, 9));
+  TILTCAL_RETURN_IF_ERROR(r.F64s("angular_velocity", imu->angular_velocity, 3));
+  TILTCAL_RETURN_IF_ERROR(
+      r.F64s("angular_velocity_covariance", imu->angular_velocity_covariance, 9));
+  TILTCAL_RETURN_IF_ERROR(r.F64s("linear_acceleration", imu->linear_acceleration, 3));
+  TILTCAL_RETURN_IF_ERROR(
+      r.F64s("linear_acceleration_covariance", imu->linear_acceleration_covariance, 9));
+  return r.ExpectEnd(kImuType);
+}
+
+Status DecodePointCloud2(const uint8_t* data, size_t size, bag::PointCloud2View* cloud) {
+  CdrReader r;
+  TILTCAL_RETURN_IF_ERROR(r.Open(data, size));
+  TILTCAL_RETURN_IF_ERROR(ReadHeader(&r, &cloud->header));
+  TILTCAL_RETURN_IF_ERROR(r.U32("height", &cloud->height));
+  TILTCAL_RETURN_IF_ERROR(r.U32("width", &cloud->width));
+  uint32_t num_fields = 0;
+  TILTCAL_RETURN_IF_ERROR(r.U32("fields", &num_fields));
+  // Each PointField takes at least 13 bytes; refuse absurd counts before resizing.
+  if (num_fields > size / 13) {
+    return Status::Error("message runs past its end: " + std::to_string(num_fields) +
+                         " point fields cannot fit in " + std::to_string(size) + " bytes");
+  }
+  cloud->fields.resize(num_fields);
+  for (bag::PointField& field : cloud->fields) {
+    TILTCAL_RETURN_IF_ERROR(r.String("fields.name", &field.name));
+    TILTCAL_RETURN_IF_ERROR(r.U32("fields.offset", &field.offset));
+    TILTCAL_RETURN_IF_ERROR(r.U8("fields.datatype", &field.datatype));
+    TILTCAL_RETURN_IF_ERROR(r.U32("fields.count", &field.count));
+  }
+  TILTCAL_RETURN_IF_ERROR(r.Bool("is_bigendian", &cloud->is_bigendian));
+  TILTCAL_RETURN_IF_ERROR(r.U32("point_step", &cloud->point_step));
+  TILTCAL_RETURN_IF_ERROR(r.U32("row_step", &cloud->row_step));
+  TILTCAL_RETURN_IF_ERROR(r.ByteSequence("data", &cloud->data, &cloud->data_size));
+  TILTCAL_RETURN_IF_ERROR(r.Bool("is_dense", &cloud->is_dense));
+  return r.ExpectEnd(kPointCloud2Type);
+}
+
+}  // namespace tiltcal::ros2

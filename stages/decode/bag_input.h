@@ -1,0 +1,35 @@
+#ifndef TILTCAL_STAGES_DECODE_BAG_INPUT_H_
+#define TILTCAL_STAGES_DECODE_BAG_INPUT_H_
+
+// Decode's input, chosen by its shape:
+//   a file starting with the MCAP magic      MCAP (bag/mcap/), ROS 2 cdr or ROS 1
+//   a file starting with "SQLite format 3"   one rosbag2 sqlite3 .db3 (bag/ros2/)
+//   any other file                           ROS 1 bag (bag/ros1/), as before
+//   a folder with metadata.yaml              a rosbag2 bag: its .db3 files
+//                                            (storage sqlite3), or its .mcap
+//                                            file (storage mcap)
+// A folder without metadata.yaml is an error naming it and the shapes.
+
+#include <memory>
+#include <string>
+
+#include "bag/message_reader.h"
+#include "common/status.h"
+
+namespace tiltcal::decode {
+
+// The type names decode reads, in the naming of the input's format.
+struct SensorTypes {
+  const char* imu;
+  const char* point_cloud2;
+};
+SensorTypes SensorTypesOf(const bag::MessageReader& reader);
+
+// Opens `path` with the reader of its shape. `chunk_cache_size`: the
+// decompressed chunks the ROS 1 reader keeps.
+Status OpenBagInput(const std::string& path, size_t chunk_cache_size,
+                    std::unique_ptr<bag::MessageReader>* reader);
+
+}  // namespace tiltcal::decode
+
+#endif  // TILTCAL_STAGES_DECODE_BAG_INPUT_H_

@@ -1,0 +1,65 @@
+#!/usr/bin/python3
+"""Reads the sensor_msgs/Imu and sensor_msgs/PointCloud2 messages of a ROS1
+bag with the real ROS library (Debian python3-rosbag) and prints them as the
+JSON lines write_ros2_bags.mjs --messages= takes, in record order: the same
+values as ROS 2 messages (std_msgs/Header without seq, stamp as
+{sec, nanosec}, the cloud's data in base64). Other topics are left out.
+
+Usage: /usr/bin/python3 ros1_bag_to_ros2_jsonl.py BAG > messages.jsonl
+"""
+
+import base64
+import json
+import sys
+
+import rosbag
+
+
+def header(h):
+    return {"stamp": {"sec": h.stamp.secs, "nanosec": h.stamp.nsecs}, "frame_id": h.frame_id}
+
+
+def vector(v):
+    return {"x": v.x, "y": v.y, "z": v.z}
+
+
+def main():
+    out = sys.stdout
+    with rosbag.Bag(sys.argv[1]) as bag:
+        for topic, msg, t in bag.read_messages():
+            record_ns = str(t.secs * 1000000000 + t.nsecs)
+            if msg._type == "sensor_msgs/Imu":
+                o = msg.orientation
+                ros2 = {
+                    "header": header(msg.header),
+                    "orientation": {"x": o.x, "y": o.y, "z": o.z, "w": o.w},
+                    "orientation_covariance": list(msg.orientation_covariance),
+                    "angular_velocity": vector(msg.angular_velocity),
+                    "angular_velocity_covariance": list(msg.angular_velocity_covariance),
+                    "linear_acceleration": vector(msg.linear_acceleration),
+                    "linear_acceleration_covariance": list(msg.linear_acceleration_covariance),
+                }
+                kind = "sensor_msgs/msg/Imu"
+            elif msg._type == "sensor_msgs/PointCloud2":
+                ros2 = {
+                    "header": header(msg.header),
+                    "height": msg.height,
+                    "width": msg.width,
+                    "fields": [{"name": f.name, "offset": f.offset, "datatype": f.datatype,
+                                "count": f.count} for f in msg.fields],
+                    "is_bigendian": bool(msg.is_bigendian),
+                    "point_step": msg.point_step,
+                    "row_step": msg.row_step,
+                    "data_b64": base64.b64encode(msg.data).decode("ascii"),
+                    "is_dense": bool(msg.is_dense),
+                }
+                kind = "sensor_msgs/msg/PointCloud2"
+            else:
+                continue
+            # repr() of a float round-trips; json.dumps uses it.
+            out.write(json.dumps({"topic": topic, "type": kind, "record_ns": record_ns,
+                                  "msg": ros2}) + "\n")
+
+
+if __name__ == "__main__":
+    main()
