@@ -31,27 +31,34 @@ Status CheckUnits(const proto::Rig& rig) {
 
 }  // namespace
 
-Status ValidateRig(proto::Rig* rig) {
-  if (!rig->has_imu_from_lidar() || !rig->imu_from_lidar().has_rotation()) {
-    return Status::Error("imu_from_lidar.rotation is missing (the measured extrinsic C_bl)");
+Status ValidateImuFromLidar(bool present, proto::Rigid3* imu_from_lidar,
+                            const std::string& field) {
+  if (!present || !imu_from_lidar->has_rotation()) {
+    return Status::Error(field + ".rotation is missing (the extrinsic C_bl)");
   }
-  proto::Quaternion* q = rig->mutable_imu_from_lidar()->mutable_rotation();
+  proto::Quaternion* q = imu_from_lidar->mutable_rotation();
   const double norm = std::sqrt(q->w() * q->w() + q->x() * q->x() + q->y() * q->y() +
                                 q->z() * q->z());
-  if (!std::isfinite(norm)) return Status::Error("imu_from_lidar.rotation is not finite");
+  if (!std::isfinite(norm)) return Status::Error(field + ".rotation is not finite");
   if (std::fabs(norm - 1.0) > kRigQuaternionNormTolerance) {
     return Status::Error(fmt::format(
-        "imu_from_lidar.rotation is not a unit quaternion (norm {:.6g}; w x y z, Hamilton)", norm));
+        "{}.rotation is not a unit quaternion (norm {:.6g}; w x y z, Hamilton)", field, norm));
   }
   *q = ToProto(ToEigen(*q));
-  const proto::Vector3& translation = rig->imu_from_lidar().translation();
-  if (!IsFinite(translation)) return Status::Error("imu_from_lidar.translation is not finite");
+  const proto::Vector3& translation = imu_from_lidar->translation();
+  if (!IsFinite(translation)) return Status::Error(field + ".translation is not finite");
   const double distance = ToEigen(translation).norm();
   if (distance > kRigMaxTranslationM) {
     return Status::Error(fmt::format(
-        "imu_from_lidar.translation is {:.3g} m long, more than {} m (metres, IMU frame)",
-        distance, kRigMaxTranslationM));
+        "{}.translation is {:.3g} m long, more than {} m (metres, IMU frame)", field, distance,
+        kRigMaxTranslationM));
   }
+  return Status::Ok();
+}
+
+Status ValidateRig(proto::Rig* rig) {
+  TILTCAL_RETURN_IF_ERROR(ValidateImuFromLidar(rig->has_imu_from_lidar(),
+                                               rig->mutable_imu_from_lidar(), "imu_from_lidar"));
   if (!std::isfinite(rig->imu_height_m()) || rig->imu_height_m() < 0 ||
       rig->imu_height_m() > kRigMaxImuHeightM) {
     return Status::Error(fmt::format("imu_height_m = {} is outside [0, {}] m (0 = unknown)",
