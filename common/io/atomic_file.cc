@@ -186,7 +186,19 @@ Status WriteFileAtomically(const std::string& path, const std::string& contents)
   return file.Commit();
 }
 
+// An error unless `path` is a regular file (after symlinks): a directory
+// opens as an empty stream, and a device may never end.
+Status CheckRegularFile(const std::string& path) {
+  std::error_code error;
+  const fs::file_status status = fs::status(path, error);
+  if (!fs::exists(status)) return Status::Error(path + ": cannot open: No such file or directory");
+  if (fs::is_directory(status)) return Status::Error(path + ": is a directory, not a file");
+  if (!fs::is_regular_file(status)) return Status::Error(path + ": not a regular file");
+  return Status::Ok();
+}
+
 Status ReadFileToString(const std::string& path, std::string* contents) {
+  TILTCAL_RETURN_IF_ERROR(CheckRegularFile(path));
   std::ifstream in(path, std::ios::binary);
   if (!in) return Status::Error(path + ": cannot open: " + ErrnoText());
   std::ostringstream buffer;
@@ -197,6 +209,7 @@ Status ReadFileToString(const std::string& path, std::string* contents) {
 }
 
 Status ReadFileHead(const std::string& path, size_t max_bytes, std::string* contents) {
+  TILTCAL_RETURN_IF_ERROR(CheckRegularFile(path));
   std::ifstream in(path, std::ios::binary);
   if (!in) return Status::Error(path + ": cannot open: " + ErrnoText());
   contents->assign(max_bytes, '\0');

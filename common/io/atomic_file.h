@@ -68,10 +68,11 @@ Status CheckOutputPath(const std::string& path);
 // Writes `contents` to `path` atomically.
 Status WriteFileAtomically(const std::string& path, const std::string& contents);
 
-// Reads a whole file.
+// Reads a whole file. A path that is not a regular file (a directory, a
+// device) is an error naming it.
 Status ReadFileToString(const std::string& path, std::string* contents);
 
-// Reads at most the first `max_bytes` bytes of a file.
+// Reads at most the first `max_bytes` bytes of a regular file.
 Status ReadFileHead(const std::string& path, size_t max_bytes, std::string* contents);
 
 }  // namespace tiltcal

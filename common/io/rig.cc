@@ -64,18 +64,20 @@ Status ValidateRig(proto::Rig* rig) {
     return Status::Error(fmt::format("imu_height_m = {} is outside [0, {}] m (0 = unknown)",
                                      rig->imu_height_m(), kRigMaxImuHeightM));
   }
-  if (rig->has_gravity_flat_in_imu()) {
-    if (!IsFinite(rig->gravity_flat_in_imu())) {
-      return Status::Error("gravity_flat_in_imu is not finite");
-    }
-    const double g = ToEigen(rig->gravity_flat_in_imu()).norm();
-    if (g != 0.0 && (g < kRigMinGravityMps2 || g > kRigMaxGravityMps2)) {
-      return Status::Error(fmt::format(
-          "gravity_flat_in_imu has norm {:.4g}, not a gravity in m/s² (expected {} to {})", g,
-          kRigMinGravityMps2, kRigMaxGravityMps2));
-    }
+  if (rig->has_gravity_flat_in_imu() && ToEigen(rig->gravity_flat_in_imu()).norm() != 0.0) {
+    TILTCAL_RETURN_IF_ERROR(ValidateGravityFlat(rig->gravity_flat_in_imu(), "gravity_flat_in_imu"));
   }
   return CheckUnits(*rig);
+}
+
+Status ValidateGravityFlat(const proto::Vector3& gravity, const std::string& field) {
+  if (!IsFinite(gravity)) return Status::Error(field + " is not finite");
+  const double g = ToEigen(gravity).norm();
+  if (g < kRigMinGravityMps2 || g > kRigMaxGravityMps2) {
+    return Status::Error(fmt::format("{} has norm {:.4g}, not a gravity in m/s² (expected {} to {})",
+                                     field, g, kRigMinGravityMps2, kRigMaxGravityMps2));
+  }
+  return Status::Ok();
 }
 
 Status LoadRig(const std::string& path, proto::Rig* rig) {

@@ -25,6 +25,11 @@ inline constexpr double kRigMaxGravityMps2 = 11.0;
 Status ValidateImuFromLidar(bool present, proto::Rigid3* imu_from_lidar,
                             const std::string& field);
 
+// Checks a gravity read from a file (g_f in the IMU frame, m/s²): finite,
+// its norm within [kRigMinGravityMps2, kRigMaxGravityMps2]. The error names
+// `field`.
+Status ValidateGravityFlat(const proto::Vector3& gravity, const std::string& field);
+
 // Checks a rig (the dataset's rig.txtpb): imu_from_lidar present with a unit
 // quaternion (within kRigQuaternionNormTolerance; normalised in place),
 // every value finite, the translation, imu_height_m and gravity_flat_in_imu

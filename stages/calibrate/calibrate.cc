@@ -63,6 +63,11 @@ Status ReadCalibrateInputs(const CalibratePaths& paths, const proto::CalibratePa
   }
   if (!paths.gravity.empty()) {
     TILTCAL_RETURN_IF_ERROR(ReadTextProto(paths.gravity, &inputs->gravity));
+    if (inputs->gravity.has_gravity_flat()) {
+      TILTCAL_RETURN_IF_ERROR(
+          ValidateGravityFlat(inputs->gravity.gravity_flat_in_imu(), "gravity_flat_in_imu")
+              .WithContext(paths.gravity));
+    }
     inputs->has_gravity = true;
   }
   return Status::Ok();
