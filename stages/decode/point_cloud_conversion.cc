@@ -3,7 +3,10 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <optional>
 #include <type_traits>
+
+#include "common/checked_conversion.h"
 
 namespace tiltcal {
 
@@ -476,12 +479,22 @@ Status ConvertGeneric(const PointCloud2View& cloud, const CloudLayout& layout,
                              " s from header.stamp; offsets must stay within +-2.147 s "
                              "(point times in another clock than the stamp?)");
       }
+      if (out.ring != nullptr) {
+        // A float or signed ring field may hold what no ring number is.
+        const double ring = layout.ring.Get(p, swap);
+        const std::optional<uint32_t> checked = CheckedTruncate<uint32_t>(ring);
+        if (!checked) {
+          return Status::Error("point " + std::to_string(r * width + c) + ": its ring (field '" +
+                               layout.ring.name + "') is " + std::to_string(ring) +
+                               ", not a ring number");
+        }
+        out.ring[k] = *checked;
+      }
       out.x[k] = x;
       out.y[k] = y;
       out.z[k] = z;
       out.intensity[k] =
           layout.intensity.present ? static_cast<float>(layout.intensity.Get(p, swap)) : 0.0f;
-      if (out.ring != nullptr) out.ring[k] = static_cast<uint32_t>(layout.ring.Get(p, swap));
       out.time_offset_ns[k] = static_cast<int32_t>(offset_ns);
       ++k;
     }

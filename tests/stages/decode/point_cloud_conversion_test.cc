@@ -126,6 +126,29 @@ TEST(PointCloudConversion, FrameIdThatIsNotUtf8IsAnError) {
   EXPECT_EQ(scan.frame_id(), view.header.frame_id);
 }
 
+// Found by fuzzing (UBSan, float-cast-overflow): a float ring of -1 or NaN
+// was cast to uint32. It is an error naming the point and the field.
+TEST(PointCloudConversion, RingThatIsNoRingNumberIsAnError) {
+  for (const float ring : {-1.0f, std::nanf(""), 5e9f}) {
+    CloudBuilder b(16, 2, 1);
+    b.Field("x", 0, ros1::kFloat32);
+    b.Field("y", 4, ros1::kFloat32);
+    b.Field("z", 8, ros1::kFloat32);
+    b.Field("ring", 12, ros1::kFloat32);
+    for (uint32_t c = 0; c < 2; ++c) {
+      b.Set<float>(0, c, 0, 5.0f);
+      b.Set<float>(0, c, 4, 0.0f);
+      b.Set<float>(0, c, 8, 0.0f);
+      b.Set<float>(0, c, 12, c == 0 ? 3.0f : ring);
+    }
+    proto::Scan scan;
+    const Status status = Convert(b, &scan);
+    ASSERT_FALSE(status.ok()) << ring;
+    EXPECT_EQ(status.message().rfind("point 1: its ring (field 'ring') is ", 0), 0u)
+        << status.message();
+  }
+}
+
 TEST(PointCloudConversion, Float64XyzAnyIntensityTypeLineAndOffsetTime) {
   CloudBuilder b(35, 2, 1);
   b.Field("x", 0, ros1::kFloat64);
