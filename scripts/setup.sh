@@ -10,6 +10,7 @@ PACKAGES=(
   liblz4-dev lz4 libbz2-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   python3-rosbag python3-sensor-msgs python3-numpy python3-matplotlib
+  clang libclang-rt-14-dev
 )
 
 missing=()

@@ -1,0 +1,26 @@
+// libFuzzer harness: any bytes as a serialized sensor_msgs/PointCloud2,
+// decoded and converted to a Scan by the fast and the generic loops, which
+// must agree.
+#include <cstddef>
+#include <cstdint>
+#include <cstdlib>
+
+#include "bag/ros1/messages.h"
+#include "stages/decode/point_cloud_conversion.h"
+#include "tiltcal/proto/scan.pb.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  tiltcal::ros1::PointCloud2View cloud;
+  if (!tiltcal::ros1::DecodePointCloud2(data, size, &cloud).ok()) return 0;
+  tiltcal::PointConversionOptions fast, generic;
+  fast.min_range_m = generic.min_range_m = 0.5;
+  generic.allow_fast_path = false;
+  tiltcal::proto::Scan fast_scan, generic_scan;
+  const bool fast_ok = tiltcal::ConvertPointCloud2ToScan(cloud, fast, &fast_scan).ok();
+  const bool generic_ok = tiltcal::ConvertPointCloud2ToScan(cloud, generic, &generic_scan).ok();
+  if (fast_ok != generic_ok ||
+      (fast_ok && fast_scan.SerializeAsString() != generic_scan.SerializeAsString())) {
+    std::abort();  // the two loops disagree
+  }
+  return 0;
+}
