@@ -136,6 +136,7 @@ Status WritePcdAtomically(const std::string& path, const pcl::PCLPointCloud2& cl
   pcl::PCDWriter writer;
   std::string contents =
       writer.generateHeaderBinary(cloud, Eigen::Vector4f::Zero(), Eigen::Quaternionf::Identity());
+  contents += "DATA binary\n";
   contents.append(reinterpret_cast<const char*>(cloud.data.data()), cloud.data.size());
   return WriteFileAtomically(path, contents);
 }
