@@ -55,7 +55,8 @@ build_tools() {
     cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release > /dev/null
   fi
   cmake --build build -j "$(nproc)" --target tiltcal_simulate tiltcal_decode tiltcal_ground \
-    tiltcal_gravity tiltcal_calibrate tiltcal_report tiltcal_inspect
+    tiltcal_gravity tiltcal_gravity_reference tiltcal_calibrate tiltcal_dataset_calibration \
+    tiltcal_report tiltcal_inspect tiltcal_export
 }
 
 phase "setup and build" build_tools
@@ -63,11 +64,11 @@ phase "simulate flat dataset (3 x ${DURATION_S} s)" \
   simulate_dataset stages/simulate/scenarios/flat_vlp16.txtpb "$FLAT" flat 3
 phase "simulate tilted dataset (5 x ${DURATION_S} s)" \
   simulate_dataset stages/simulate/scenarios/tilted_husky_vlp16.txtpb "$TILTED" tilted 5
-# The tilted dataset takes its flat-ground gravity g_f from the flat run.
-sed -i -E 's#^gravity_reference:.*#gravity_reference: "../husky_flat/out/flat_1/gravity.txtpb"#' \
-  "$TILTED/rig.txtpb"
+# The tilted dataset takes its flat-ground gravity g_f from the flat dataset's
+# calibrations (out/gravity_reference.txtpb, made by the tilted dataset's make).
+sed -i -E 's#^gravity_reference:.*#gravity_reference: "../husky_flat"#' "$TILTED/rig.txtpb"
 grep -q gravity_reference "$TILTED/rig.txtpb" ||
-  echo 'gravity_reference: "../husky_flat/out/flat_1/gravity.txtpb"' >> "$TILTED/rig.txtpb"
+  echo 'gravity_reference: "../husky_flat"' >> "$TILTED/rig.txtpb"
 
 phase "pipeline, flat dataset (-j2)" make -s -f Makefile.pipeline DATASET="$FLAT" -j2
 phase "pipeline, tilted dataset (-j2)" make -s -f Makefile.pipeline DATASET="$TILTED" -j2
@@ -77,6 +78,7 @@ for dataset in "$FLAT" "$TILTED"; do
   cat "$dataset/out/repeatability.txt"
   echo
 done
+echo "Report pages (open in a browser): $FLAT/out/report.html $TILTED/out/report.html" | sed "s#$ROOT/##g"
 echo "Plots:"
 ls -1 "$FLAT"/out/*.png "$TILTED"/out/*.png "$FLAT"/out/*/*.png "$TILTED"/out/*/*.png 2>/dev/null |
   sed "s#^$ROOT/##; s#^#  #"

@@ -20,6 +20,7 @@
 #include "stages/calibrate/ground_residuals.h"
 #include "stages/calibrate/initialisation.h"
 #include "stages/calibrate/lidar_association.h"
+#include "stages/calibrate/map_export.h"
 #include "stages/calibrate/map_sharpness.h"
 #include "stages/calibrate/problem_builder.h"
 #include "stages/calibrate/residual_statistics.h"
@@ -296,8 +297,19 @@ void FillCovariance(const CalibrateInputs& inputs, const proto::CalibrateParams&
     const Status cs = ComputeExtrinsicCovariance(problem->problem(), state,
                                                  static_cast<int>(params.num_threads()), &cov);
     if (cs.ok()) {
-      FillCovarianceReport(cov, state->ImuFromLidarRotation().toRotationMatrix(),
-                           PrincipalRotationAxis(inputs.imu, state->GyroBias()),
+      const VarianceFactor factor = ComputeVarianceFactor(problem->problem());
+      result->set_variance_factor(factor.sigma0_squared);
+      result->set_redundancy(factor.redundancy);
+      if (params.observability().scale_by_variance_factor() && factor.redundancy > 0) {
+        Matrix7d prior_information = Matrix7d::Zero();
+        prior_information.block<3, 3>(3, 3) = TranslationPriorInformation(
+            result->translation_prior_sigma_m(), ToEigen(result->translation_prior_axis_b()));
+        cov = ScaleDataInformation(cov, prior_information, factor.sigma0_squared);
+        result->set_covariance_scaled_by_variance_factor(true);
+      }
+      const MotionAxis motion = PrincipalRotationAxis(inputs.imu, state->GyroBias());
+      *result->mutable_motion_rotation_axis_b() = ToProto(motion.axis_b);
+      FillCovarianceReport(cov, state->ImuFromLidarRotation().toRotationMatrix(), motion,
                            params.observability(), result);
     } else {
       proto::ObservabilityDirection* d = result->add_observability();
@@ -385,6 +397,24 @@ void FillVerdictFacts(const CalibrateInputs& inputs, const proto::CalibrateParam
   AddTiming("verdict_facts", Seconds(start), result);
 }
 
+// The before/after maps of map_export.h, when their paths are given.
+Status WriteMaps(const CalibratePaths& paths, const proto::CalibrateParams& params,
+                 const CalibrateInputs& inputs, const CalibrationState& state, std::ostream* log) {
+  const std::pair<std::string, Rigid3d> maps[] = {
+      {paths.out_map_rig, ToEigen(inputs.rig.imu_from_lidar())},
+      {paths.out_map_calibrated,
+       Rigid3d{state.ImuFromLidarRotation(), state.ImuFromLidarTranslation()}}};
+  for (const auto& [path, imu_from_lidar] : maps) {
+    if (path.empty()) continue;
+    const std::vector<MapPoint> points =
+        BuildMapPoints(state, imu_from_lidar, inputs.scans, params.map_export(),
+                       params.association().deskew_node_spacing_s());
+    TILTCAL_RETURN_IF_ERROR(WriteMapPcd(path, points));
+    Log(log, fmt::format("map {} ({} points)", path, points.size()));
+  }
+  return Status::Ok();
+}
+
 }  // namespace
 
 Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& params,
@@ -438,6 +468,8 @@ Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& pa
   problem_options.translation_prior_m = ToEigen(inputs.rig.imu_from_lidar()).translation;
   problem_options.translation_prior_sigma_m = params.extrinsic_translation_prior_sigma_m();
   problem_options.translation_prior_axis_b = init.rotation_axis_b;
+  result->set_translation_prior_sigma_m(problem_options.translation_prior_sigma_m);
+  *result->mutable_translation_prior_axis_b() = ToProto(init.rotation_axis_b.normalized());
   OuterLoop loop;
   bool settled = false;
   const int max_rounds = static_cast<int>(params.outer_loop().iterations());
@@ -471,7 +503,11 @@ Status Run(const CalibratePaths& paths, const proto::CalibrateParams& params, st
   TILTCAL_RETURN_IF_ERROR(ReadCalibrateInputs(paths, params, &inputs));
   const double read_s = Seconds(start);
   proto::CalibrationResult result;
-  TILTCAL_RETURN_IF_ERROR(Calibrate(inputs, params, &result, nullptr, log));
+  // Replaced by the final state (the grid here is a placeholder).
+  CalibrationState final_state(
+      spline::UniformKnotGrid::ForDuration(0.0, 1.0, params.spline().knot_spacing_s()));
+  TILTCAL_RETURN_IF_ERROR(Calibrate(inputs, params, &result, &final_state, log));
+  TILTCAL_RETURN_IF_ERROR(WriteMaps(paths, params, inputs, final_state, log));
   proto::PhaseTiming* t = result.add_timings();
   t->set_phase("read_inputs");
   t->set_seconds(read_s);

@@ -58,6 +58,43 @@ Status ComputeExtrinsicCovariance(ceres::Problem* problem, CalibrationState* sta
   return Status::Ok();
 }
 
+VarianceFactor ComputeVarianceFactor(ceres::Problem* problem) {
+  VarianceFactor out;
+  std::vector<double*> blocks;
+  problem->GetParameterBlocks(&blocks);
+  int64_t free_parameters = 0;
+  for (double* b : blocks) {
+    if (!problem->IsParameterBlockConstant(b)) free_parameters += problem->ParameterBlockTangentSize(b);
+  }
+  const int64_t redundancy = problem->NumResiduals() - free_parameters;
+  double cost = 0.0;
+  ceres::Problem::EvaluateOptions options;
+  options.apply_loss_function = true;
+  if (redundancy <= 0 || !problem->Evaluate(options, &cost, nullptr, nullptr, nullptr) ||
+      !std::isfinite(cost)) {
+    return out;
+  }
+  out.redundancy = redundancy;
+  out.sigma0_squared = 2.0 * cost / static_cast<double>(redundancy);
+  return out;
+}
+
+Eigen::Matrix3d TranslationPriorInformation(double sigma_m, const Eigen::Vector3d& axis_b) {
+  if (sigma_m <= 0.0) return Eigen::Matrix3d::Zero();
+  const Eigen::Matrix3d w = axis_b.norm() > 0.0
+                                ? Eigen::Matrix3d(axis_b.normalized() * axis_b.normalized().transpose())
+                                : Eigen::Matrix3d::Identity();
+  return w / (sigma_m * sigma_m);
+}
+
+Matrix7d ScaleDataInformation(const Matrix7d& covariance, const Matrix7d& prior_information,
+                              double sigma0_squared) {
+  const Matrix7d information = covariance.inverse();
+  const Matrix7d scaled = (information - prior_information) / sigma0_squared + prior_information;
+  const Matrix7d out = scaled.inverse();
+  return 0.5 * (out + out.transpose());
+}
+
 std::string DescribeDirection(const Eigen::Vector3d& v) {
   int k = 0;
   v.cwiseAbs().maxCoeff(&k);

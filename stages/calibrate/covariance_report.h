@@ -22,6 +22,7 @@
 // vehicle on a plane, translation along that axis (vertical) is the weak one
 // without ground residuals.
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -54,6 +55,30 @@ MotionAxis PrincipalRotationAxis(const std::vector<imu::ImuReading>& samples,
 // failure of the stage.
 Status ComputeExtrinsicCovariance(ceres::Problem* problem, CalibrationState* state,
                                   int num_threads, Matrix7d* covariance);
+
+// A-posteriori variance factor of the weighted least-squares problem at its
+// current parameters: sigma0^2 = 2 F / (m - n), F the cost with the robust
+// loss (ceres' 1/2 sum rho), m the number of residuals, n the tangent size of
+// the non-constant parameter blocks. The expected value of sigma0^2 is 1 when
+// the residual sigmas are the noise's; the covariance (J^T J)^{-1} computed
+// with those sigmas is then scaled by sigma0^2 (docs/design.md §11).
+// sigma0_squared is 1 and redundancy <= 0 when m <= n.
+struct VarianceFactor {
+  double sigma0_squared = 1.0;
+  int64_t redundancy = 0;
+};
+VarianceFactor ComputeVarianceFactor(ceres::Problem* problem);
+
+// Information of the prior on r_b^{lb}, frame b: a a^T / sigma^2 along a unit
+// axis a, I / sigma^2 for a zero axis, zero for sigma <= 0.
+Eigen::Matrix3d TranslationPriorInformation(double sigma_m, const Eigen::Vector3d& axis_b);
+
+// The covariance with the data's information scaled by 1/sigma0^2 and the
+// priors' kept: a prior acts on the extrinsic block only, so the marginal
+// information is P^{-1} = S_data + L_prior, and the result is
+// ((P^{-1} - L_prior) / sigma0^2 + L_prior)^{-1}.
+Matrix7d ScaleDataInformation(const Matrix7d& covariance, const Matrix7d& prior_information,
+                              double sigma0_squared);
 
 // Writes covariance, rotation_sigma_deg, translation_sigma_m,
 // time_offset_sigma_s and the observability directions into *result; a

@@ -146,7 +146,7 @@ void CheckWeakDirections(const proto::CalibrationResult& r, Findings* f) {
     if (translation && r.has_rig_imu_from_lidar()) {
       f->weak.push_back(WeakTranslationReason(d, r));
     } else if (rotation) {
-      f->weak.push_back("weakly determined, stays near its start (the rig's C_bl): " +
+      f->weak.push_back("weakly determined (sigma above observability.weak_rotation_sigma_deg): " +
                         WithoutWeakMark(d.description()));
     } else {
       f->weak.push_back("weakly determined: " + WithoutWeakMark(d.description()));

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
 #include <vector>
 
 #include <fmt/format.h>
@@ -18,6 +17,7 @@
 #include "common/io/rig.h"
 #include "common/io/static_detection_params.h"
 #include "common/io/text_proto.h"
+#include "stages/gravity/gravity_reference.h"
 
 namespace tiltcal::gravity {
 
@@ -175,8 +175,10 @@ Status EstimateGravityReference(const GravityInputs& inputs, const proto::Gravit
 
 namespace {
 
-// g_f named by the rig: its own gravity_flat_in_imu, or a gravity.txtpb of a
-// flat run at a path relative to the dataset (the rig's folder).
+// g_f named by the rig: its own gravity_flat_in_imu, or the gravity
+// reference at a path relative to the dataset (the rig's folder): a flat
+// dataset folder (its out/gravity_reference.txtpb) or a flat run's
+// gravity.txtpb.
 Status ReadDatasetReference(const std::string& rig_path, const proto::Rig& rig,
                             proto::GravityReference* reference, std::string* source) {
   if (rig.has_gravity_flat_in_imu() && ToEigen(rig.gravity_flat_in_imu()).norm() > 0) {
@@ -186,8 +188,7 @@ Status ReadDatasetReference(const std::string& rig_path, const proto::Rig& rig,
     return Status::Ok();
   }
   if (rig.gravity_reference().empty()) return Status::Ok();
-  const std::string path =
-      (std::filesystem::path(rig_path).parent_path() / rig.gravity_reference()).string();
+  const std::string path = ResolveGravityReferencePath(rig_path, rig.gravity_reference());
   TILTCAL_RETURN_IF_ERROR(ReadTextProto(path, reference));
   if (!reference->has_gravity_flat()) {
     return Status::Error(path + ": the gravity reference named by " + rig_path +

@@ -16,9 +16,9 @@ void AddImuNotes(const proto::CheckParams& params, CheckFindings* f) {
   }
   if (imu.gyro_unit == imu::GyroUnit::kDegreesPerSecond) {
     notes.push_back(fmt::format(
-        "IMU gyro in deg/s (95th percentile |ω| {:.1f}, more than a vehicle turns in rad/s): "
+        "IMU gyro in deg/s ({:g}th percentile |ω| {:.1f}, more than a vehicle turns in rad/s): "
         "it will be converted to rad/s (× π/180)",
-        imu.gyro_speed_p95));
+        imu.gyro.percentile, imu.gyro.rate_at_percentile));
   }
   if (!imu.static_start.found) {
     notes.push_back(

@@ -22,10 +22,11 @@ Status CheckParamsAreValid(const proto::CheckParams& params) {
   if (l.ground_inlier_distance_m() > l.ground_min_depth_m() + l.ground_max_range_m()) {
     return Status::Error("lidar.ground_inlier_distance_m is larger than the ground region");
   }
-  if (params.imu().min_rotation_radps() >= params.imu().max_vehicle_rate_radps()) {
+  if (params.imu().min_rotation_radps() >= params.imu().max_vehicle_turn_rate_radps()) {
     return Status::Error(
-        fmt::format("imu.min_rotation_radps ({:g}) must be below imu.max_vehicle_rate_radps ({:g})",
-                    params.imu().min_rotation_radps(), params.imu().max_vehicle_rate_radps()));
+        fmt::format(
+            "imu.min_rotation_radps ({:g}) must be below imu.max_vehicle_turn_rate_radps ({:g})",
+            params.imu().min_rotation_radps(), params.imu().max_vehicle_turn_rate_radps()));
   }
   return Status::Ok();
 }

@@ -62,13 +62,16 @@ void AnalyseImu(const BagSurvey& survey, const proto::CheckParams& params, Check
         fmt::format("IMU: {} usable sample(s) on '{}'", readings.size(), f->imu_topic));
     return;
   }
-  std::vector<double> speed;
-  speed.reserve(readings.size());
-  for (const imu::ImuReading& r : readings) speed.push_back(r.angular_velocity_radps.norm());
-  imu.gyro_speed_p95 = Quantile(std::move(speed), 0.95);
-  imu.gyro_unit = imu.gyro_speed_p95 > params.imu().max_vehicle_rate_radps()
-                      ? imu::GyroUnit::kDegreesPerSecond
-                      : imu::GyroUnit::kRadiansPerSecond;
+  imu.gyro = imu::DetectGyroUnitFromRates(readings, params.imu().gyro_rate_percentile(),
+                                          params.imu().max_vehicle_turn_rate_radps());
+  if (!imu.gyro.unit) {
+    f->problems.push_back(fmt::format(
+        "IMU: {:g}th percentile of |ω| {:.1f} is more than a vehicle turns even in deg/s: "
+        "the gyro's unit or scale is unknown",
+        imu.gyro.percentile, imu.gyro.rate_at_percentile));
+    return;
+  }
+  imu.gyro_unit = *imu.gyro.unit;
   imu.accel = imu::DetectAccelUnit(readings, {});
   if (!imu.accel.unit) {
     f->problems.push_back(

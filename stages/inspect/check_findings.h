@@ -20,10 +20,10 @@ namespace tiltcal::inspect {
 struct ImuFindings {
   StampStatistics stamps;
   imu::AccelUnitEvidence accel;  // in the published unit
-  // Gyro unit from the rates alone: deg/s when the 95th percentile of |ω|
-  // (published unit) exceeds ImuCheckParams.max_vehicle_rate_radps.
+  // Gyro unit from the rates alone (imu::DetectGyroUnitFromRates with
+  // ImuCheckParams.gyro_rate_percentile and max_vehicle_turn_rate_radps).
+  imu::GyroRateEvidence gyro;
   imu::GyroUnit gyro_unit = imu::GyroUnit::kRadiansPerSecond;
-  double gyro_speed_p95 = 0.0;       // published unit
   imu::StaticInterval static_start;  // SI; times from the first IMU stamp
   Eigen::Vector3d specific_force_at_rest_mps2 = Eigen::Vector3d::Zero();
   ImuExcitation excitation;

@@ -45,8 +45,8 @@ void WriteImu(const CheckFindings& f, std::ostream& out) {
                    imu.accel.median_norm,
                    imu.accel.from_static_samples ? ", static start" : ", all samples"));
   Line(out, "gyro",
-       fmt::format("{} (95th percentile |ω| {:.3f} as published)", imu::UnitName(imu.gyro_unit),
-                   imu.gyro_speed_p95));
+       fmt::format("{} ({:g}th percentile |ω| {:.3f} as published)",
+                   imu::UnitName(imu.gyro_unit), imu.gyro.percentile, imu.gyro.rate_at_percentile));
   const imu::StaticInterval& st = imu.static_start;
   Line(out, "static start",
        st.found ? fmt::format("yes, {:.2f} s (gyro bias {:.4f} {:.4f} {:.4f} rad/s)",

@@ -25,7 +25,7 @@ done
 exit 0
 STUB
 chmod +x "$BIN/stub"
-for stage in decode ground gravity calibrate report inspect; do
+for stage in decode ground gravity gravity_reference calibrate dataset_calibration report inspect; do
   ln -s stub "$BIN/tiltcal_$stage"
 done
 # A stub interpreter for the plot scripts.
@@ -49,8 +49,9 @@ fail() { echo "FAIL: $*" >&2; exit 1; }
 # Stages that `make -n` would run, one "stage sequence" per line, sorted.
 planned() {
   "${MAKE[@]}" -n "$@" | sed -e ':a' -e '/\\$/N; s/\\\n//; ta' | perl -ne '
-    next unless /(tiltcal_[a-z]+|plot_[a-z_]+\.py)/; my $stage = $1;
-    my ($seq) = m{/out/([^/ ]+)/} ? ($1) : m{/([^/ ]+)\.bag} ? ($1) : ("");
+    next unless /(tiltcal_[a-z_]+|plot_[a-z_]+\.py)/; my $stage = $1;
+    my ($seq) = $stage =~ /^tiltcal_(dataset_calibration|gravity_reference)$/ ? ("") :
+      m{/out/([^/ ]+)/} ? ($1) : m{/([^/ ]+)\.bag} ? ($1) : ("");
     print $seq eq "" ? "$stage\n" : "$stage $seq\n";' | sort -u | tr '\n' ';'
 }
 expect() {  # expect "<description>" "<planned>" "<expected>"
@@ -60,7 +61,7 @@ expect() {  # expect "<description>" "<planned>" "<expected>"
 sleep_past() { sleep 1.1; }  # make compares mtimes
 
 expect "fresh dataset runs every stage" "$(planned)" \
-"plot_extrinsics.py;plot_ground_timeline.py seq_a;plot_ground_timeline.py seq_b;tiltcal_calibrate seq_a;tiltcal_calibrate seq_b;tiltcal_decode seq_a;tiltcal_decode seq_b;tiltcal_gravity seq_a;tiltcal_gravity seq_b;tiltcal_ground seq_a;tiltcal_ground seq_b;tiltcal_inspect seq_a;tiltcal_inspect seq_b;tiltcal_report;"
+"plot_extrinsics.py;plot_ground_timeline.py seq_a;plot_ground_timeline.py seq_b;tiltcal_calibrate seq_a;tiltcal_calibrate seq_b;tiltcal_dataset_calibration;tiltcal_decode seq_a;tiltcal_decode seq_b;tiltcal_gravity seq_a;tiltcal_gravity seq_b;tiltcal_ground seq_a;tiltcal_ground seq_b;tiltcal_inspect seq_a;tiltcal_inspect seq_b;tiltcal_report;"
 
 "${MAKE[@]}" -j2 all > /dev/null
 for s in seq_a seq_b; do
@@ -69,16 +70,17 @@ for s in seq_a seq_b; do
   done
 done
 [ -f "$DATA/out/repeatability.txt" ] && [ -f "$DATA/out/extrinsic_spread.png" ] || fail "no report"
+[ -f "$DATA/out/calibration.txtpb" ] || fail "no dataset calibration"
 expect "up to date after a full run" "$(planned)" ""
 
 sleep_past; echo 'edited' >> "$DATA/params/ground.txtpb"
 expect "editing the ground params reruns ground and downstream, nothing upstream" "$(planned)" \
-"plot_extrinsics.py;plot_ground_timeline.py seq_a;plot_ground_timeline.py seq_b;tiltcal_calibrate seq_a;tiltcal_calibrate seq_b;tiltcal_gravity seq_a;tiltcal_gravity seq_b;tiltcal_ground seq_a;tiltcal_ground seq_b;tiltcal_inspect seq_a;tiltcal_inspect seq_b;tiltcal_report;"
+"plot_extrinsics.py;plot_ground_timeline.py seq_a;plot_ground_timeline.py seq_b;tiltcal_calibrate seq_a;tiltcal_calibrate seq_b;tiltcal_dataset_calibration;tiltcal_gravity seq_a;tiltcal_gravity seq_b;tiltcal_ground seq_a;tiltcal_ground seq_b;tiltcal_inspect seq_a;tiltcal_inspect seq_b;tiltcal_report;"
 "${MAKE[@]}" all > /dev/null
 
 sleep_past; echo 'edited' >> "$DATA/params/calibrate.txtpb"
-expect "calibrate params rerun calibrate and the report only" "$(planned)" \
-"plot_extrinsics.py;tiltcal_calibrate seq_a;tiltcal_calibrate seq_b;tiltcal_report;"
+expect "calibrate params rerun calibrate and the dataset-level results only" "$(planned)" \
+"plot_extrinsics.py;tiltcal_calibrate seq_a;tiltcal_calibrate seq_b;tiltcal_dataset_calibration;tiltcal_report;"
 "${MAKE[@]}" all > /dev/null
 
 sleep_past; touch "$DATA/params/ground.txtpb"
@@ -103,6 +105,34 @@ sleep_past; printf 'imu_height_m: 0.3\ngravity_reference: "flat/gravity.txtpb"\n
 sleep_past; touch "$DATA/flat/gravity.txtpb"
 expect "a changed gravity reference reruns gravity and downstream" "$(planned calibrate)" \
 "tiltcal_calibrate seq_a;tiltcal_calibrate seq_b;tiltcal_gravity seq_a;tiltcal_gravity seq_b;"
+"${MAKE[@]}" all > /dev/null
+
+# ... or from a flat dataset folder: its out/gravity_reference.txtpb, from
+# its calibrations, brought up to date by make on the tilted dataset.
+FLAT=$WORK/flat_dataset
+mkdir -p "$FLAT"; echo 'imu_height_m: 0.3' > "$FLAT/rig.txtpb"; touch "$FLAT/run_1.bag" "$FLAT/run_2.bag"
+sleep_past; printf 'imu_height_m: 0.3\ngravity_reference: "../flat_dataset"\n' > "$DATA/rig.txtpb"
+"${MAKE[@]}" all > /dev/null
+for f in run_1/calibration.txtpb run_2/calibration.txtpb gravity_reference.txtpb; do
+  [ -s "$FLAT/out/$f" ] || fail "make on the tilted dataset did not make the flat dataset's out/$f"
+done
+grep -q -- "tiltcal_gravity_reference .*--out=$FLAT/out/gravity_reference.txtpb" \
+  <(make --no-print-directory -n -B -f "$SRC/Makefile.pipeline" DATASET="$FLAT" BIN="$BIN" \
+  gravity-reference) || fail "no gravity-reference target on the flat dataset"
+mtime() { stat -c %Y.%y "$1"; }
+before=$(mtime "$DATA/out/seq_a/gravity.txtpb")
+sleep_past; "${MAKE[@]}" all > /dev/null
+[ "$(mtime "$DATA/out/seq_a/gravity.txtpb")" = "$before" ] ||
+  fail "an up-to-date flat dataset reference reran the tilted gravity stage"
+echo "ok: a flat dataset folder as the gravity reference, up to date"
+sleep_past; echo 'edited' >> "$FLAT/run_2.bag"
+"${MAKE[@]}" all > /dev/null
+[ "$FLAT/out/gravity_reference.txtpb" -nt "$FLAT/run_2.bag" ] ||
+  fail "a changed flat bag did not rebuild the flat dataset's reference"
+[ "$(mtime "$DATA/out/seq_a/gravity.txtpb")" != "$before" ] ||
+  fail "a rebuilt flat dataset reference did not rerun the tilted gravity stage"
+echo "ok: a changed flat dataset rebuilds its reference and the tilted gravity stage"
+printf 'imu_height_m: 0.3\ngravity_reference: "flat/gravity.txtpb"\n' > "$DATA/rig.txtpb"
 "${MAKE[@]}" all > /dev/null
 
 sleep_past; touch "$DATA/params/ground.txtpb"

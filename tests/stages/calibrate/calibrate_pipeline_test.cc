@@ -11,6 +11,7 @@
 #include <vector>
 
 #include <ceres/problem.h>
+#include <ceres/sized_cost_function.h>
 #include <ceres/solver.h>
 #include <gtest/gtest.h>
 
@@ -215,6 +216,68 @@ TEST(CovarianceReportTest, SigmasDirectionsAndWeakNames) {
   EXPECT_NE(result.observability(4).description().find("plane of rotation"), std::string::npos);
 }
 
+// r_i = (x - y_i) / sigma_model: the least-squares x is the mean of y and
+// 2 F / (m - n) = sum (y_i - mean)^2 / (sigma_model^2 (N - 1)), the sample
+// variance over the model's; a constant block adds no free parameter.
+class OffsetResidual final : public ceres::SizedCostFunction<1, 1, 1> {
+ public:
+  OffsetResidual(double y, double sigma) : y_(y), sigma_(sigma) {}
+  bool Evaluate(double const* const* p, double* r, double** j) const override {
+    r[0] = (p[0][0] + p[1][0] - y_) / sigma_;
+    if (j != nullptr && j[0] != nullptr) j[0][0] = 1.0 / sigma_;
+    if (j != nullptr && j[1] != nullptr) j[1][0] = 1.0 / sigma_;
+    return true;
+  }
+
+ private:
+  double y_;
+  double sigma_;
+};
+
+TEST(CovarianceReportTest, VarianceFactorIsTheSampleVarianceOverTheModels) {
+  const std::vector<double> y = {0.3, -0.2, 0.5, 0.1, -0.4, 0.25, 0.0, -0.15};
+  const double sigma_model = 0.5;
+  double mean = 0.0;
+  for (double v : y) mean += v / static_cast<double>(y.size());
+  double sum_squares = 0.0;
+  for (double v : y) sum_squares += (v - mean) * (v - mean);
+  double x = mean;  // the least-squares solution
+  double constant_offset = 0.0;
+  ceres::Problem problem;
+  for (double v : y) {
+    problem.AddResidualBlock(new OffsetResidual(v, sigma_model), nullptr, &x, &constant_offset);
+  }
+  problem.SetParameterBlockConstant(&constant_offset);
+  const VarianceFactor factor = ComputeVarianceFactor(&problem);
+  EXPECT_EQ(factor.redundancy, static_cast<int64_t>(y.size()) - 1);
+  EXPECT_NEAR(factor.sigma0_squared,
+              sum_squares / (sigma_model * sigma_model * static_cast<double>(y.size() - 1)),
+              1e-12);
+
+  // No redundancy: no factor.
+  double z = 0.0;
+  ceres::Problem one;
+  one.AddResidualBlock(new OffsetResidual(1.0, sigma_model), nullptr, &z, &constant_offset);
+  one.SetParameterBlockConstant(&constant_offset);
+  EXPECT_EQ(ComputeVarianceFactor(&one).redundancy, 0);
+  EXPECT_DOUBLE_EQ(ComputeVarianceFactor(&one).sigma0_squared, 1.0);
+}
+
+// P = (S + L)^{-1}: scaling the data's information S by 1/s keeps L.
+TEST(CovarianceReportTest, ScalingTheDataKeepsThePrior) {
+  Matrix7d a = Matrix7d::Random();
+  const Matrix7d data = a * a.transpose() + Matrix7d::Identity();
+  Matrix7d prior = Matrix7d::Zero();
+  prior.block<3, 3>(3, 3) = TranslationPriorInformation(0.05, Eigen::Vector3d(0, 0, 2));
+  EXPECT_DOUBLE_EQ(prior(5, 5), 400.0);
+  EXPECT_DOUBLE_EQ(prior(3, 3), 0.0);
+  const Matrix7d scaled = ScaleDataInformation((data + prior).inverse(), prior, 0.25);
+  EXPECT_LT((scaled - (data / 0.25 + prior).inverse()).norm(), 1e-12 * scaled.norm());
+  EXPECT_EQ(TranslationPriorInformation(0.0, Eigen::Vector3d::UnitZ()), Eigen::Matrix3d::Zero());
+  EXPECT_EQ(TranslationPriorInformation(0.5, Eigen::Vector3d::Zero()),
+            Eigen::Matrix3d::Identity() * 4.0);
+}
+
 TEST(CovarianceReportTest, PrincipalAxisOfAYawingMotion) {
   std::vector<imu::ImuReading> imu(100);
   for (size_t i = 0; i < imu.size(); ++i) {
@@ -324,7 +387,9 @@ TEST(CalibratePipelineTest, ShortFlatSequenceAgainstTruth) {
     })pb");
   proto::CalibrationResult result;
   proto::SimulationTruth truth;
-  const CalibratePaths paths = SequencePaths(dir, /*gravity=*/false);
+  CalibratePaths paths = SequencePaths(dir, /*gravity=*/false);
+  paths.out_map_rig = dir.File("map_rig.pcd");
+  paths.out_map_calibrated = dir.File("map_calibrated.pcd");
   ASSERT_TRUE(CalibrateSequence(dir, paths, params, &result, &truth));
   proto::Rig rig;
   ASSERT_TRUE(ReadTextProto(dir.File("rig.txtpb"), &rig).ok());
@@ -383,6 +448,23 @@ TEST(CalibratePipelineTest, ShortFlatSequenceAgainstTruth) {
       << FormatVerdict(result, params.verdict());
   EXPECT_EQ(result.residual_statistics_size(), 3);  // gyro, accel, lidar
   EXPECT_GT(result.map_sharpness_estimate().planar_surfels(), 100);
+  for (const proto::ResidualStatistics& s : result.residual_statistics()) {
+    int histogram_total = s.histogram_below() + s.histogram_above();
+    for (const int c : s.histogram_counts()) histogram_total += c;
+    EXPECT_EQ(histogram_total, s.count()) << s.type();
+  }
+  // The before/after maps (map_export.h): the same scans moved with the rig's
+  // extrinsic (off by 1.7 deg and 4.4 cm) and with the estimate, whose
+  // surfel map is the thinner one.
+  std::string map_rig;
+  std::string map_calibrated;
+  ASSERT_TRUE(ReadFileToString(paths.out_map_rig, &map_rig).ok());
+  ASSERT_TRUE(ReadFileToString(paths.out_map_calibrated, &map_calibrated).ok());
+  EXPECT_GT(map_rig.size(), 100000u);
+  EXPECT_EQ(map_rig.size(), map_calibrated.size());
+  EXPECT_NE(map_rig, map_calibrated);
+  EXPECT_LT(result.map_sharpness_estimate().median_thickness_m(),
+            result.map_sharpness_rig().median_thickness_m());
 
   // Observability: the translation direction closest to up.
   auto vertical_direction = [&](const proto::CalibrationResult& r) {
@@ -499,6 +581,24 @@ TEST(CalibratePipelineTest, TimeOffsetBeyondItsBoundIsSuspectWithExitCode3) {
   ASSERT_GT(result.verdict_reasons_size(), 0);
   EXPECT_NE(result.verdict_reasons(0).find("time offset at a bound"), std::string::npos)
       << result.verdict_reasons(0);
+
+  // verdict.allow_suspect: the same SUSPECT result, exit 0.
+  const std::string allow = "allow_suspect: false";
+  ASSERT_NE(params_text.find(allow), std::string::npos);
+  params_text.replace(params_text.find(allow), allow.size(), "allow_suspect: true");
+  ASSERT_TRUE(WriteFileAtomically(dir.File("params_allow.txtpb"), params_text).ok());
+  const std::string allowed_out = dir.File("calibration_allowed.txtpb");
+  const int allowed_code = testing::RunCommand(
+      testing::ToolPath("tiltcal_calibrate") + " --quiet --imu=" + paths.imu +
+          " --scans=" + paths.scans + " --ground=" + paths.ground + " --rig=" + paths.rig +
+          " --params=" + dir.File("params_allow.txtpb") + " --out=" + allowed_out,
+      &output);
+  EXPECT_EQ(allowed_code, 0) << output;
+  EXPECT_NE(output.find("tiltcal_calibrate: verdict SUSPECT"), std::string::npos) << output;
+  proto::CalibrationResult allowed;
+  ASSERT_TRUE(ReadTextProto(allowed_out, &allowed).ok());
+  EXPECT_EQ(allowed.verdict(), proto::CalibrationResult::SUSPECT);
+  EXPECT_NEAR(allowed.time_offset_s(), result.time_offset_s(), 1e-6);
 }
 
 }  // namespace

@@ -118,7 +118,7 @@ TEST(VerdictTest, WeakRotationAndTimeOffsetAreNamed) {
   r.mutable_observability(6)->set_weak(true);
   const std::string reasons = Decide(&r);
   EXPECT_EQ(r.verdict(), CalibrationResult::WEAK);
-  EXPECT_NE(reasons.find("stays near its start (the rig's C_bl): direction 2\n"), std::string::npos) << reasons;
+  EXPECT_NE(reasons.find("weakly determined (sigma above observability.weak_rotation_sigma_deg): direction 2\n"), std::string::npos) << reasons;
   EXPECT_NE(reasons.find("weakly determined: direction 6\n"), std::string::npos) << reasons;
 }
 

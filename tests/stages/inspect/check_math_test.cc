@@ -239,7 +239,7 @@ TEST(CheckParams, DefaultsAreValidAndRulesNameTheField) {
   ASSERT_FALSE(status.ok());
   EXPECT_NE(status.message().find("static_detection.hop_s"), std::string::npos) << status.message();
   const auto rates = testing::DefaultParamsWith<proto::CheckParams>(
-      DefaultParamsText(), "imu { min_rotation_radps: 0.9 max_vehicle_rate_radps: 0.5 }");
+      DefaultParamsText(), "imu { min_rotation_radps: 0.9 max_vehicle_turn_rate_radps: 0.5 }");
   EXPECT_NE(CheckParamsAreValid(rates).message().find("imu.min_rotation_radps"), std::string::npos);
 }
 
