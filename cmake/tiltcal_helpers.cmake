@@ -7,8 +7,19 @@ function(tiltcal_set_target_options target)
     target_compile_options(${target} PRIVATE -Werror)
   endif()
   if(TILTCAL_SANITIZE)
-    target_compile_options(${target} PRIVATE -fsanitize=${TILTCAL_SANITIZE} -fno-omit-frame-pointer)
-    target_link_options(${target} PRIVATE -fsanitize=${TILTCAL_SANITIZE})
+    # "undefined" does not include float -> integer casts out of range; every
+    # finding stops the program (a test or fuzz run fails, never scrolls by).
+    set(sanitize ${TILTCAL_SANITIZE})
+    if(sanitize MATCHES "undefined")
+      string(APPEND sanitize ",float-cast-overflow")
+    endif()
+    target_compile_options(${target} PRIVATE -fsanitize=${sanitize} -fno-sanitize-recover=all
+                                             -fno-omit-frame-pointer)
+    target_link_options(${target} PRIVATE -fsanitize=${sanitize})
+  endif()
+  if(TILTCAL_FUZZ)
+    # Coverage for libFuzzer in every target; the harnesses add its main.
+    target_compile_options(${target} PRIVATE -fsanitize=fuzzer-no-link)
   endif()
   if(CMAKE_BUILD_TYPE STREQUAL "Debug")
     target_compile_definitions(${target} PRIVATE EIGEN_INITIALIZE_MATRICES_BY_NAN)

@@ -13,6 +13,7 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   python3-rosbag python3-sensor-msgs python3-numpy python3-matplotlib python3-yaml
   chromium
+  clang libclang-rt-14-dev
 )
 
 missing=()

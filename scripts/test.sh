@@ -1,9 +1,13 @@
 #!/usr/bin/env bash
 # Installs dependencies when needed, builds with warnings as errors and runs
-# every test. Tests that need ../shared/fixtures skip with a message when it
-# is absent.
+# every test, then the sanitizer and fuzz runs of the parsers. Tests that
+# need ../shared/fixtures skip with a message when it is absent.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/build.sh -DTILTCAL_WERROR=ON
-cd "${BUILD_DIR:-build}"
-ctest --output-on-failure -j "$(nproc)" "$@"
+(cd "${BUILD_DIR:-build}" && ctest --output-on-failure -j "$(nproc)" "$@")
+# The parsers under ASan + UBSan and a few seconds of fuzzing each
+# (scripts/sanitize_and_fuzz.sh); SKIP_SANITIZERS=1 leaves them out.
+if [ "${SKIP_SANITIZERS:-0}" != 1 ]; then
+  scripts/sanitize_and_fuzz.sh
+fi

@@ -1,6 +1,11 @@
 #include "common/imu/static_detection.h"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <optional>
+
+#include "common/checked_conversion.h"
 
 namespace tiltcal::imu {
 
@@ -59,19 +64,30 @@ std::vector<StaticInterval> DetectStaticIntervals(const std::vector<ImuReading>&
     }
     in_run = false;
   };
-  for (int k = 0;; ++k) {
-    const double begin_t = t0 + k * options.hop_s;
+  // Windows holding fewer than two samples are never static; the loop jumps
+  // over them to the first window that can reach the next sample, so the
+  // work is bounded by the samples (times window_s / hop_s), not by the span
+  // of the stamps over hop_s.
+  for (int64_t k = 0;;) {
+    const double begin_t = t0 + static_cast<double>(k) * options.hop_s;
     const double end_t = begin_t + options.window_s;
     if (end_t > t_last + 1e-12) break;
     const size_t begin = LowerIndex(samples, begin_t);
     const size_t end = LowerIndex(samples, end_t);
-    const bool is_static = [&] {
-      if (end < begin + 2) return false;  // too sparse to judge
-      const StaticInterval s = Statistics(samples, begin, end);
-      return s.gyro_std_radps <= options.max_gyro_std_radps &&
-             s.accel_std_mps2 <= options.max_accel_std_mps2 &&
-             s.mean_gyro_radps.norm() <= options.max_gyro_mean_radps;
-    }();
+    if (end < begin + 2) {  // too sparse to judge
+      close_run();
+      // First window whose end reaches the sample after samples[begin].
+      const double next_t = samples[std::min(begin + 1, samples.size() - 1)].time_s;
+      const double k_reach = std::floor((next_t - options.window_s - t0) / options.hop_s);
+      const std::optional<int64_t> k_next = CheckedTruncate<int64_t>(k_reach);
+      if (!k_next) break;  // beyond any window index: past the last sample
+      k = std::max(*k_next, k + 1);
+      continue;
+    }
+    const StaticInterval s = Statistics(samples, begin, end);
+    const bool is_static = s.gyro_std_radps <= options.max_gyro_std_radps &&
+                           s.accel_std_mps2 <= options.max_accel_std_mps2 &&
+                           s.mean_gyro_radps.norm() <= options.max_gyro_mean_radps;
     if (is_static) {
       if (!in_run) run_begin = begin_t;
       in_run = true;
@@ -79,6 +95,7 @@ std::vector<StaticInterval> DetectStaticIntervals(const std::vector<ImuReading>&
     } else {
       close_run();
     }
+    ++k;
   }
   close_run();
   return intervals;

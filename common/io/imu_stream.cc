@@ -1,5 +1,6 @@
 #include "common/io/imu_stream.h"
 
+#include "common/checked_conversion.h"
 #include "common/io/eigen_proto.h"
 #include "common/io/record_stream.h"
 #include "tiltcal/proto/imu.pb.h"
@@ -18,7 +19,7 @@ Status ReadImuReadings(const std::string& path, std::vector<imu::ImuReading>* re
     if (end) break;
     if (readings->empty()) *first_stamp_ns = sample.stamp_ns();
     imu::ImuReading reading;
-    reading.time_s = static_cast<double>(sample.stamp_ns() - *first_stamp_ns) * 1e-9;
+    reading.time_s = DifferenceSeconds(sample.stamp_ns(), *first_stamp_ns);
     reading.angular_velocity_radps = ToEigen(sample.angular_velocity_radps());
     reading.linear_acceleration_mps2 = ToEigen(sample.linear_acceleration_mps2());
     readings->push_back(reading);

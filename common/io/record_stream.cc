@@ -19,6 +19,7 @@ using google::protobuf::util::SerializeDelimitedToZeroCopyStream;
 class RecordWriter::Impl {
  public:
   AtomicFile file;
+  bool finished = false;
   std::unique_ptr<Lz4FrameOutput> lz4;
   std::unique_ptr<pbio::CopyingOutputStreamAdaptor> lz4_adaptor;
   std::unique_ptr<pbio::FileOutputStream> plain;
@@ -71,6 +72,13 @@ Status RecordWriter::Write(const google::protobuf::Message& record) {
 }
 
 Status RecordWriter::Close() {
+  TILTCAL_RETURN_IF_ERROR(Finish());
+  return impl_->file.Commit();
+}
+
+Status RecordWriter::Finish() {
+  if (impl_->finished) return Status::Ok();
+  impl_->finished = true;
   const std::string& path = impl_->file.path();
   bool ok = true;
   if (impl_->lz4_adaptor) {
@@ -79,11 +87,14 @@ Status RecordWriter::Close() {
     ok = impl_->plain->Flush();
   }
   if (!ok) {
+    const std::string message = path + ": cannot write output";
     impl_->file.Abandon();
-    return Status::Error(path + ": cannot write output");
+    return Status::Error(message);
   }
-  return impl_->file.Commit();
+  return impl_->file.Finish();
 }
+
+AtomicFile* RecordWriter::file() { return &impl_->file; }
 
 // ---------------------------------------------------------------- reader --
 
@@ -113,6 +124,12 @@ Status RecordReader::Open(const std::string& path, const std::string& expected_p
   impl_->file = std::fopen(path.c_str(), "rb");
   if (impl_->file == nullptr) {
     return Status::Error(path + ": cannot open: " + std::strerror(errno));
+  }
+  if (std::FILE* manifest = std::fopen(CommitManifestPath(path).c_str(), "rb")) {
+    std::fclose(manifest);
+    return Status::Error(path + ": its writer was interrupted while committing it with other "
+                         "outputs (" + CommitManifestPath(path) +
+                         " exists); rerun the stage that wrote it");
   }
   unsigned char first[4] = {0, 0, 0, 0};
   const size_t got = std::fread(first, 1, sizeof(first), impl_->file);

@@ -33,7 +33,12 @@ class RecordWriter {
   Status Open(const std::string& path, const std::string& payload_type,
               const proto::Provenance& provenance, bool compress);
   Status Write(const google::protobuf::Message& record);
+  // Finish() and AtomicFile::Commit(): the stream appears at its path.
   Status Close();
+  // Completes the stream under its temporary name (once; later calls do
+  // nothing), for CommitTogether({file(), ...}).
+  Status Finish();
+  AtomicFile* file();
 
   int64_t num_records() const { return num_records_; }
 

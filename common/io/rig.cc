@@ -31,44 +31,53 @@ Status CheckUnits(const proto::Rig& rig) {
 
 }  // namespace
 
-Status ValidateRig(proto::Rig* rig) {
-  if (!rig->has_imu_from_lidar() || !rig->imu_from_lidar().has_rotation()) {
-    return Status::Error("imu_from_lidar.rotation is missing (the measured extrinsic C_bl)");
+Status ValidateImuFromLidar(bool present, proto::Rigid3* imu_from_lidar,
+                            const std::string& field) {
+  if (!present || !imu_from_lidar->has_rotation()) {
+    return Status::Error(field + ".rotation is missing (the extrinsic C_bl)");
   }
-  proto::Quaternion* q = rig->mutable_imu_from_lidar()->mutable_rotation();
+  proto::Quaternion* q = imu_from_lidar->mutable_rotation();
   const double norm = std::sqrt(q->w() * q->w() + q->x() * q->x() + q->y() * q->y() +
                                 q->z() * q->z());
-  if (!std::isfinite(norm)) return Status::Error("imu_from_lidar.rotation is not finite");
+  if (!std::isfinite(norm)) return Status::Error(field + ".rotation is not finite");
   if (std::fabs(norm - 1.0) > kRigQuaternionNormTolerance) {
     return Status::Error(fmt::format(
-        "imu_from_lidar.rotation is not a unit quaternion (norm {:.6g}; w x y z, Hamilton)", norm));
+        "{}.rotation is not a unit quaternion (norm {:.6g}; w x y z, Hamilton)", field, norm));
   }
   *q = ToProto(ToEigen(*q));
-  const proto::Vector3& translation = rig->imu_from_lidar().translation();
-  if (!IsFinite(translation)) return Status::Error("imu_from_lidar.translation is not finite");
+  const proto::Vector3& translation = imu_from_lidar->translation();
+  if (!IsFinite(translation)) return Status::Error(field + ".translation is not finite");
   const double distance = ToEigen(translation).norm();
   if (distance > kRigMaxTranslationM) {
     return Status::Error(fmt::format(
-        "imu_from_lidar.translation is {:.3g} m long, more than {} m (metres, IMU frame)",
-        distance, kRigMaxTranslationM));
+        "{}.translation is {:.3g} m long, more than {} m (metres, IMU frame)", field, distance,
+        kRigMaxTranslationM));
   }
+  return Status::Ok();
+}
+
+Status ValidateRig(proto::Rig* rig) {
+  TILTCAL_RETURN_IF_ERROR(ValidateImuFromLidar(rig->has_imu_from_lidar(),
+                                               rig->mutable_imu_from_lidar(), "imu_from_lidar"));
   if (!std::isfinite(rig->imu_height_m()) || rig->imu_height_m() < 0 ||
       rig->imu_height_m() > kRigMaxImuHeightM) {
     return Status::Error(fmt::format("imu_height_m = {} is outside [0, {}] m (0 = unknown)",
                                      rig->imu_height_m(), kRigMaxImuHeightM));
   }
-  if (rig->has_gravity_flat_in_imu()) {
-    if (!IsFinite(rig->gravity_flat_in_imu())) {
-      return Status::Error("gravity_flat_in_imu is not finite");
-    }
-    const double g = ToEigen(rig->gravity_flat_in_imu()).norm();
-    if (g != 0.0 && (g < kRigMinGravityMps2 || g > kRigMaxGravityMps2)) {
-      return Status::Error(fmt::format(
-          "gravity_flat_in_imu has norm {:.4g}, not a gravity in m/s² (expected {} to {})", g,
-          kRigMinGravityMps2, kRigMaxGravityMps2));
-    }
+  if (rig->has_gravity_flat_in_imu() && ToEigen(rig->gravity_flat_in_imu()).norm() != 0.0) {
+    TILTCAL_RETURN_IF_ERROR(ValidateGravityFlat(rig->gravity_flat_in_imu(), "gravity_flat_in_imu"));
   }
   return CheckUnits(*rig);
+}
+
+Status ValidateGravityFlat(const proto::Vector3& gravity, const std::string& field) {
+  if (!IsFinite(gravity)) return Status::Error(field + " is not finite");
+  const double g = ToEigen(gravity).norm();
+  if (g < kRigMinGravityMps2 || g > kRigMaxGravityMps2) {
+    return Status::Error(fmt::format("{} has norm {:.4g}, not a gravity in m/s² (expected {} to {})",
+                                     field, g, kRigMinGravityMps2, kRigMaxGravityMps2));
+  }
+  return Status::Ok();
 }
 
 Status LoadRig(const std::string& path, proto::Rig* rig) {

@@ -18,6 +18,18 @@ inline constexpr double kRigMaxImuHeightM = 10.0;
 inline constexpr double kRigMinGravityMps2 = 8.5;
 inline constexpr double kRigMaxGravityMps2 = 11.0;
 
+// Checks an extrinsic (C_bl, r_b^{lb}) read from a file: present, every
+// value finite, a unit quaternion within kRigQuaternionNormTolerance
+// (normalised in place), a translation at most kRigMaxTranslationM long.
+// The error names the field by `field` ("imu_from_lidar").
+Status ValidateImuFromLidar(bool present, proto::Rigid3* imu_from_lidar,
+                            const std::string& field);
+
+// Checks a gravity read from a file (g_f in the IMU frame, m/s²): finite,
+// its norm within [kRigMinGravityMps2, kRigMaxGravityMps2]. The error names
+// `field`.
+Status ValidateGravityFlat(const proto::Vector3& gravity, const std::string& field);
+
 // Checks a rig (the dataset's rig.txtpb): imu_from_lidar present with a unit
 // quaternion (within kRigQuaternionNormTolerance; normalised in place),
 // every value finite, the translation, imu_height_m and gravity_flat_in_imu

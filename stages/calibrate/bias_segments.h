@@ -13,11 +13,22 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
+#include <fmt/format.h>
+
+#include "common/checked_conversion.h"
+#include "common/status.h"
 
 namespace tiltcal::calibrate {
+
+// Shortest bias segment (besides 0 = one segment), s, and the most segments
+// one bias may have.
+inline constexpr double kMinBiasSegmentS = 1.0;
+inline constexpr int kMaxBiasSegments = 100000;
 
 struct BiasSegments {
   double t0_s = 0.0;
@@ -25,22 +36,33 @@ struct BiasSegments {
   std::vector<std::array<double, 3>> values = {{0.0, 0.0, 0.0}};
 
   // ceil(duration_s / segment_s) segments from t0_s (one when segment_s <= 0
-  // or the duration is shorter), each set to the current mean.
-  void Split(double start_s, double duration_s, double segment_length_s) {
+  // or the duration is shorter), each set to the current mean. More than
+  // kMaxBiasSegments (or a count that is not a finite int) is an error naming
+  // `field`, the params field of the segment length.
+  Status Split(double start_s, double duration_s, double segment_length_s,
+               const std::string& field) {
     const Eigen::Vector3d mean = Mean();
     int count = 1;
     if (segment_length_s > 0.0 && duration_s > segment_length_s) {
-      count = static_cast<int>(std::ceil(duration_s / segment_length_s));
+      const std::optional<int> checked = CheckedCeil<int>(duration_s / segment_length_s);
+      if (!checked || *checked > kMaxBiasSegments) {
+        return Status::Error(fmt::format(
+            "params: {} = {} s cuts the {} s sequence into more than {} bias segments", field,
+            segment_length_s, duration_s, kMaxBiasSegments));
+      }
+      count = *checked;
     }
     t0_s = start_s;
     segment_s = count > 1 ? segment_length_s : 0.0;
     values.assign(count, {mean.x(), mean.y(), mean.z()});
+    return Status::Ok();
   }
   int size() const { return static_cast<int>(values.size()); }
   // Index of the segment at time t_s (clamped to the segments).
   int Index(double t_s) const {
     if (segment_s <= 0.0) return 0;
     const double i = std::floor((t_s - t0_s) / segment_s);
+    if (std::isnan(i)) return 0;
     return static_cast<int>(std::clamp(i, 0.0, static_cast<double>(size() - 1)));
   }
   double* Block(double t_s) { return values[Index(t_s)].data(); }

@@ -9,6 +9,7 @@
 #include <ceres/solver.h>
 #include <fmt/format.h>
 
+#include "common/io/atomic_file.h"
 #include "common/io/eigen_proto.h"
 #include "common/io/imu_stream.h"
 #include "common/io/provenance.h"
@@ -63,6 +64,11 @@ Status ReadCalibrateInputs(const CalibratePaths& paths, const proto::CalibratePa
   }
   if (!paths.gravity.empty()) {
     TILTCAL_RETURN_IF_ERROR(ReadTextProto(paths.gravity, &inputs->gravity));
+    if (inputs->gravity.has_gravity_flat()) {
+      TILTCAL_RETURN_IF_ERROR(
+          ValidateGravityFlat(inputs->gravity.gravity_flat_in_imu(), "gravity_flat_in_imu")
+              .WithContext(paths.gravity));
+    }
     inputs->has_gravity = true;
   }
   return Status::Ok();
@@ -341,11 +347,11 @@ void FillEstimate(const CalibrationState& state, const std::vector<std::string>&
 // A solve that failed outright (ceres FAILURE) or ended on a non-finite
 // cost leaves no usable estimate: an error, not a result.
 Status CheckSolveUsable(const OuterLoop& loop) {
-  if (loop.summary.termination_type == ceres::FAILURE) {
-    return Status::Error("the solve failed: " + loop.summary.message);
-  }
-  if (!std::isfinite(loop.summary.final_cost)) {
-    return Status::Error("the solve ended on a non-finite cost");
+  if (loop.summary.termination_type == ceres::FAILURE ||
+      !std::isfinite(loop.summary.final_cost)) {
+    return Status::Error(fmt::format("the solve failed (termination {}, final cost {}): {}",
+                                     loop.termination, loop.summary.final_cost,
+                                     loop.summary.message));
   }
   return Status::Ok();
 }
@@ -421,11 +427,17 @@ Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& pa
   // Grid over the IMU samples (IMU clock, t0 = first sample = 0).
   const double t0 = inputs.imu.front().time_s;
   const double duration = inputs.imu.back().time_s - t0;
+  if (!(duration <= params.spline().max_duration_s())) {
+    return Status::Error(fmt::format(
+        "imu: the stamps span {} s, more than spline.max_duration_s = {} s (a stamp far from "
+        "its neighbours?)",
+        duration, params.spline().max_duration_s()));
+  }
   CalibrationState state(
       spline::UniformKnotGrid::ForDuration(t0, duration, params.spline().knot_spacing_s()));
   state.gravity_norm_mps2 = params.gravity_norm_mps2();
-  state.SetBiasSegments(params.imu_noise().gyro_bias_segment_s(),
-                        params.imu_noise().accel_bias_segment_s());
+  TILTCAL_RETURN_IF_ERROR(state.SetBiasSegments(params.imu_noise().gyro_bias_segment_s(),
+                                                params.imu_noise().accel_bias_segment_s()));
   InitialisationReport init;
   TILTCAL_RETURN_IF_ERROR(Initialise(inputs, params, &state, &init, result, log));
 
@@ -486,6 +498,7 @@ Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& pa
 Status Run(const CalibratePaths& paths, const proto::CalibrateParams& params, std::ostream* log,
            proto::CalibrationResult* written) {
   const auto start = Clock::now();
+  TILTCAL_RETURN_IF_ERROR(CheckOutputPath(paths.out));
   CalibrateInputs inputs;
   TILTCAL_RETURN_IF_ERROR(ReadCalibrateInputs(paths, params, &inputs));
   const double read_s = Seconds(start);

@@ -2,7 +2,10 @@
 
 #include <string>
 
+#include <fmt/format.h>
+
 #include "common/io/params.h"
+#include "stages/calibrate/bias_segments.h"
 #include "stages/calibrate/default_params_text.h"
 
 namespace tiltcal::calibrate {
@@ -15,7 +18,19 @@ Status MustBePositive(double value, const std::string& field) {
 
 }  // namespace
 
+// 0 (one constant bias) or at least kMinBiasSegmentS: a bias is a slowly
+// wandering offset, and each segment is a parameter block of the solve.
+Status ValidateBiasSegment(double segment_s, const std::string& field) {
+  if (segment_s == 0.0 || segment_s >= kMinBiasSegmentS) return Status::Ok();
+  return Status::Error(fmt::format("params: {} = {} must be 0 (one constant bias) or at least {} s",
+                                   field, segment_s, kMinBiasSegmentS));
+}
+
 Status ValidateImuNoiseParams(const proto::ImuNoiseParams& params) {
+  TILTCAL_RETURN_IF_ERROR(
+      ValidateBiasSegment(params.gyro_bias_segment_s(), "imu_noise.gyro_bias_segment_s"));
+  TILTCAL_RETURN_IF_ERROR(
+      ValidateBiasSegment(params.accel_bias_segment_s(), "imu_noise.accel_bias_segment_s"));
   TILTCAL_RETURN_IF_ERROR(MustBePositive(params.gyro_sigma_radps(), "imu_noise.gyro_sigma_radps"));
   return MustBePositive(params.accel_sigma_mps2(), "imu_noise.accel_sigma_mps2");
 }

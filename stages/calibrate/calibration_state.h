@@ -75,11 +75,12 @@ struct CalibrationState {
   // Splits b_g and b_a into segments of gyro_segment_s and accel_segment_s
   // over the spline (0 = one segment), each at its current mean. Call before
   // a Problem refers to the state.
-  void SetBiasSegments(double gyro_segment_s, double accel_segment_s) {
+  Status SetBiasSegments(double gyro_segment_s, double accel_segment_s) {
     const double t0 = trajectory.grid().t0_s();
     const double duration = trajectory.grid().end_s() - t0;
-    gyro_bias.Split(t0, duration, gyro_segment_s);
-    accel_bias.Split(t0, duration, accel_segment_s);
+    TILTCAL_RETURN_IF_ERROR(
+        gyro_bias.Split(t0, duration, gyro_segment_s, "imu_noise.gyro_bias_segment_s"));
+    return accel_bias.Split(t0, duration, accel_segment_s, "imu_noise.accel_bias_segment_s");
   }
   // Every parameter block of b_g and b_a (3 doubles each).
   std::vector<double*> BiasBlocks() {

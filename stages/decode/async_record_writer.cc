@@ -74,13 +74,18 @@ Status AsyncRecordWriter::Submit(google::protobuf::Message* record) {
 }
 
 Status AsyncRecordWriter::Close() {
+  TILTCAL_RETURN_IF_ERROR(Finish());
+  return writer_.Close();
+}
+
+Status AsyncRecordWriter::Finish() {
   {
     std::unique_lock<std::mutex> lock(mutex_);
     changed_.wait(lock, [this] { return queue_.empty() && !busy_; });
   }
   Stop();
   TILTCAL_RETURN_IF_ERROR(error_);
-  return writer_.Close();
+  return writer_.Finish();
 }
 
 }  // namespace tiltcal

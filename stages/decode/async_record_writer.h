@@ -41,6 +41,10 @@ class AsyncRecordWriter {
   Status Submit(google::protobuf::Message* record);
   // Writes what is queued and closes the stream.
   Status Close();
+  // Writes every submitted record and completes the file under its
+  // temporary name, for CommitTogether({file(), ...}).
+  Status Finish();
+  AtomicFile* file() { return writer_.file(); }
 
  private:
   void Work();

@@ -6,13 +6,17 @@
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include <fmt/format.h>
 
 #include "bag/message_reader.h"
+#include "common/checked_conversion.h"
 #include "common/cli/command_line.h"
+#include "common/io/atomic_file.h"
 #include "common/io/provenance.h"
+#include "common/io/record_stream.h"
 #include "common/io/rig.h"
 #include "stages/decode/async_record_writer.h"
 #include "stages/decode/bag_input.h"
@@ -170,7 +174,8 @@ Status CheckPaths(const DecodePaths& paths) {
   if (paths.out_imu == paths.out_scans) {
     return Status::Error("--out_imu and --out_scans name the same file " + paths.out_imu);
   }
-  return Status::Ok();
+  TILTCAL_RETURN_IF_ERROR(CheckOutputPath(paths.out_imu));
+  return CheckOutputPath(paths.out_scans);
 }
 
 // Opens the bag and chooses its IMU and LiDAR topics (params, else rig, else
@@ -208,10 +213,20 @@ Status MakeReadOptions(const bag::MessageReader& reader, const proto::DecodePara
   int64_t bag_end_ns = 0;
   (void)reader.TimeRange(&bag_start_ns, &bag_end_ns);
   if (params.start_offset_s() <= 0 && params.duration_s() <= 0) return Status::Ok();
-  options->start_ns = bag_start_ns + std::llround(params.start_offset_s() * 1e9);
-  if (params.duration_s() > 0) {
-    options->end_ns = options->start_ns + std::llround(params.duration_s() * 1e9);
+  // The schema bounds both fields to 10^7 s (10^16 ns); checked here too
+  // for callers that bypass the params loader.
+  const std::optional<int64_t> offset_ns = SecondsToNs(params.start_offset_s());
+  const std::optional<int64_t> duration_ns = SecondsToNs(params.duration_s());
+  const std::optional<int64_t> start_ns =
+      offset_ns ? CheckedAdd(bag_start_ns, *offset_ns) : std::nullopt;
+  const std::optional<int64_t> end_ns =
+      start_ns && duration_ns ? CheckedAdd(*start_ns, *duration_ns) : std::nullopt;
+  if (!end_ns) {
+    return Status::Error(fmt::format("{}: start_offset_s {} and duration_s {} overflow the stamps",
+                                     reader.path(), params.start_offset_s(), params.duration_s()));
   }
+  options->start_ns = *start_ns;
+  if (params.duration_s() > 0) options->end_ns = *end_ns;
   if (options->start_ns > bag_end_ns) {
     return Status::Error(reader.path() + ": start_offset_s " +
                          std::to_string(params.start_offset_s()) +
@@ -262,6 +277,9 @@ Status Decode(const DecodePaths& paths, const proto::DecodeParams& params, std::
   const Clock::time_point t0 = Clock::now();
   DecodeSummary s;
   TILTCAL_RETURN_IF_ERROR(CheckPaths(paths));
+  // A run killed while committing its pair: finish that commit first.
+  TILTCAL_RETURN_IF_ERROR(CompleteInterruptedCommit(paths.out_imu));
+  TILTCAL_RETURN_IF_ERROR(CompleteInterruptedCommit(paths.out_scans));
   TILTCAL_RETURN_IF_ERROR(decode::ValidateDecodeParams(params).WithContext(
       paths.params.empty() ? "decode params" : paths.params));
   proto::Rig rig;
@@ -295,15 +313,16 @@ Status Decode(const DecodePaths& paths, const proto::DecodeParams& params, std::
   }
   TILTCAL_RETURN_IF_ERROR(CheckSomethingWritten(paths.bag, imu, s));
   imu.SortAndDropRepeatedStamps(&s);
+  TILTCAL_RETURN_IF_ERROR(imu.CheckStampGaps(params.max_stamp_gap_s()));
   TILTCAL_RETURN_IF_ERROR(CheckStampsAndUnits(paths, params, rig, imu, scans, &s));
   proto::Provenance imu_provenance = provenance;
   for (const std::string& note : s.imu_notes) imu_provenance.add_notes(note);
+  RecordWriter imu_writer;
   TILTCAL_RETURN_IF_ERROR(
-      imu.Write(paths.out_imu, imu_provenance, s.accel_to_si, s.gyro_to_si, &s));
-  if (Status status = scans_writer.Close(); !status.ok()) {
-    std::remove(paths.out_imu.c_str());  // both outputs or none
-    return status;
-  }
+      imu.Write(paths.out_imu, imu_provenance, s.accel_to_si, s.gyro_to_si, &imu_writer, &s));
+  TILTCAL_RETURN_IF_ERROR(scans_writer.Finish());
+  // Both outputs or neither, also when the process is killed meanwhile.
+  TILTCAL_RETURN_IF_ERROR(CommitTogether({imu_writer.file(), scans_writer.file()}));
   s.chunks_decompressed = reader.chunks_decompressed();
   s.wall_s = std::chrono::duration<double>(Clock::now() - t0).count();
   PrintSummary(log, paths, params.lidar_stamp_shift_s(), s);

@@ -7,6 +7,7 @@
 
 #include "bag/ros1/messages.h"
 #include "bag/ros2/messages.h"
+#include "common/checked_conversion.h"
 #include "common/io/record_stream.h"
 #include "tiltcal/proto/imu.pb.h"
 
@@ -67,6 +68,10 @@ Status ImuSink::Add(const bag::Message& m, DecodeSummary* s) {
   Record r;
   r.stamp_ns = bag::RosTimeToNs(message_.header.stamp);
   r.record_ns = m.time_ns;
+  if (r.stamp_ns == 0) {
+    return Status::Error(MessageContext(bag_, m, index) +
+                         ": sensor_msgs/Imu header stamp is 0 (never set by its driver)");
+  }
   for (int i = 0; i < 3; ++i) {
     r.angular_velocity[i] = message_.angular_velocity[i];
     r.linear_acceleration[i] = message_.linear_acceleration[i];
@@ -145,17 +150,31 @@ decode::StampSpan ImuSink::Span() const {
   return span;
 }
 
+Status ImuSink::CheckStampGaps(double max_gap_s) const {
+  for (size_t i = 1; i < samples_.size(); ++i) {
+    const double gap_s = DifferenceSeconds(samples_[i].stamp_ns, samples_[i - 1].stamp_ns);
+    if (gap_s > max_gap_s) {
+      return Status::Error(fmt::format(
+          "{}: IMU stamps jump by {:.3f} s from {} s to {} s (sample {} in stamp order, record "
+          "time {} s), more than max_stamp_gap_s = {} s",
+          bag_, gap_s, FormatSeconds(samples_[i - 1].stamp_ns), FormatSeconds(samples_[i].stamp_ns),
+          i, FormatSeconds(samples_[i].record_ns), max_gap_s));
+    }
+  }
+  return Status::Ok();
+}
+
 Status ImuSink::Write(const std::string& path, const proto::Provenance& provenance,
-                      double accel_to_si, double gyro_to_si, DecodeSummary* s) {
-  RecordWriter writer;
-  TILTCAL_RETURN_IF_ERROR(writer.Open(path, proto::ImuSample::descriptor()->full_name(),
-                                      provenance, /*compress=*/false));
+                      double accel_to_si, double gyro_to_si, RecordWriter* writer,
+                      DecodeSummary* s) {
+  TILTCAL_RETURN_IF_ERROR(writer->Open(path, proto::ImuSample::descriptor()->full_name(),
+                                       provenance, /*compress=*/false));
   proto::ImuSample sample;
   for (const Record& r : samples_) {
     ToSample(r, accel_to_si, gyro_to_si, &sample);
-    TILTCAL_RETURN_IF_ERROR(writer.Write(sample));
+    TILTCAL_RETURN_IF_ERROR(writer->Write(sample));
   }
-  TILTCAL_RETURN_IF_ERROR(writer.Close());
+  TILTCAL_RETURN_IF_ERROR(writer->Finish());
   s->imu_written = static_cast<int64_t>(samples_.size());
   return Status::Ok();
 }
@@ -197,6 +216,10 @@ Status ScanSink::Convert(const bag::Message& m, int64_t index, proto::Scan* scan
   if (!status.ok()) {
     return status.WithContext(MessageContext(bag_, m, index) + ": " + PointCloud2TypeName(m));
   }
+  if (scan->stamp_ns() == 0) {
+    return Status::Error(MessageContext(bag_, m, index) +
+                         ": sensor_msgs/PointCloud2 header stamp is 0 (never set by its driver)");
+  }
   scan->set_stamp_ns(scan->stamp_ns() + stamp_shift_ns_);
   s->points_dropped_invalid += scan->num_dropped_invalid();
   s->points_dropped_range += scan->num_dropped_zero_range();
@@ -222,6 +245,15 @@ Status ScanSink::Convert(const bag::Message& m, int64_t index, proto::Scan* scan
     }
     ++s->scans_non_monotonic_dropped;
     return Status::Ok();
+  }
+  if (s->scans_written > 0 &&
+      DifferenceSeconds(scan->stamp_ns(), last_stamp_ns_) > params_.max_stamp_gap_s()) {
+    return Status::Error(fmt::format(
+        "{}: scan stamp {} s is {:.3f} s after the previous scan's {} s, more than "
+        "max_stamp_gap_s = {} s",
+        MessageContext(bag_, m, index), FormatSeconds(scan->stamp_ns()),
+        DifferenceSeconds(scan->stamp_ns(), last_stamp_ns_), FormatSeconds(last_stamp_ns_),
+        params_.max_stamp_gap_s()));
   }
   last_stamp_ns_ = scan->stamp_ns();
   scan->set_index(static_cast<uint32_t>(s->scans_written));

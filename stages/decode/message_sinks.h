@@ -49,10 +49,15 @@ class ImuSink {
   std::vector<imu::ImuReading> Readings() const;
   decode::StampSpan Span() const;
 
+  // After SortAndDropRepeatedStamps: an error naming the sample when two
+  // consecutive stamps are more than max_gap_s apart.
+  Status CheckStampGaps(double max_gap_s) const;
+
   // After SortAndDropRepeatedStamps: writes the stream with the specific
-  // force multiplied by accel_to_si and the angular velocity by gyro_to_si.
+  // force multiplied by accel_to_si and the angular velocity by gyro_to_si
+  // through *writer, finished under its temporary name (not committed).
   Status Write(const std::string& path, const proto::Provenance& provenance, double accel_to_si,
-               double gyro_to_si, DecodeSummary* s);
+               double gyro_to_si, RecordWriter* writer, DecodeSummary* s);
 
  private:
   // One IMU sample kept until the end.

@@ -3,7 +3,10 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <optional>
 #include <type_traits>
+
+#include "common/checked_conversion.h"
 
 namespace tiltcal {
 
@@ -476,12 +479,22 @@ Status ConvertGeneric(const PointCloud2View& cloud, const CloudLayout& layout,
                              " s from header.stamp; offsets must stay within +-2.147 s "
                              "(point times in another clock than the stamp?)");
       }
+      if (out.ring != nullptr) {
+        // A float or signed ring field may hold what no ring number is.
+        const double ring = layout.ring.Get(p, swap);
+        const std::optional<uint32_t> checked = CheckedTruncate<uint32_t>(ring);
+        if (!checked) {
+          return Status::Error("point " + std::to_string(r * width + c) + ": its ring (field '" +
+                               layout.ring.name + "') is " + std::to_string(ring) +
+                               ", not a ring number");
+        }
+        out.ring[k] = *checked;
+      }
       out.x[k] = x;
       out.y[k] = y;
       out.z[k] = z;
       out.intensity[k] =
           layout.intensity.present ? static_cast<float>(layout.intensity.Get(p, swap)) : 0.0f;
-      if (out.ring != nullptr) out.ring[k] = static_cast<uint32_t>(layout.ring.Get(p, swap));
       out.time_offset_ns[k] = static_cast<int32_t>(offset_ns);
       ++k;
     }
@@ -489,6 +502,45 @@ Status ConvertGeneric(const PointCloud2View& cloud, const CloudLayout& layout,
   result->count = k;
   *source = time.source();
   return Status::Ok();
+}
+
+// True when `text` is well-formed UTF-8 (no overlong forms, surrogates or
+// code points above U+10FFFF), as a protobuf string field must be: a
+// Scan with another frame_id would be written but could not be read back.
+bool IsValidUtf8(const std::string& text) {
+  const auto* s = reinterpret_cast<const unsigned char*>(text.data());
+  const size_t n = text.size();
+  for (size_t i = 0; i < n;) {
+    const unsigned char c = s[i];
+    size_t length = 0;
+    uint32_t code = 0;
+    if (c < 0x80) {
+      ++i;
+      continue;
+    } else if ((c & 0xE0) == 0xC0) {
+      length = 2;
+      code = c & 0x1F;
+    } else if ((c & 0xF0) == 0xE0) {
+      length = 3;
+      code = c & 0x0F;
+    } else if ((c & 0xF8) == 0xF0) {
+      length = 4;
+      code = c & 0x07;
+    } else {
+      return false;
+    }
+    if (i + length > n) return false;
+    for (size_t k = 1; k < length; ++k) {
+      if ((s[i + k] & 0xC0) != 0x80) return false;
+      code = (code << 6) | (s[i + k] & 0x3F);
+    }
+    const uint32_t smallest[5] = {0, 0, 0x80, 0x800, 0x10000};
+    if (code < smallest[length] || code > 0x10FFFF || (code >= 0xD800 && code <= 0xDFFF)) {
+      return false;
+    }
+    i += length;
+  }
+  return true;
 }
 
 // Clears `scan` and sets the fields known before the points are read.
@@ -548,6 +600,9 @@ std::string DescribeFields(const PointCloud2View& cloud) {
 
 Status ConvertPointCloud2ToScan(const PointCloud2View& cloud,
                                 const PointConversionOptions& options, proto::Scan* scan) {
+  if (!IsValidUtf8(cloud.header.frame_id)) {
+    return Status::Error("header.frame_id is not valid UTF-8");
+  }
   ResetScan(cloud, scan);
   CloudLayout layout;
   TILTCAL_RETURN_IF_ERROR(FindLayout(cloud, &layout));

@@ -6,8 +6,10 @@
 
 #include <fmt/format.h>
 
+#include "common/checked_conversion.h"
 #include "common/imu/gyro_integrator.h"
 #include "common/imu/imu_initialisation.h"
+#include "common/io/atomic_file.h"
 #include "common/io/eigen_proto.h"
 #include "common/io/imu_stream.h"
 #include "common/io/provenance.h"
@@ -73,8 +75,7 @@ void AddInclinationSamples(const GravityInputs& inputs, const imu::ImuInitialisa
   const Eigen::Vector3d up_in_world = -init.gravity_in_world_mps2.normalized();
   const Eigen::Quaterniond imu_from_lidar = ToEigen(inputs.rig.imu_from_lidar().rotation());
   for (const proto::GroundPlane& plane : inputs.ground) {
-    const double t = static_cast<double>(plane.stamp_ns() - inputs.first_imu_stamp_ns) * 1e-9 +
-                     time_offset_s;
+    const double t = DifferenceSeconds(plane.stamp_ns(), inputs.first_imu_stamp_ns) + time_offset_s;
     const Eigen::Vector3d up_in_imu = attitude.Rotation(t).conjugate() * up_in_world;
     proto::InclinationSample* sample = out->add_inclination();
     sample->set_stamp_ns(plane.stamp_ns());
@@ -220,11 +221,46 @@ void LogSummary(const proto::GravityReference& out, const proto::GravityParams& 
 
 }  // namespace
 
+namespace {
+
+// A valid plane's normal is a unit vector: NaN or zero normals (a corrupt
+// or hand-made file) are an error naming the file and the record, not a
+// slope of NaN in the percentile or a level ground.
+Status CheckGroundNormals(const std::string& path, const std::vector<proto::GroundPlane>& planes) {
+  for (size_t i = 0; i < planes.size(); ++i) {
+    if (!planes[i].valid()) continue;
+    const double norm = ToEigen(planes[i].normal_in_lidar()).norm();
+    if (!(std::fabs(norm - 1.0) <= 1e-3)) {
+      return Status::Error(fmt::format(
+          "{}: record {}: normal_in_lidar of a valid plane has norm {} (a unit vector expected)",
+          path, i, norm));
+    }
+  }
+  return Status::Ok();
+}
+
+// The flat calibration's g_a must be a gravity: present, finite, its norm
+// within the rig's bounds for g_f.
+Status CheckCalibrationGravity(const std::string& path,
+                               const proto::CalibrationResult& calibration) {
+  const double g = ToEigen(calibration.gravity_in_world()).norm();
+  if (!calibration.has_gravity_in_world() || !(g >= kRigMinGravityMps2 && g <= kRigMaxGravityMps2)) {
+    return Status::Error(fmt::format(
+        "{}: gravity_in_world has norm {} (missing or not a gravity in m/s², expected {} to {})",
+        path, g, kRigMinGravityMps2, kRigMaxGravityMps2));
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
 Status Run(const GravityPaths& paths, const proto::GravityParams& params, std::ostream* log) {
+  TILTCAL_RETURN_IF_ERROR(CheckOutputPath(paths.out));
   GravityInputs inputs;
   TILTCAL_RETURN_IF_ERROR(ReadImuReadings(paths.imu, &inputs.imu, &inputs.first_imu_stamp_ns));
   if (!paths.ground.empty()) {
     TILTCAL_RETURN_IF_ERROR(ReadAllRecords<proto::GroundPlane>(paths.ground, &inputs.ground));
+    TILTCAL_RETURN_IF_ERROR(CheckGroundNormals(paths.ground, inputs.ground));
   }
   TILTCAL_RETURN_IF_ERROR(LoadRig(paths.rig, &inputs.rig));
   TILTCAL_RETURN_IF_ERROR(ReadDatasetReference(paths.rig, inputs.rig, &inputs.dataset_reference,
@@ -232,6 +268,7 @@ Status Run(const GravityPaths& paths, const proto::GravityParams& params, std::o
   proto::CalibrationResult calibration;
   if (!paths.calibration.empty()) {
     TILTCAL_RETURN_IF_ERROR(ReadTextProto(paths.calibration, &calibration));
+    TILTCAL_RETURN_IF_ERROR(CheckCalibrationGravity(paths.calibration, calibration));
     inputs.flat_calibration = &calibration;
   }
 

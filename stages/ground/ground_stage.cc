@@ -13,6 +13,7 @@
 #include "common/imu/gyro_integrator.h"
 #include "common/imu/imu_reading.h"
 #include "common/imu/static_detection.h"
+#include "common/io/atomic_file.h"
 #include "common/io/eigen_proto.h"
 #include "common/io/imu_stream.h"
 #include "common/io/provenance.h"
@@ -165,6 +166,8 @@ Status Run(const GroundPaths& paths, const proto::GroundParams& params, std::ost
       paths.imu.empty()) {
     return Status::Error("--imu, --scans, --rig and --out_ground are required");
   }
+  TILTCAL_RETURN_IF_ERROR(CheckOutputPath(paths.out_ground));
+  if (!paths.out_scans.empty()) TILTCAL_RETURN_IF_ERROR(CheckOutputPath(paths.out_scans));
   proto::Rig rig;
   TILTCAL_RETURN_IF_ERROR(LoadRig(paths.rig, &rig));
   ImuAttitude attitude;

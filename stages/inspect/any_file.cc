@@ -55,6 +55,7 @@ Status OpenAnyFile(const std::string& path, AnyFile* file) {
   TILTCAL_RETURN_IF_ERROR(ReadFileHead(path, 16, &contents));
   if (!StartsLikeStream(contents)) {
     TILTCAL_RETURN_IF_ERROR(ReadFileToString(path, &contents));
+    if (contents.empty()) return Status::Error(path + ": empty file");
     return ParseTextAsAnyType(path, contents, file);
   }
   RecordReader reader;

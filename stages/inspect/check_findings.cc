@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include "common/checked_conversion.h"
 #include "common/io/eigen_proto.h"
 #include "common/io/static_detection_params.h"
 #include "stages/inspect/calibration_notes.h"
@@ -17,7 +18,7 @@ namespace {
 
 // Seconds between two ns stamps.
 double SecondsBetween(int64_t from_ns, int64_t to_ns) {
-  return 1e-9 * static_cast<double>(to_ns - from_ns);
+  return DifferenceSeconds(to_ns, from_ns);
 }
 
 double MedianDifferenceS(const std::vector<int64_t>& a_ns, const std::vector<int64_t>& b_ns) {

@@ -5,6 +5,7 @@
 
 #include <google/protobuf/text_format.h>
 
+#include "common/checked_conversion.h"
 #include "stages/inspect/any_file.h"
 #include "stages/inspect/csv_table.h"
 #include "tiltcal/proto/ground.pb.h"
@@ -45,7 +46,7 @@ class StreamStats {
   void Print(std::ostream& out) const {
     out << "records: " << count_ << "\n";
     if (has_stamps_ && count_ > 0) {
-      const double span_s = (last_ns_ - first_ns_) * 1e-9;
+      const double span_s = DifferenceSeconds(last_ns_, first_ns_);
       out << "stamps: " << first_ns_ << " .. " << last_ns_ << " ns (span "
           << FormatDouble(span_s) << " s";
       if (count_ > 1 && span_s > 0) out << ", " << FormatDouble((count_ - 1) / span_s) << " Hz";

@@ -1,5 +1,8 @@
 // tiltcal_inspect: looks into any file of the pipeline.
+#include <cerrno>
+#include <cstring>
 #include <iostream>
+#include <string>
 
 #include "common/cli/command_line.h"
 #include "common/io/params.h"
@@ -13,6 +16,14 @@ namespace {
 
 using tiltcal::Status;
 using tiltcal::cli::CommandLine;
+
+// Flushes std::cout: a table cut short (a full disk behind `> ground.csv`)
+// is a failure, not exit 0.
+Status FlushStdout() {
+  std::cout.flush();
+  if (std::cout) return Status::Ok();
+  return Status::Error(std::string("standard output: cannot write: ") + std::strerror(errno));
+}
 
 // `check --bag=... [--rig=...] [--params=...]`: the pre-flight check of a bag.
 Status RunCheckCommand(const CommandLine& cli) {
@@ -35,6 +46,7 @@ Status RunCommand(const CommandLine& cli, const std::string& command, const std:
   if (command == "csv") {
     const bool points = cli.GetSwitch("points");
     TILTCAL_RETURN_IF_ERROR(inspect::RunCsv(path, {points, record, cli.Get("field")}, std::cout));
+    TILTCAL_RETURN_IF_ERROR(FlushStdout());
     // ground.binpb: rejected scans by reason on stderr (the table stays clean).
     return points ? Status::Ok() : inspect::PrintGroundSummary(path, std::cerr);
   }
@@ -88,8 +100,7 @@ int main(int argc, char** argv) {
     return tiltcal::cli::kExitUsage;
   }
   std::ios::sync_with_stdio(false);
-  const Status status = check ? RunCheckCommand(cli)
-                                           : RunCommand(cli, command, cli.positional()[1]);
-  std::cout.flush();
+  Status status = check ? RunCheckCommand(cli) : RunCommand(cli, command, cli.positional()[1]);
+  if (status.ok()) status = FlushStdout();
   return cli.Finish(status);
 }

@@ -6,6 +6,7 @@
 #include <pcl/PCLPointCloud2.h>
 #include <pcl/io/pcd_io.h>
 
+#include "common/io/atomic_file.h"
 #include "common/io/record_stream.h"
 #include "tiltcal/proto/ground.pb.h"
 #include "tiltcal/proto/scan.pb.h"
@@ -128,19 +129,16 @@ pcl::PCLPointCloud2 MakeCloud(const proto::Scan& scan, const proto::GroundPlane*
   return cloud;
 }
 
-// Writes `cloud` as a binary PCD to a temporary name and renames it.
+// Writes `cloud` as a binary PCD (PCL's header, then the packed points as
+// PCDWriter::writeBinary lays them out) through WriteFileAtomically: a write
+// error (a full disk) is reported, never a signal from a memory map.
 Status WritePcdAtomically(const std::string& path, const pcl::PCLPointCloud2& cloud) {
-  const std::string temp = path + ".tmp";
   pcl::PCDWriter writer;
-  if (writer.writeBinary(temp, cloud) != 0) {
-    std::remove(temp.c_str());
-    return Status::Error(path + ": cannot write the PCD");
-  }
-  if (std::rename(temp.c_str(), path.c_str()) != 0) {
-    std::remove(temp.c_str());
-    return Status::Error(path + ": cannot rename the temporary PCD");
-  }
-  return Status::Ok();
+  std::string contents =
+      writer.generateHeaderBinary(cloud, Eigen::Vector4f::Zero(), Eigen::Quaternionf::Identity());
+  contents += "DATA binary\n";
+  contents.append(reinterpret_cast<const char*>(cloud.data.data()), cloud.data.size());
+  return WriteFileAtomically(path, contents);
 }
 
 }  // namespace
@@ -148,6 +146,7 @@ Status WritePcdAtomically(const std::string& path, const pcl::PCLPointCloud2& cl
 Status RunPcd(const std::string& scans_path, const PcdOptions& options, std::ostream& log) {
   if (options.out_path.empty()) return Status::Error("pcd needs --out=FILE.pcd");
   if (options.record < 0) return Status::Error("pcd: --record must be >= 0");
+  TILTCAL_RETURN_IF_ERROR(CheckOutputPath(options.out_path));
   proto::Scan scan;
   TILTCAL_RETURN_IF_ERROR(ReadScan(scans_path, options.record, &scan));
   proto::GroundPlane plane;

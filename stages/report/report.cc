@@ -238,10 +238,32 @@ std::string FormatCsv(const Repeatability& r) {
   return out;
 }
 
+namespace {
+
+// Reads a calibration or a truth file whose extrinsic and time offset go
+// into the statistics: a file without them, or with a NaN, Inf or a
+// non-unit quaternion, is an error naming the file and the field (it would
+// turn the mean and σ into garbage).
+template <typename Answer>
+Status ReadCalibrationAnswer(const std::string& path, Answer* answer) {
+  TILTCAL_RETURN_IF_ERROR(ReadTextProto(path, answer));
+  TILTCAL_RETURN_IF_ERROR(ValidateImuFromLidar(answer->has_imu_from_lidar(),
+                                               answer->mutable_imu_from_lidar(), "imu_from_lidar")
+                              .WithContext(path));
+  if (!std::isfinite(answer->time_offset_s())) {
+    return Status::Error(path + ": time_offset_s is not finite");
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
 Status Run(const ReportPaths& paths, std::ostream* log) {
   if (paths.sequence_dirs.empty()) {
     return Status::Error("no sequence directories given");
   }
+  TILTCAL_RETURN_IF_ERROR(CheckOutputPath(paths.out));
+  if (!paths.out_csv.empty()) TILTCAL_RETURN_IF_ERROR(CheckOutputPath(paths.out_csv));
   std::vector<SequenceResult> results;
   std::vector<std::string> suspect_set_aside;
   for (const std::string& dir : paths.sequence_dirs) {
@@ -252,10 +274,10 @@ Status Run(const ReportPaths& paths, std::ostream* log) {
       suspect_set_aside.push_back(dir + "/calibration.suspect.txtpb");
       continue;
     }
-    TILTCAL_RETURN_IF_ERROR(ReadTextProto(dir + "/calibration.txtpb", &result.calibration));
+    TILTCAL_RETURN_IF_ERROR(ReadCalibrationAnswer(dir + "/calibration.txtpb", &result.calibration));
     if (std::filesystem::exists(dir + "/truth.txtpb")) {
       result.truth.emplace();
-      TILTCAL_RETURN_IF_ERROR(ReadTextProto(dir + "/truth.txtpb", &*result.truth));
+      TILTCAL_RETURN_IF_ERROR(ReadCalibrationAnswer(dir + "/truth.txtpb", &*result.truth));
     }
     results.push_back(std::move(result));
   }

@@ -12,9 +12,10 @@
 
 #include "bag/ros1/bag_writer.h"
 #include "bag/ros1/message_encoding.h"
+#include "common/cli/command_line.h"
 #include "common/geometry/euler_angles.h"
 #include "common/imu/imu_units.h"
-#include "common/cli/command_line.h"
+#include "common/io/atomic_file.h"
 #include "common/io/eigen_proto.h"
 #include "common/io/provenance.h"
 #include "common/io/text_proto.h"
@@ -562,6 +563,9 @@ Status Run(const SimulatePaths& paths, const proto::SimulateParams& params, std:
   if (paths.out_bag.empty() || paths.out_truth.empty()) {
     return Status::Error("--out_bag and --out_truth are required");
   }
+  TILTCAL_RETURN_IF_ERROR(CheckOutputPath(paths.out_bag));
+  TILTCAL_RETURN_IF_ERROR(CheckOutputPath(paths.out_truth));
+  if (!paths.out_rig.empty()) TILTCAL_RETURN_IF_ERROR(CheckOutputPath(paths.out_rig));
   Scenario scenario;
   const Status built = BuildScenario(params, &scenario);
   if (!built.ok()) return paths.params.empty() ? built : built.WithContext(paths.params);

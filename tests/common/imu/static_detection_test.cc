@@ -1,5 +1,10 @@
 #include "common/imu/static_detection.h"
 
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
 #include <gtest/gtest.h>
 
 #include "tests/common/imu/synthetic_imu.h"
@@ -51,6 +56,115 @@ TEST(StaticDetection, ShortStillnessIsIgnored) {
       Eigen::Quaterniond::Identity(), {0, 0, -9.81}, Eigen::Vector3d::Zero(), 0.001, 0.01,
       nullptr);
   EXPECT_FALSE(DetectStaticStart(readings, {}).found);
+}
+
+// The detector before it stepped over empty windows: every window of the
+// span, one hop at a time (O(span / hop)). The reference for the tests below.
+std::vector<StaticInterval> EveryWindowReference(const std::vector<ImuReading>& samples,
+                                                 const StaticDetectionOptions& options) {
+  std::vector<StaticInterval> intervals;
+  auto lower = [&](double t) {
+    return static_cast<size_t>(
+        std::lower_bound(samples.begin(), samples.end(), t,
+                         [](const ImuReading& s, double v) { return s.time_s < v; }) -
+        samples.begin());
+  };
+  auto stats = [&](size_t begin, size_t end) {
+    StaticInterval s;
+    s.begin_index = begin;
+    s.end_index = end;
+    const double n = static_cast<double>(end - begin);
+    for (size_t i = begin; i < end; ++i) {
+      s.mean_gyro_radps += samples[i].angular_velocity_radps / n;
+      s.mean_accel_mps2 += samples[i].linear_acceleration_mps2 / n;
+    }
+    Eigen::Vector3d gv = Eigen::Vector3d::Zero(), av = Eigen::Vector3d::Zero();
+    for (size_t i = begin; i < end; ++i) {
+      gv += (samples[i].angular_velocity_radps - s.mean_gyro_radps).cwiseAbs2();
+      av += (samples[i].linear_acceleration_mps2 - s.mean_accel_mps2).cwiseAbs2();
+    }
+    s.gyro_std_radps = std::sqrt(gv.maxCoeff() / n);
+    s.accel_std_mps2 = std::sqrt(av.maxCoeff() / n);
+    return s;
+  };
+  bool in_run = false;
+  double run_begin = 0, run_end = 0;
+  auto close_run = [&] {
+    if (in_run && run_end - run_begin >= options.min_duration_s) {
+      StaticInterval interval = stats(lower(run_begin), lower(run_end));
+      interval.begin_s = run_begin;
+      interval.end_s = run_end;
+      intervals.push_back(interval);
+    }
+    in_run = false;
+  };
+  const double t0 = samples.front().time_s;
+  for (int64_t k = 0;; ++k) {
+    const double begin_t = t0 + static_cast<double>(k) * options.hop_s;
+    const double end_t = begin_t + options.window_s;
+    if (end_t > samples.back().time_s + 1e-12) break;
+    const size_t begin = lower(begin_t), end = lower(end_t);
+    bool is_static = false;
+    if (end >= begin + 2) {
+      const StaticInterval s = stats(begin, end);
+      is_static = s.gyro_std_radps <= options.max_gyro_std_radps &&
+                  s.accel_std_mps2 <= options.max_accel_std_mps2 &&
+                  s.mean_gyro_radps.norm() <= options.max_gyro_mean_radps;
+    }
+    if (is_static) {
+      if (!in_run) run_begin = begin_t;
+      in_run = true;
+      run_end = end_t;
+    } else {
+      close_run();
+    }
+  }
+  close_run();
+  return intervals;
+}
+
+void ExpectSameIntervals(const std::vector<StaticInterval>& a,
+                         const std::vector<StaticInterval>& b) {
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].begin_index, b[i].begin_index) << i;
+    EXPECT_EQ(a[i].end_index, b[i].end_index) << i;
+    EXPECT_EQ(a[i].begin_s, b[i].begin_s) << i;
+    EXPECT_EQ(a[i].end_s, b[i].end_s) << i;
+  }
+}
+
+// Still 3 s, turning 3 s, still 2 s, turning, as above.
+std::vector<ImuReading> StillAndTurning(double duration_s) {
+  return testing::SyntheticImu(200, duration_s, Omega, Eigen::Quaterniond::Identity(),
+                               {0, 0, -9.81}, Eigen::Vector3d::Zero(), 0.001, 0.01, nullptr);
+}
+
+TEST(StaticDetection, GapsGiveTheSameIntervalsAsEveryWindow) {
+  // Two recordings 500 s apart (10^4 hops in the gap): the windows without
+  // samples that are stepped over change nothing.
+  std::vector<ImuReading> readings = StillAndTurning(9);
+  for (ImuReading r : StillAndTurning(9)) {
+    r.time_s += 500.0;
+    readings.push_back(r);
+  }
+  const auto intervals = DetectStaticIntervals(readings, {});
+  EXPECT_EQ(intervals.size(), 4u);
+  ExpectSameIntervals(intervals, EveryWindowReference(readings, {}));
+}
+
+TEST(StaticDetection, StampFarInTheFutureIsBoundedWork) {
+  // One sample at the end of uint32 seconds (2^32 − 1 s: 4·10^10 hops of
+  // 0.1 s, hours for a loop over every window): the same intervals as with
+  // that sample 100 s after the others, where every window can be tried.
+  std::vector<ImuReading> readings = StillAndTurning(9);
+  readings.push_back(readings.back());
+  readings.back().time_s = 100.0;
+  const auto reference = EveryWindowReference(readings, {});
+  EXPECT_EQ(reference.size(), 2u);
+  readings.back().time_s = 4294967295.0;
+  ASSERT_TRUE(ValidateImuReadings(readings).ok());
+  ExpectSameIntervals(DetectStaticIntervals(readings, {}), reference);
 }
 
 TEST(ImuReadings, ValidationNamesTheSample) {

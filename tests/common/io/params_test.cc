@@ -20,7 +20,8 @@ Status LoadFromText(const std::string& text, google::protobuf::Message* params) 
 
 TEST(Params, ValidFileLoads) {
   proto::DecodeParams params;
-  const Status status = LoadFromText("min_range_m: 0.5\nchunk_cache_size: 4\n", &params);
+  const Status status =
+      LoadFromText("min_range_m: 0.5\nchunk_cache_size: 4\nmax_stamp_gap_s: 60\n", &params);
   ASSERT_TRUE(status.ok()) << status.message();
   EXPECT_DOUBLE_EQ(params.min_range_m(), 0.5);
 }
@@ -95,11 +96,13 @@ namespace {
 TEST(Params, MissingPathMeansTheDefaultText) {
   proto::DecodeParams params;
   const Status status =
-      LoadParamsOrDefaults("", "min_range_m: 0.25\nchunk_cache_size: 4\n", &params);
+      LoadParamsOrDefaults("", "min_range_m: 0.25\nchunk_cache_size: 4\nmax_stamp_gap_s: 60\n",
+                           &params);
   ASSERT_TRUE(status.ok()) << status.message();
   EXPECT_DOUBLE_EQ(params.min_range_m(), 0.25);
   const Status bad =
-      LoadParamsOrDefaults("", "min_range_m: -1\nchunk_cache_size: 4\n", &params);
+      LoadParamsOrDefaults("", "min_range_m: -1\nchunk_cache_size: 4\nmax_stamp_gap_s: 60\n",
+                           &params);
   ASSERT_FALSE(bad.ok());
   EXPECT_NE(bad.message().find("default DecodeParams: field min_range_m = -1"),
             std::string::npos)

@@ -2,6 +2,7 @@
 // runs on a value the file does not show), and each cross-field rule rejects
 // its violation with an error naming the field.
 
+#include <cmath>
 #include <string>
 #include <utility>
 
@@ -10,6 +11,8 @@
 #include <gtest/gtest.h>
 
 #include "common/io/atomic_file.h"
+#include "stages/calibrate/bias_segments.h"
+#include "stages/calibrate/calibrate.h"
 #include "stages/calibrate/calibrate_params_validation.h"
 #include "stages/calibrate/default_params_text.h"
 #include "tests/stages/calibrate/calibrate_params_text.h"
@@ -81,6 +84,8 @@ TEST(CalibrateParamsTest, EachRuleNamesItsField) {
   const std::pair<const char*, const char*> cases[] = {
       {"imu_noise { gyro_sigma_radps: 0 }", "imu_noise.gyro_sigma_radps"},
       {"imu_noise { accel_sigma_mps2: 0 }", "imu_noise.accel_sigma_mps2"},
+      {"imu_noise { gyro_bias_segment_s: 1e-300 }", "imu_noise.gyro_bias_segment_s = 1e-300"},
+      {"imu_noise { accel_bias_segment_s: 0.5 }", "imu_noise.accel_bias_segment_s = 0.5"},
       {"scans { min_range_m: 5 max_range_m: 5 }", "scans.max_range_m"},
       {"lidar { sigma_m: 0 }", "lidar.sigma_m"},
       {"init { odometry_position_sigma_m: 0 }", "init.odometry_position_sigma_m"},
@@ -104,6 +109,34 @@ TEST(CalibrateParamsTest, EachRuleNamesItsField) {
     const std::string message = ErrorWith(override_text);
     EXPECT_NE(message.find(field), std::string::npos) << override_text << ": " << message;
   }
+}
+
+// One IMU stamp far in the future (2^32 − 1 s) would make the knot grid and
+// the static detection span 136 years: refused before any knot is made.
+TEST(CalibrateParamsTest, ImuSpanBeyondMaxDurationIsRefused) {
+  CalibrateInputs inputs;
+  inputs.imu.resize(20);
+  for (size_t i = 0; i < inputs.imu.size(); ++i) inputs.imu[i].time_s = 0.005 * i;
+  inputs.imu.back().time_s = 4294967295.0;
+  proto::CalibrationResult result;
+  const Status status = Calibrate(inputs, tiltcal::testing::DefaultCalibrateParamsWith(), &result,
+                                  nullptr, nullptr);
+  ASSERT_FALSE(status.ok());
+  EXPECT_NE(status.message().find("more than spline.max_duration_s = 3600 s"), std::string::npos)
+      << status.message();
+}
+
+TEST(CalibrateParamsTest, BiasSegmentsBeyondTheirCountAreAnErrorNotACrash) {
+  BiasSegments bias;
+  const Status too_many = bias.Split(0.0, 4294967295.0, 1.0, "imu_noise.gyro_bias_segment_s");
+  ASSERT_FALSE(too_many.ok());
+  EXPECT_NE(too_many.message().find("imu_noise.gyro_bias_segment_s = 1 s"), std::string::npos)
+      << too_many.message();
+  EXPECT_EQ(bias.size(), 1);  // left as it was
+  EXPECT_FALSE(bias.Split(0.0, 1e300, 1e-300, "f").ok());  // the count overflows an int
+  ASSERT_TRUE(bias.Split(0.0, 60.0, 10.0, "f").ok());
+  EXPECT_EQ(bias.size(), 6);
+  EXPECT_EQ(bias.Index(std::nan("")), 0);
 }
 
 }  // namespace

@@ -199,7 +199,7 @@ double WorstAccelBiasSegmentError(double segment_s, const Eigen::Vector3d& accel
   const std::vector<imu::ImuReading> imu = Imu(gyro_bias, accel_bias, &rng, drift);
   const spline::UniformKnotGrid grid = spline::UniformKnotGrid::ForDuration(0.0, kDuration, 0.05);
   CalibrationState state(grid);
-  state.SetBiasSegments(0.0, segment_s);
+  EXPECT_TRUE(state.SetBiasSegments(0.0, segment_s).ok());
   state.SetGyroBias(gyro_bias);
   state.SetGravityDirection(kGravity);
   state.SetImuFromLidarTranslation(r_bl);
@@ -238,7 +238,7 @@ double WorstGyroBiasSegmentError(double segment_s, const Eigen::Vector3d& gyro_b
       Imu(gyro_bias, Eigen::Vector3d::Zero(), &rng, Eigen::Vector3d::Zero(), drift);
   const spline::UniformKnotGrid grid = spline::UniformKnotGrid::ForDuration(0.0, kDuration, 0.05);
   CalibrationState state(grid);
-  state.SetBiasSegments(segment_s, 0.0);
+  EXPECT_TRUE(state.SetBiasSegments(segment_s, 0.0).ok());
   state.SetGyroBias(gyro_bias);
   FitRotationSplineToGyro(imu, Options(), &state);
 
@@ -298,7 +298,7 @@ TEST(CalibrationStateTest, BiasSegmentsCoverTheSplineAndClampOutside) {
   ASSERT_EQ(state.gyro_bias.size(), 1);
   state.SetAccelBias(Eigen::Vector3d(0.1, 0.2, 0.3));
   state.SetGyroBias(Eigen::Vector3d(-1.0, -2.0, -3.0));
-  state.SetBiasSegments(4.0, 5.0);
+  ASSERT_TRUE(state.SetBiasSegments(4.0, 5.0).ok());
   ASSERT_EQ(state.gyro_bias.size(), 3);   // ceil(12 / 4)
   ASSERT_EQ(state.accel_bias.size(), 3);  // ceil(12 / 5)
   EXPECT_TRUE(state.gyro_bias.At(13.9).isApprox(Eigen::Vector3d(-1.0, -2.0, -3.0)));
@@ -314,11 +314,11 @@ TEST(CalibrationStateTest, BiasSegmentsCoverTheSplineAndClampOutside) {
   EXPECT_TRUE(state.AccelBias().isApprox(Eigen::Vector3d(0.2, 0.3, 0.4)));  // the mean
   EXPECT_EQ(state.accel_bias.Block(3.0), state.accel_bias.values[0].data());
   // Back to one segment: the mean.
-  state.SetBiasSegments(0.0, 0.0);
+  ASSERT_TRUE(state.SetBiasSegments(0.0, 0.0).ok());
   ASSERT_EQ(state.accel_bias.size(), 1);
   EXPECT_TRUE(state.accel_bias.At(13.0).isApprox(Eigen::Vector3d(0.2, 0.3, 0.4)));
   // A segment longer than the spline: one segment.
-  state.SetBiasSegments(20.0, 20.0);
+  ASSERT_TRUE(state.SetBiasSegments(20.0, 20.0).ok());
   EXPECT_EQ(state.gyro_bias.size(), 1);
   EXPECT_EQ(state.gyro_bias.segment_s, 0.0);
 }

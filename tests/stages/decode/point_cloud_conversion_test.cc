@@ -97,6 +97,58 @@ TEST(PointCloudConversion, VelodynePointStep22WithNegativeTimes) {
   EXPECT_LT(scan.time_offset_ns(0), -98000000);
 }
 
+// Found by fuzzing: a frame_id that is not UTF-8 made a Scan that protobuf
+// writes (with a log line) but refuses to read back.
+TEST(PointCloudConversion, FrameIdThatIsNotUtf8IsAnError) {
+  for (const std::string& frame_id :
+       {std::string("lidar\xff"), std::string("\xc0\xaf"), std::string("\xed\xa0\x80"),
+        std::string("\xe2\x82")}) {
+    CloudBuilder b(12, 1, 1);
+    b.Field("x", 0, ros1::kFloat32);
+    b.Field("y", 4, ros1::kFloat32);
+    b.Field("z", 8, ros1::kFloat32);
+    PointCloud2View view = b.view();
+    view.header.frame_id = frame_id;
+    proto::Scan scan;
+    const Status status = ConvertPointCloud2ToScan(view, {}, &scan);
+    ASSERT_FALSE(status.ok());
+    EXPECT_EQ(status.message(), "header.frame_id is not valid UTF-8");
+  }
+  CloudBuilder b(12, 1, 1);
+  b.Field("x", 0, ros1::kFloat32);
+  b.Field("y", 4, ros1::kFloat32);
+  b.Field("z", 8, ros1::kFloat32);
+  b.Set<float>(0, 0, 0, 5.0f);
+  PointCloud2View view = b.view();
+  view.header.frame_id = "capteur_\xc3\xa9t\xc3\xa9_\xe2\x82\xac_\xf0\x9f\x9a\x97";  // é, €, 🚗
+  proto::Scan scan;
+  ASSERT_TRUE(ConvertPointCloud2ToScan(view, {}, &scan).ok());
+  EXPECT_EQ(scan.frame_id(), view.header.frame_id);
+}
+
+// Found by fuzzing (UBSan, float-cast-overflow): a float ring of -1 or NaN
+// was cast to uint32. It is an error naming the point and the field.
+TEST(PointCloudConversion, RingThatIsNoRingNumberIsAnError) {
+  for (const float ring : {-1.0f, std::nanf(""), 5e9f}) {
+    CloudBuilder b(16, 2, 1);
+    b.Field("x", 0, ros1::kFloat32);
+    b.Field("y", 4, ros1::kFloat32);
+    b.Field("z", 8, ros1::kFloat32);
+    b.Field("ring", 12, ros1::kFloat32);
+    for (uint32_t c = 0; c < 2; ++c) {
+      b.Set<float>(0, c, 0, 5.0f);
+      b.Set<float>(0, c, 4, 0.0f);
+      b.Set<float>(0, c, 8, 0.0f);
+      b.Set<float>(0, c, 12, c == 0 ? 3.0f : ring);
+    }
+    proto::Scan scan;
+    const Status status = Convert(b, &scan);
+    ASSERT_FALSE(status.ok()) << ring;
+    EXPECT_EQ(status.message().rfind("point 1: its ring (field 'ring') is ", 0), 0u)
+        << status.message();
+  }
+}
+
 TEST(PointCloudConversion, Float64XyzAnyIntensityTypeLineAndOffsetTime) {
   CloudBuilder b(35, 2, 1);
   b.Field("x", 0, ros1::kFloat64);

@@ -31,6 +31,11 @@ struct VehicleBagOptions {
   // Added to the LiDAR header stamps (not to the record times): a LiDAR that
   // stamps on another clock than the IMU.
   int64_t lidar_stamp_offset_ns = 0;
+  // IMU message `far_future_imu_index` (>= 0) stamped at the last second
+  // uint32 can hold (2^32 − 1 s, in 2106); zero_stamps: every header stamp 0
+  // (a driver that never sets them).
+  int far_future_imu_index = -1;
+  bool zero_stamps = false;
 };
 
 inline constexpr int64_t kVehicleBagStartNs = 1700000000000000000LL;
@@ -69,7 +74,9 @@ inline bool WriteVehicleBag(const std::string& path, const VehicleBagOptions& op
   for (size_t i = 0; i < readings.size(); ++i) {
     const int64_t stamp_ns = kVehicleBagStartNs + std::llround(readings[i].time_s * 1e9);
     Message m{stamp_ns + kVehicleBagImuLatencyNs, imu_connection, ""};
-    if (!ros1::SerializeImu(static_cast<uint32_t>(i), stamp_ns, "imu_link",
+    int64_t published_ns = options.zero_stamps ? 0 : stamp_ns;
+    if (static_cast<int>(i) == options.far_future_imu_index) published_ns = 4294967295LL * 1000000000;
+    if (!ros1::SerializeImu(static_cast<uint32_t>(i), published_ns, "imu_link",
                             readings[i].angular_velocity_radps * options.gyro_scale,
                             readings[i].linear_acceleration_mps2 * options.accel_scale, 1e-6,
                             1e-4, &m.bytes)) {
@@ -100,7 +107,8 @@ inline bool WriteVehicleBag(const std::string& path, const VehicleBagOptions& op
     }
     Message m{true_ns + kVehicleBagLidarLatencyNs, cloud_connection, ""};
     if (!ros1::SerializePointCloud2(static_cast<uint32_t>(k),
-                                    true_ns + options.lidar_stamp_offset_ns, "lidar", 1, kPoints,
+                                    options.zero_stamps ? 0 : true_ns + options.lidar_stamp_offset_ns,
+                                    "lidar", 1, kPoints,
                                     fields, kPointStep, data, true, &m.bytes)) {
       return false;
     }

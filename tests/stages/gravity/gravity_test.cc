@@ -1,6 +1,7 @@
 #include "stages/gravity/gravity.h"
 
 #include <cmath>
+#include <vector>
 
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
@@ -190,6 +191,58 @@ TEST(Gravity, RunWritesTheReferenceAndFailsCleanlyOnBadInputs) {
   status = gravity::Run(paths, DefaultParams(), nullptr);
   ASSERT_FALSE(status.ok());
   EXPECT_NE(status.message().find("missing.binpb"), std::string::npos);
+}
+
+// Ground planes with a NaN or zero normal, and a flat calibration without a
+// gravity: errors naming the file and the record or field, no output.
+TEST(Gravity, NanOrZeroNormalsAndACalibrationWithoutGravityAreRefused) {
+  testing::TempDir dir;
+  Scenario scenario(0.0);
+  {
+    RecordWriter imu_writer;
+    ASSERT_TRUE(imu_writer.Open(dir.File("imu.binpb"), "tiltcal.proto.ImuSample", {}, false).ok());
+    for (const auto& reading : scenario.inputs.imu) {
+      proto::ImuSample sample;
+      sample.set_stamp_ns(scenario.inputs.first_imu_stamp_ns + std::llround(reading.time_s * 1e9));
+      *sample.mutable_angular_velocity_radps() = ToProto(reading.angular_velocity_radps);
+      *sample.mutable_linear_acceleration_mps2() = ToProto(reading.linear_acceleration_mps2);
+      ASSERT_TRUE(imu_writer.Write(sample).ok());
+    }
+    ASSERT_TRUE(imu_writer.Close().ok());
+  }
+  ASSERT_TRUE(WriteTextProto(dir.File("rig.txtpb"), scenario.inputs.rig).ok());
+  GravityPaths paths;
+  paths.imu = dir.File("imu.binpb");
+  paths.rig = dir.File("rig.txtpb");
+  paths.out = dir.File("gravity.txtpb");
+  for (const Eigen::Vector3d& normal : std::vector<Eigen::Vector3d>{
+           Eigen::Vector3d(std::nan(""), 0, 1), Eigen::Vector3d::Zero()}) {
+    std::vector<proto::GroundPlane> planes = scenario.inputs.ground;
+    *planes[5].mutable_normal_in_lidar() = ToProto(normal);
+    RecordWriter ground_writer;
+    ASSERT_TRUE(
+        ground_writer.Open(dir.File("ground.binpb"), "tiltcal.proto.GroundPlane", {}, false).ok());
+    for (const auto& plane : planes) ASSERT_TRUE(ground_writer.Write(plane).ok());
+    ASSERT_TRUE(ground_writer.Close().ok());
+    paths.ground = dir.File("ground.binpb");
+    const Status status = gravity::Run(paths, DefaultParams(), nullptr);
+    ASSERT_FALSE(status.ok()) << normal.transpose();
+    EXPECT_NE(status.message().find(paths.ground + ": record 5: normal_in_lidar"),
+              std::string::npos)
+        << status.message();
+    EXPECT_FALSE(testing::FileExists(paths.out));
+  }
+  paths.ground.clear();
+  proto::CalibrationResult no_gravity;
+  *no_gravity.mutable_imu_from_lidar() = scenario.inputs.rig.imu_from_lidar();
+  ASSERT_TRUE(WriteTextProto(dir.File("calibration.txtpb"), no_gravity).ok());
+  paths.calibration = dir.File("calibration.txtpb");
+  const Status status = gravity::Run(paths, DefaultParams(), nullptr);
+  ASSERT_FALSE(status.ok());
+  EXPECT_NE(status.message().find(paths.calibration + ": gravity_in_world has norm 0"),
+            std::string::npos)
+      << status.message();
+  EXPECT_FALSE(testing::FileExists(paths.out));
 }
 
 }  // namespace

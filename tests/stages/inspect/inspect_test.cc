@@ -1,5 +1,6 @@
 #include "stages/inspect/inspect.h"
 
+#include <filesystem>
 #include <sstream>
 #include <vector>
 
@@ -155,6 +156,60 @@ TEST(InspectCli, BadFileIsOneErrorLineAndNonZeroExit) {
   EXPECT_EQ(code, 1);
   EXPECT_EQ(Lines(output).size(), 1u) << output;
   EXPECT_NE(output.find(dir.File("junk.binpb")), std::string::npos) << output;
+}
+
+// `> ground.csv` on a full disk: the table is cut short, so the exit is 1
+// with one line naming standard output (the Makefile builds ground.csv so).
+TEST(InspectCli, StdoutThatCannotBeWrittenIsAFailure) {
+  testing::TempDir dir;
+  WriteStream(dir.File("ground.binpb"), SomePlanes(), false);
+  for (const char* command : {" csv ", " cat "}) {
+    std::string output;
+    const int code = testing::RunCommand(
+        "{ " + testing::ToolPath("tiltcal_inspect") + command + dir.File("ground.binpb") +
+            " > /dev/full; }",
+        &output);
+    EXPECT_EQ(code, 1) << command << output;
+    EXPECT_EQ(Lines(output).size(), 1u) << output;
+    EXPECT_NE(output.find("standard output: cannot write: No space left on device"),
+              std::string::npos)
+        << output;
+  }
+}
+
+// A PCD on a full disk (here: a file size limit of 512 bytes, with SIGXFSZ
+// ignored so that the write fails with EFBIG as it would with ENOSPC): one
+// error line naming the PCD, exit 1, neither the PCD nor a temporary left.
+TEST(InspectCli, PcdOnAFullDiskIsAnErrorAndLeavesNothing) {
+  testing::TempDir dir;
+  std::vector<proto::Scan> scans(1);
+  for (int i = 0; i < 100; ++i) {  // 100 points × 25 bytes: over the limit
+    scans[0].add_x(i + 1.0f);
+    scans[0].add_y(0);
+    scans[0].add_z(0);
+    scans[0].add_intensity(1);
+    scans[0].add_ring(0);
+    scans[0].add_time_offset_ns(0);
+  }
+  WriteStream(dir.File("scans.binpb.lz4"), scans, true);
+  const std::string pcd = dir.File("scan0.pcd");
+  std::string output;
+  const int code = testing::RunCommand("sh -c \"trap '' XFSZ; ulimit -f 1; exec " +
+                                           testing::ToolPath("tiltcal_inspect") + " pcd " +
+                                           dir.File("scans.binpb.lz4") + " --out=" + pcd + "\"",
+                                       &output);
+  EXPECT_EQ(code, 1) << output;
+  EXPECT_EQ(Lines(output).size(), 1u) << output;
+  EXPECT_NE(output.find(pcd + ": cannot write output"), std::string::npos) << output;
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()), {}), 1)
+      << "only the scans stay";
+  // Without the limit the same command writes the PCD.
+  ASSERT_EQ(testing::RunCommand(testing::ToolPath("tiltcal_inspect") + " pcd " +
+                                    dir.File("scans.binpb.lz4") + " --out=" + pcd,
+                                &output),
+            0)
+      << output;
+  EXPECT_TRUE(testing::FileExists(pcd));
 }
 
 TEST(FormatDouble, ShortestRoundTrip) {

@@ -106,6 +106,43 @@ TEST(Repeatability, RunWritesTableAndCsvAndFailsOnMissingResult) {
   EXPECT_FALSE(testing::FileExists(dir.File("other.txt")));
 }
 
+// A calibration or truth file without an extrinsic, or with a NaN, would
+// enter the mean and σ: an error naming the file and the field, no output.
+TEST(Repeatability, EmptyOrNanCalibrationAndTruthAreRefused) {
+  testing::TempDir dir;
+  std::filesystem::create_directory(dir.File("seq1"));
+  const SequenceResult good = Sequence("seq1", {180, 0, 10}, {0.1, 0, 0.2}, 0.005);
+  ReportPaths paths;
+  paths.sequence_dirs = {dir.File("seq1")};
+  paths.out = dir.File("repeatability.txt");
+  const std::string calibration = dir.File("seq1/calibration.txtpb");
+  const std::string truth = dir.File("seq1/truth.txtpb");
+  const std::pair<std::string, std::string> cases[] = {
+      {"# no extrinsic\ntime_offset_s: 0.01\n", "imu_from_lidar.rotation is missing"},
+      {"imu_from_lidar { rotation { w: nan } }\n", "imu_from_lidar.rotation is not finite"},
+      {"imu_from_lidar { rotation { w: 1 } translation { x: nan } }\n",
+       "imu_from_lidar.translation is not finite"},
+      {"imu_from_lidar { rotation { w: 1 } }\ntime_offset_s: inf\n", "time_offset_s"},
+  };
+  for (const auto& [text, error] : cases) {
+    ASSERT_TRUE(WriteFileAtomically(calibration, text).ok());
+    Status status = report::Run(paths, nullptr);
+    ASSERT_FALSE(status.ok()) << text;
+    EXPECT_EQ(status.message().rfind(calibration + ": ", 0), 0u) << status.message();
+    EXPECT_NE(status.message().find(error), std::string::npos) << status.message();
+    EXPECT_FALSE(testing::FileExists(paths.out));
+    // The same text as the truth, beside a good calibration.
+    ASSERT_TRUE(WriteTextProto(calibration, good.calibration).ok());
+    ASSERT_TRUE(WriteFileAtomically(truth, text).ok());
+    status = report::Run(paths, nullptr);
+    ASSERT_FALSE(status.ok()) << text;
+    EXPECT_EQ(status.message().rfind(truth + ": ", 0), 0u) << status.message();
+    EXPECT_FALSE(testing::FileExists(paths.out));
+    std::filesystem::remove(truth);
+  }
+  ASSERT_TRUE(report::Run(paths, nullptr).ok());
+}
+
 // The verdict column, and a SUSPECT result the pipeline set aside
 // (calibration.suspect.txtpb only): listed below the table, not in the mean.
 TEST(Repeatability, VerdictColumnAndSuspectSequencesSetAside) {

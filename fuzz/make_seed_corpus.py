@@ -1,0 +1,166 @@
+#!/usr/bin/python3
+"""Writes the fuzzers' seed corpus (fuzz/corpus/<harness>/): small valid
+inputs of each parser, from which libFuzzer mutates. Run with Debian's
+/usr/bin/python3 (python3-rosbag) and the lz4 command; the output is
+committed, so this runs only when a seed is added.
+    fuzz/make_seed_corpus.py"""
+import io
+import os
+import shutil
+import struct
+import subprocess
+
+import rosbag
+import rospy
+from sensor_msgs.msg import Imu, PointCloud2, PointField
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+CORPUS = os.path.join(HERE, 'corpus')
+
+
+def varint(n):
+    out = b''
+    while True:
+        byte = n & 0x7f
+        n >>= 7
+        if n:
+            out += bytes([byte | 0x80])
+        else:
+            return out + bytes([byte])
+
+
+def field(number, wire_type, payload):
+    key = varint((number << 3) | wire_type)
+    if wire_type == 0:
+        return key + varint(payload)
+    if wire_type == 1:
+        return key + struct.pack('<d', payload)
+    return key + varint(len(payload)) + payload
+
+
+def vector3(x, y, z):
+    return field(1, 1, x) + field(2, 1, y) + field(3, 1, z)
+
+
+def delimited(message):
+    return varint(len(message)) + message
+
+
+def stream(payload_type, records):
+    header = field(1, 2, payload_type.encode()) + field(2, 0, 1) + \
+        field(3, 2, field(1, 2, b'make_seed_corpus'))
+    return b'TILTCAL1' + delimited(header) + b''.join(delimited(r) for r in records)
+
+
+def imu_records():
+    return [field(1, 0, 1700000000000000000 + i * 5000000) +
+            field(2, 2, vector3(0.01 * i, 0.0, -0.02)) +
+            field(3, 2, vector3(0.1, -0.2, 9.81)) for i in range(6)]
+
+
+def scan_records():
+    records = []
+    for k in range(2):
+        floats = lambda values: struct.pack('<%df' % len(values), *values)
+        n = 5
+        records.append(field(1, 0, k) + field(2, 0, 1700000000000000000 + k * 100000000) +
+                       field(4, 2, b'lidar') +
+                       field(5, 2, floats([1.0 + i for i in range(n)])) +
+                       field(6, 2, floats([0.5] * n)) + field(7, 2, floats([-1.0] * n)) +
+                       field(8, 2, floats([7.0] * n)) +
+                       field(9, 2, b''.join(varint(i) for i in range(n))) +
+                       field(10, 2, b''.join(varint(2 * i) for i in range(n))) +  # zigzag
+                       field(11, 0, 1))
+    return records
+
+
+def cloud(layout, stamp, n=8):
+    """A PointCloud2 in a driver's layout: velodyne, ouster or hesai."""
+    f32, f64, u16, u32 = PointField.FLOAT32, PointField.FLOAT64, PointField.UINT16, PointField.UINT32
+    if layout == 'velodyne':
+        fields = [('x', 0, f32), ('y', 4, f32), ('z', 8, f32), ('intensity', 12, f32),
+                  ('ring', 16, u16), ('time', 18, f32)]
+        fmt, step = '<ffffHf', 22
+        point = lambda i: (1.0 + i, 2.0, -0.5, 3.0, i % 16, 0.001 * i)
+    elif layout == 'ouster':
+        fields = [('x', 0, f32), ('y', 4, f32), ('z', 8, f32), ('intensity', 16, f32),
+                  ('t', 20, u32), ('ring', 24, u16)]
+        fmt, step = '<fff4xfIH6x', 32
+        point = lambda i: (1.0 + i, 2.0, -0.5, 3.0, 1000 * i, i % 16)
+    else:
+        fields = [('x', 0, f32), ('y', 4, f32), ('z', 8, f32), ('intensity', 12, f32),
+                  ('timestamp', 16, f64), ('ring', 24, u16)]
+        fmt, step = '<ffffdH', 26
+        point = lambda i: (1.0 + i, 2.0, -0.5, 3.0, stamp.to_sec() + 1e-4 * i, i % 16)
+    msg = PointCloud2()
+    msg.header.stamp = stamp
+    msg.header.frame_id = 'lidar'
+    msg.height, msg.width = 1, n
+    msg.fields = [PointField(name, offset, datatype, 1) for name, offset, datatype in fields]
+    msg.is_bigendian = False
+    msg.point_step = step
+    msg.row_step = step * n
+    msg.data = b''.join(struct.pack(fmt, *point(i)) for i in range(n))
+    msg.is_dense = True
+    return msg
+
+
+def imu(stamp, i):
+    msg = Imu()
+    msg.header.stamp = stamp
+    msg.header.seq = i
+    msg.angular_velocity.z = 0.01 * i
+    msg.linear_acceleration.z = 9.81
+    return msg
+
+
+def write_bag(path, compression, layout):
+    with rosbag.Bag(path, 'w', compression=compression, chunk_threshold=2048) as bag:
+        for i in range(20):
+            t = rospy.Time(1700000000, i * 5000000)
+            bag.write('/imu/data', imu(t, i), t)
+            if i % 10 == 0:
+                bag.write('/points', cloud(layout, t), t)
+
+
+def serialized(msg):
+    buffer = io.BytesIO()
+    msg.serialize(buffer)
+    return buffer.getvalue()
+
+
+def main():
+    shutil.rmtree(CORPUS, ignore_errors=True)
+    for harness in ('ros1_bag_reader', 'record_stream', 'text_proto', 'point_cloud2'):
+        os.makedirs(os.path.join(CORPUS, harness))
+    bags = os.path.join(CORPUS, 'ros1_bag_reader')
+    for compression, layout in (('none', 'velodyne'), ('bz2', 'ouster'), ('lz4', 'hesai')):
+        write_bag(os.path.join(bags, '%s_%s.bag' % (compression, layout)), compression, layout)
+    data = open(os.path.join(bags, 'none_velodyne.bag'), 'rb').read()
+    open(os.path.join(bags, 'unindexed.bag'), 'wb').write(data[:len(data) * 3 // 4])
+
+    streams = os.path.join(CORPUS, 'record_stream')
+    for name, payload, records in (('imu.binpb', 'tiltcal.proto.ImuSample', imu_records()),
+                                   ('scans.binpb', 'tiltcal.proto.Scan', scan_records())):
+        path = os.path.join(streams, name)
+        open(path, 'wb').write(stream(payload, records))
+        subprocess.run(['lz4', '-q', '-f', '-B4', path, path + '.lz4'], check=True)
+
+    texts = os.path.join(CORPUS, 'text_proto')
+    for stage in ('calibrate', 'decode'):
+        shutil.copy(os.path.join(ROOT, 'stages', stage, 'default_params.txtpb'),
+                    os.path.join(texts, stage + '.txtpb'))
+    open(os.path.join(texts, 'rig.txtpb'), 'w').write(
+        'imu_from_lidar { rotation { w: 0.7071067811865476 z: 0.7071067811865476 }\n'
+        '  translation { x: 0.1 y: -0.02 z: 0.3 } }\nimu_height_m: 0.35\n'
+        'gravity_flat_in_imu { z: -9.81 }\nimu_accel_unit: MPS2\nimu_topic: "/imu/data"\n')
+
+    clouds = os.path.join(CORPUS, 'point_cloud2')
+    for layout in ('velodyne', 'ouster', 'hesai'):
+        open(os.path.join(clouds, layout + '.msg'), 'wb').write(
+            serialized(cloud(layout, rospy.Time(1700000000, 0))))
+
+
+if __name__ == '__main__':
+    main()

@@ -1,0 +1,50 @@
+#!/usr/bin/env bash
+# The parsers under the sanitizers (README.md, "Reliability"): builds, with
+# clang, ASan + UBSan (float-cast-overflow included, stop at the first
+# finding) and libFuzzer coverage, only what the I/O, bag and decode tests
+# and the fuzz harnesses need; runs those tests; then runs each harness for
+# FUZZ_SECONDS (default 10) from its committed seed corpus (fuzz/corpus/).
+# New inputs go to a temporary directory; a crash leaves its input as
+# crash-* in $BUILD_DIR/fuzz-artifacts/ and fails the script.
+#   scripts/sanitize_and_fuzz.sh
+set -euo pipefail
+cd "$(dirname "$0")/.."
+BUILD_DIR=${SANITIZE_BUILD_DIR:-build-sanitize}
+FUZZ_SECONDS=${FUZZ_SECONDS:-10}
+FUZZERS=(ros1_bag_reader_fuzzer record_stream_fuzzer text_proto_fuzzer point_cloud2_fuzzer)
+TESTS=(io_test checked_conversion_test imu_test ros1_unit_test ros1_bags_test
+       decode_unit_test decode_bags_test)
+
+if [ ! -f "$BUILD_DIR/build.ninja" ]; then
+  cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ \
+    -DTILTCAL_SANITIZE=address,undefined -DTILTCAL_FUZZ=ON -DTILTCAL_BUILD_BENCHMARKS=OFF \
+    >/dev/null
+fi
+cmake --build "$BUILD_DIR" -j "$(nproc)" --target "${FUZZERS[@]}" "${TESTS[@]}" tiltcal_decode \
+  tiltcal_inspect
+
+export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
+export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+for t in "${TESTS[@]}"; do
+  (cd "$BUILD_DIR" && "tests/$t" --gtest_brief=1 > "tests/$t.log" 2>&1) ||
+    { tail -60 "$BUILD_DIR/tests/$t.log" >&2; echo "$t failed under the sanitizers" >&2; exit 1; }
+  echo "$t: passed under ASan + UBSan"
+done
+
+artifacts=$BUILD_DIR/fuzz-artifacts
+mkdir -p "$artifacts"
+for fuzzer in "${FUZZERS[@]}"; do
+  corpus=$(mktemp -d)
+  log=$artifacts/${fuzzer}.log
+  if ! "$BUILD_DIR/bin/$fuzzer" -max_total_time="$FUZZ_SECONDS" -rss_limit_mb=2048 \
+      -timeout=10 -artifact_prefix="$artifacts/" "$corpus" "fuzz/corpus/${fuzzer%_fuzzer}" \
+      > "$log" 2>&1; then
+    rm -rf "$corpus"
+    tail -40 "$log" >&2
+    echo "$fuzzer: a finding (input in $artifacts/)" >&2
+    exit 1
+  fi
+  rm -rf "$corpus"
+  echo "$fuzzer: $(grep -o 'Done [0-9]* runs in [0-9]* second(s)' "$log")"
+done
