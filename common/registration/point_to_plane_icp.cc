@@ -107,8 +107,6 @@ PointToPlaneIcpResult AlignPointToPlane(const std::vector<Eigen::Vector3d>& sour
       break;
     }
   }
-  // Statistics at the final pose.
-  SetStatistics(Linearise(source, map, result.map_from_source, options), &result);
   return result;
 }
 

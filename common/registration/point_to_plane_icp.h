@@ -39,8 +39,9 @@ struct PointToPlaneIcpResult {
   bool registered = false;       // at least min_correspondences and a solvable system
   bool converged = false;        // the last update was below the thresholds
   int iterations = 0;
-  // After the last iteration, with the final pose: correspondences found and
-  // those with |r| <= kernel scale, and the RMS residual of the latter, m.
+  // Of the last linearisation (at the pose before the last update, which is
+  // below the thresholds when converged): correspondences found, those with
+  // |r| <= kernel scale, and the RMS residual of the latter, m.
   int num_correspondences = 0;
   int num_inliers = 0;
   double inlier_rms_m = 0.0;

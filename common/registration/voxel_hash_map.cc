@@ -78,14 +78,19 @@ void VoxelHashMap::RemoveFarFrom(const Eigen::Vector3d& center, double max_dista
 
 bool VoxelHashMap::FindNearestOnPlane(const Eigen::Vector3d& p, double max_distance_m,
                                       PlaneNeighbour* neighbour) const {
-  const Eigen::Vector3i center = VoxelOf(p, options_.voxel_m);
+  // Only the voxels that the ball of radius max_distance_m around p touches
+  // (at most 27 when max_distance_m <= voxel_m).
+  const Eigen::Vector3i low = VoxelOf(p - Eigen::Vector3d::Constant(max_distance_m), options_.voxel_m);
+  const Eigen::Vector3i high =
+      VoxelOf(p + Eigen::Vector3d::Constant(max_distance_m), options_.voxel_m);
   double best_sq = max_distance_m * max_distance_m;
   const Voxel* best_voxel = nullptr;
   const Eigen::Vector3d* best_point = nullptr;
-  for (int dx = -1; dx <= 1; ++dx) {
-    for (int dy = -1; dy <= 1; ++dy) {
-      for (int dz = -1; dz <= 1; ++dz) {
-        const auto it = voxels_.find(center + Eigen::Vector3i(dx, dy, dz));
+  Eigen::Vector3i key;
+  for (key.x() = low.x(); key.x() <= high.x(); ++key.x()) {
+    for (key.y() = low.y(); key.y() <= high.y(); ++key.y()) {
+      for (key.z() = low.z(); key.z() <= high.z(); ++key.z()) {
+        const auto it = voxels_.find(key);
         if (it == voxels_.end() || !it->second.has_plane) continue;
         for (const Eigen::Vector3d& q : it->second.points) {
           const double d_sq = (q - p).squaredNorm();

@@ -59,9 +59,9 @@ class VoxelHashMap {
   // Drops the voxels whose first point lies farther than max_distance_m from
   // `center` (map frame).
   void RemoveFarFrom(const Eigen::Vector3d& center, double max_distance_m);
-  // The nearest stored point to p within max_distance_m, searched in p's
-  // voxel and its 26 neighbours, among the voxels with a plane. False when
-  // there is none.
+  // The nearest stored point to p within max_distance_m among the voxels
+  // with a plane (searched in every voxel the ball of that radius touches).
+  // False when there is none.
   bool FindNearestOnPlane(const Eigen::Vector3d& p, double max_distance_m,
                           PlaneNeighbour* neighbour) const;
 

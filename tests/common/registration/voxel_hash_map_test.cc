@@ -36,10 +36,12 @@ TEST(VoxelHashMapTest, CapsPointsPerVoxelAndFitsThinPlanes) {
   EXPECT_NEAR(std::abs(n.normal.z()), 1.0, 1e-9);
   EXPECT_EQ(n.point, floor[0]);
   EXPECT_NEAR(n.distance_m, (floor[0] - Eigen::Vector3d(0.06, 0.06, 0.7)).norm(), 1e-12);
-  // Beyond the gate, and in a neighbour voxel: still found within 27 voxels.
+  // From the voxel above: beyond a 0.5 m gate, within a 1 m one; two voxels
+  // up, found with a gate that reaches that far.
   EXPECT_FALSE(map.FindNearestOnPlane({0.06, 0.06, 1.4}, 0.5, &n));
   EXPECT_TRUE(map.FindNearestOnPlane({0.06, 0.06, 1.4}, 1.0, &n));
-  EXPECT_FALSE(map.FindNearestOnPlane({0.06, 0.06, 2.4}, 10.0, &n));  // two voxels up
+  EXPECT_FALSE(map.FindNearestOnPlane({0.06, 0.06, 2.4}, 1.0, &n));
+  EXPECT_TRUE(map.FindNearestOnPlane({0.06, 0.06, 2.4}, 2.0, &n));
 }
 
 TEST(VoxelHashMapTest, ALineOfPointsHasNoPlane) {
