@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "common/io/atomic_file.h"
+#include "common/io/params.h"
 #include "stages/calibrate/calibrate_params_validation.h"
 #include "stages/calibrate/default_params_text.h"
 #include "tests/stages/calibrate/calibrate_params_text.h"
@@ -86,6 +87,14 @@ TEST(CalibrateParamsTest, EachRuleNamesItsField) {
       {"init { odometry_position_sigma_m: 0 }", "init.odometry_position_sigma_m"},
       {"init { deskew_node_spacing_s: 0 }", "init.deskew_node_spacing_s"},
       {"odometry { quality_map { voxel_m: 0 } }", "odometry.quality_map.voxel_m"},
+      {"odometry { method: VOXEL_ICP voxel_icp { max_correspondence_m: 0 } }",
+       "odometry.voxel_icp.max_correspondence_m"},
+      {"odometry { method: VOXEL_ICP voxel_icp { kernel_scale_m: 0 } }",
+       "odometry.voxel_icp.kernel_scale_m"},
+      {"odometry { method: VOXEL_ICP voxel_icp { max_plane_thickness_m: 0 } }",
+       "odometry.voxel_icp.max_plane_thickness_m"},
+      {"odometry { method: VOXEL_ICP voxel_icp { min_plane_points: 30 max_points_per_cell: 20 } }",
+       "odometry.voxel_icp.min_plane_points"},
       {"map { voxel_m: 0 }", "map.voxel_m"},
       {"association { max_distance_m: 0 }", "association.max_distance_m"},
       {"association { deskew_node_spacing_s: 0 }", "association.deskew_node_spacing_s"},
@@ -104,6 +113,20 @@ TEST(CalibrateParamsTest, EachRuleNamesItsField) {
     const std::string message = ErrorWith(override_text);
     EXPECT_NE(message.find(field), std::string::npos) << override_text << ": " << message;
   }
+}
+
+TEST(CalibrateParamsTest, VoxelIcpNeedsItsSettingsOnlyWhenChosen) {
+  proto::CalibrateParams params = tiltcal::testing::DefaultCalibrateParamsWith();
+  params.mutable_odometry()->clear_voxel_icp();
+  params.mutable_odometry()->set_method(proto::LidarOdometryParams::VOXEL_ICP);
+  const Status status = ValidateCalibrateParams(params);
+  ASSERT_FALSE(status.ok());
+  EXPECT_EQ(status.message(),
+            "params: odometry.voxel_icp is required with odometry.method VOXEL_ICP");
+  // A params file written for GICP (before VOXEL_ICP existed) stays valid.
+  params.mutable_odometry()->set_method(proto::LidarOdometryParams::GICP);
+  EXPECT_TRUE(ValidateCalibrateParams(params).ok());
+  EXPECT_TRUE(ValidateAgainstSchema(params).ok());
 }
 
 }  // namespace
