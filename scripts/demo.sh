@@ -55,7 +55,7 @@ build_tools() {
     cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release > /dev/null
   fi
   cmake --build build -j "$(nproc)" --target tiltcal_simulate tiltcal_decode tiltcal_ground \
-    tiltcal_gravity tiltcal_calibrate tiltcal_report tiltcal_inspect
+    tiltcal_gravity tiltcal_calibrate tiltcal_report tiltcal_inspect tiltcal_export
 }
 
 phase "setup and build" build_tools
@@ -77,6 +77,7 @@ for dataset in "$FLAT" "$TILTED"; do
   cat "$dataset/out/repeatability.txt"
   echo
 done
+echo "Report pages (open in a browser): $FLAT/out/report.html $TILTED/out/report.html" | sed "s#$ROOT/##g"
 echo "Plots:"
 ls -1 "$FLAT"/out/*.png "$TILTED"/out/*.png "$FLAT"/out/*/*.png "$TILTED"/out/*/*.png 2>/dev/null |
   sed "s#^$ROOT/##; s#^#  #"

@@ -9,7 +9,8 @@ PACKAGES=(
   libpcl-dev libprotobuf-dev protobuf-compiler
   liblz4-dev lz4 libbz2-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  python3-rosbag python3-sensor-msgs python3-numpy python3-matplotlib
+  python3-rosbag python3-sensor-msgs python3-numpy python3-matplotlib python3-yaml
+  chromium
 )
 
 missing=()

@@ -19,6 +19,7 @@
 #include "stages/calibrate/ground_residuals.h"
 #include "stages/calibrate/initialisation.h"
 #include "stages/calibrate/lidar_association.h"
+#include "stages/calibrate/map_export.h"
 #include "stages/calibrate/map_sharpness.h"
 #include "stages/calibrate/problem_builder.h"
 #include "stages/calibrate/residual_statistics.h"
@@ -379,6 +380,24 @@ void FillVerdictFacts(const CalibrateInputs& inputs, const proto::CalibrateParam
   AddTiming("verdict_facts", Seconds(start), result);
 }
 
+// The before/after maps of map_export.h, when their paths are given.
+Status WriteMaps(const CalibratePaths& paths, const proto::CalibrateParams& params,
+                 const CalibrateInputs& inputs, const CalibrationState& state, std::ostream* log) {
+  const std::pair<std::string, Rigid3d> maps[] = {
+      {paths.out_map_rig, ToEigen(inputs.rig.imu_from_lidar())},
+      {paths.out_map_calibrated,
+       Rigid3d{state.ImuFromLidarRotation(), state.ImuFromLidarTranslation()}}};
+  for (const auto& [path, imu_from_lidar] : maps) {
+    if (path.empty()) continue;
+    const std::vector<MapPoint> points =
+        BuildMapPoints(state, imu_from_lidar, inputs.scans, params.map_export(),
+                       params.association().deskew_node_spacing_s());
+    TILTCAL_RETURN_IF_ERROR(WriteMapPcd(path, points));
+    Log(log, fmt::format("map {} ({} points)", path, points.size()));
+  }
+  return Status::Ok();
+}
+
 }  // namespace
 
 Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& params,
@@ -458,7 +477,11 @@ Status Run(const CalibratePaths& paths, const proto::CalibrateParams& params, st
   TILTCAL_RETURN_IF_ERROR(ReadCalibrateInputs(paths, params, &inputs));
   const double read_s = Seconds(start);
   proto::CalibrationResult result;
-  TILTCAL_RETURN_IF_ERROR(Calibrate(inputs, params, &result, nullptr, log));
+  // Replaced by the final state (the grid here is a placeholder).
+  CalibrationState final_state(
+      spline::UniformKnotGrid::ForDuration(0.0, 1.0, params.spline().knot_spacing_s()));
+  TILTCAL_RETURN_IF_ERROR(Calibrate(inputs, params, &result, &final_state, log));
+  TILTCAL_RETURN_IF_ERROR(WriteMaps(paths, params, inputs, final_state, log));
   proto::PhaseTiming* t = result.add_timings();
   t->set_phase("read_inputs");
   t->set_seconds(read_s);

@@ -45,6 +45,10 @@ struct CalibratePaths {
   std::string rig;      // rig.txtpb
   std::string params;   // for the provenance
   std::string out;      // calibration.txtpb
+  // Optional before/after maps (map_export.h): the scans with the rig's
+  // extrinsic and with the estimate, binary PCD.
+  std::string out_map_rig;
+  std::string out_map_calibrated;
   std::string command_line;
 };
 
@@ -70,7 +74,8 @@ Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& pa
                  proto::CalibrationResult* result, CalibrationState* final_state,
                  std::ostream* log);
 
-// Reads, calibrates, writes calibration.txtpb atomically with provenance;
+// Reads, calibrates, writes the maps when asked and then calibration.txtpb,
+// each atomically, the calibration with provenance;
 // the result written (with its verdict) also goes to *written when not null.
 // A SUSPECT verdict is not an error here: the caller decides (main exits
 // cli::kExitSuspect unless VerdictParams.allow_suspect).

@@ -18,6 +18,9 @@ int main(int argc, char** argv) {
   cli.AddFlag("rig", "input: the dataset's rig.txtpb", kRequired);
   cli.AddFlag("params", "input: params (default: stages/calibrate/default_params.txtpb)");
   cli.AddFlag("out", "output: calibration.txtpb", kRequired);
+  cli.AddFlag("out_map_rig", "output, optional: map_rig.pcd (the scans with the rig's extrinsic)");
+  cli.AddFlag("out_map_calibrated",
+              "output, optional: map_calibrated.pcd (the scans with the estimate)");
   cli.AddSwitch("quiet", "no progress lines on stderr");
   cli.AddExample(
       "tiltcal_calibrate --imu=out/run1/imu.binpb --scans=out/run1/scans.binpb.lz4 "
@@ -35,6 +38,8 @@ int main(int argc, char** argv) {
   paths.rig = cli.Get("rig");
   paths.params = cli.Get("params");
   paths.out = cli.Get("out");
+  paths.out_map_rig = cli.Get("out_map_rig");
+  paths.out_map_calibrated = cli.Get("out_map_calibrated");
   paths.command_line = cli.command_line();
   tiltcal::proto::CalibrateParams params;
   tiltcal::Status status = tiltcal::calibrate::LoadCalibrateParams(paths.params, &params);

@@ -27,6 +27,32 @@ ResidualType TypeOf(const ceres::CostFunction* f) {
   return kOther;
 }
 
+// 40 bins of 0.25 over [-5, 5): a standard normal fills the middle 24.
+constexpr double kHistogramMin = -5.0;
+constexpr double kHistogramBinWidth = 0.25;
+constexpr int kHistogramBins = 40;
+
+void FillHistogram(const std::vector<double>& values, proto::ResidualStatistics* s) {
+  std::vector<int> counts(kHistogramBins, 0);
+  int below = 0;
+  int above = 0;
+  for (const double v : values) {
+    const double bin = std::floor((v - kHistogramMin) / kHistogramBinWidth);
+    if (bin < 0) {
+      ++below;
+    } else if (bin >= kHistogramBins) {
+      ++above;
+    } else {
+      ++counts[static_cast<size_t>(bin)];
+    }
+  }
+  s->set_histogram_min(kHistogramMin);
+  s->set_histogram_bin_width(kHistogramBinWidth);
+  for (const int c : counts) s->add_histogram_counts(c);
+  s->set_histogram_below(below);
+  s->set_histogram_above(above);
+}
+
 }  // namespace
 
 proto::ResidualStatistics SummariseResiduals(const char* type, std::vector<double> values) {
@@ -34,6 +60,7 @@ proto::ResidualStatistics SummariseResiduals(const char* type, std::vector<doubl
   s.set_type(type);
   s.set_count(static_cast<int>(values.size()));
   if (values.empty()) return s;
+  FillHistogram(values, &s);
   double sum_squares = 0.0;
   for (double& v : values) {
     sum_squares += v * v;

@@ -12,10 +12,12 @@ int main(int argc, char** argv) {
                     "out/<sequence> folders, each with calibration.txtpb (+ truth.txtpb)", 1, -1);
   cli.AddFlag("out", "output: the repeatability table (text)", tiltcal::cli::kRequired);
   cli.AddFlag("out_csv", "output: the same as CSV");
+  cli.AddFlag("out_html", "output: the dataset's page (self-contained HTML)");
   cli.AddFlag("rig", "input: the dataset's rig.txtpb, for the measured extrinsic row");
   cli.AddFlag("title", "first line of the table");
   cli.AddExample(
       "tiltcal_report --out=out/repeatability.txt --out_csv=out/repeatability.csv "
+      "--out_html=out/report.html "
       "--rig=datasets/husky/rig.txtpb out/run1 out/run2");
   if (const auto exit_code = cli.Parse(argc, argv)) return *exit_code;
   tiltcal::report::ReportPaths paths;
@@ -23,6 +25,7 @@ int main(int argc, char** argv) {
   paths.rig = cli.Get("rig");
   paths.out = cli.Get("out");
   paths.out_csv = cli.Get("out_csv");
+  paths.out_html = cli.Get("out_html");
   paths.title = cli.Get("title");
   return cli.Finish(tiltcal::report::Run(paths, &std::cout));
 }

@@ -11,6 +11,7 @@
 #include "common/io/eigen_proto.h"
 #include "common/io/rig.h"
 #include "common/io/text_proto.h"
+#include "stages/report/report_page.h"
 
 namespace tiltcal::report {
 
@@ -41,10 +42,43 @@ void AddErrors(const proto::SimulationTruth& truth, const proto::CalibrationResu
   row->time_offset_error_ms = 1e3 * (estimate.time_offset_s() - truth.time_offset_s());
 }
 
+// The last component of a sequence directory ("out/run1/" -> "run1").
+std::string SequenceName(const std::string& dir) {
+  const std::filesystem::path path = std::filesystem::path(dir).lexically_normal();
+  const std::string name = path.filename().string();
+  return name.empty() ? path.parent_path().filename().string() : name;
+}
+
 std::string Fixed(double value, int decimals) {
   char buffer[64];
   std::snprintf(buffer, sizeof(buffer), "%.*f", decimals, value);
   return buffer;
+}
+
+// The sections of the page: every directory's calibration.txtpb or
+// calibration.suspect.txtpb and its maps, linked relative to the page.
+Status ReadSequencePages(const ReportPaths& paths, std::vector<SequencePage>* pages) {
+  const std::filesystem::path page_dir =
+      std::filesystem::absolute(paths.out_html).lexically_normal().parent_path();
+  auto link = [&](const std::string& file) {
+    return std::filesystem::exists(file)
+               ? std::filesystem::absolute(file).lexically_normal().lexically_relative(page_dir)
+                     .string()
+               : std::string();
+  };
+  for (const std::string& dir : paths.sequence_dirs) {
+    SequencePage page;
+    page.name = SequenceName(dir);
+    page.set_aside = !std::filesystem::exists(dir + "/calibration.txtpb");
+    const std::string file =
+        dir + (page.set_aside ? "/calibration.suspect.txtpb" : "/calibration.txtpb");
+    TILTCAL_RETURN_IF_ERROR(ReadTextProto(file, &page.calibration));
+    page.calibration_link = link(file);
+    page.map_rig_link = link(dir + "/map_rig.pcd");
+    page.map_calibrated_link = link(dir + "/map_calibrated.pcd");
+    pages->push_back(std::move(page));
+  }
+  return Status::Ok();
 }
 
 std::string Pad(const std::string& text, size_t width) {
@@ -185,10 +219,7 @@ Status Run(const ReportPaths& paths, std::ostream* log) {
   std::vector<std::string> suspect_set_aside;
   for (const std::string& dir : paths.sequence_dirs) {
     SequenceResult result;
-    result.name = std::filesystem::path(dir).lexically_normal().filename().string();
-    if (result.name.empty()) {
-      result.name = std::filesystem::path(dir).lexically_normal().parent_path().filename();
-    }
+    result.name = SequenceName(dir);
     if (!std::filesystem::exists(dir + "/calibration.txtpb") &&
         std::filesystem::exists(dir + "/calibration.suspect.txtpb")) {
       suspect_set_aside.push_back(dir + "/calibration.suspect.txtpb");
@@ -213,6 +244,12 @@ Status Run(const ReportPaths& paths, std::ostream* log) {
   TILTCAL_RETURN_IF_ERROR(WriteFileAtomically(paths.out, table));
   if (!paths.out_csv.empty()) {
     TILTCAL_RETURN_IF_ERROR(WriteFileAtomically(paths.out_csv, FormatCsv(repeatability)));
+  }
+  if (!paths.out_html.empty()) {
+    std::vector<SequencePage> pages;
+    TILTCAL_RETURN_IF_ERROR(ReadSequencePages(paths, &pages));
+    TILTCAL_RETURN_IF_ERROR(
+        WriteFileAtomically(paths.out_html, FormatHtml(paths.title, repeatability, pages)));
   }
   if (log != nullptr) *log << table;
   return Status::Ok();

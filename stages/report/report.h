@@ -65,13 +65,17 @@ struct ReportPaths {
   std::string rig;                         // optional: the measured extrinsic row
   std::string out;                         // the table (text)
   std::string out_csv;                     // optional: the same as CSV
+  // Optional: the dataset's page (report_page.h), with links relative to it.
+  std::string out_html;
   std::string title;                       // first line of the table
 };
 
 // Reads <dir>/calibration.txtpb and <dir>/truth.txtpb (if present) for each
 // directory (a directory with only calibration.suspect.txtpb, a SUSPECT
-// result Makefile.pipeline set aside, is listed as such and left out), computes the repeatability, writes the table and the CSV, and
-// prints the table to `log` (nullptr: silent).
+// result Makefile.pipeline set aside, is listed as such and left out of the
+// rows), computes the repeatability, writes the table, the CSV and the page
+// (where the set-aside sequences have their section too), and prints the
+// table to `log` (nullptr: silent).
 Status Run(const ReportPaths& paths, std::ostream* log);
 
 }  // namespace tiltcal::report

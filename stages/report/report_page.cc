@@ -1,0 +1,177 @@
+#include "stages/report/report_page.h"
+
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "common/geometry/euler_angles.h"
+#include "common/io/eigen_proto.h"
+#include "stages/report/residual_histogram_svg.h"
+
+namespace tiltcal::report {
+namespace {
+
+constexpr char kStyle[] =
+    "body{font-family:sans-serif;margin:2em;max-width:70em;color:#222}"
+    "table{border-collapse:collapse;margin:0.5em 0}"
+    "td,th{border:1px solid #ccc;padding:2px 8px;text-align:right}"
+    "th:first-child,td:first-child{text-align:left}"
+    ".verdict-OK{color:#1e7b34}.verdict-WEAK{color:#a06800}.verdict-SUSPECT{color:#b00020}"
+    ".histograms{display:flex;flex-wrap:wrap;gap:1em}"
+    "code,pre{background:#f4f4f4;padding:1px 4px}";
+
+std::string VerdictName(const proto::CalibrationResult& c) {
+  return c.verdict() == proto::CalibrationResult::VERDICT_UNSET
+             ? "UNSET"
+             : proto::CalibrationResult::Verdict_Name(c.verdict());
+}
+
+std::string RowCells(const Row& row, bool errors) {
+  std::string cells = "<td>" + EscapeHtml(row.label) + "</td>";
+  for (int i = 0; i < 3; ++i) cells += fmt::format("<td>{:.2f}</td>", row.translation_cm[i]);
+  for (int i = 0; i < 3; ++i) cells += fmt::format("<td>{:.3f}</td>", row.euler123_deg[i]);
+  cells += fmt::format("<td>{:.3f}</td>", row.time_offset_ms);
+  if (errors) {
+    if (row.has_errors) {
+      cells += fmt::format("<td>{:.3f}</td>", row.rotation_error_deg);
+      for (int i = 0; i < 3; ++i) {
+        cells += fmt::format("<td>{:.2f}</td>", row.translation_error_cm[i]);
+      }
+      cells += fmt::format("<td>{:.3f}</td>", row.time_offset_error_ms);
+    } else {
+      cells += "<td></td><td></td><td></td><td></td><td></td>";
+    }
+  }
+  cells += fmt::format("<td class=\"verdict-{0}\">{0}</td>", EscapeHtml(row.verdict));
+  return "<tr>" + cells + "</tr>\n";
+}
+
+std::string RepeatabilityTable(const Repeatability& r) {
+  bool errors = r.mean.has_errors;
+  for (const Row& row : r.sequences) errors = errors || row.has_errors;
+  std::string out =
+      "<h2>Repeatability</h2>\n<p>imu_from_lidar: r_b^{lb} in cm, C_bl as 1-2-3 Euler angles "
+      "(C = Rz(θ3) Ry(θ2) Rx(θ1)) in deg, τ in ms (t_imu = t_lidar + τ); the sigma row holds "
+      "the per-component σ of the SO(3) deviations.</p>\n<table id=\"repeatability\">\n<tr>"
+      "<th>sequence</th><th>r_x</th><th>r_y</th><th>r_z</th><th>θ1</th><th>θ2</th><th>θ3</th>"
+      "<th>τ</th>";
+  if (errors) out += "<th>rot err</th><th>x err</th><th>y err</th><th>z err</th><th>τ err</th>";
+  out += "<th>verdict</th></tr>\n";
+  for (const Row& row : r.sequences) out += RowCells(row, errors);
+  out += RowCells(r.mean, errors) + RowCells(r.sigma, errors);
+  if (r.measured) out += RowCells(*r.measured, errors);
+  out += "</table>\n";
+  for (const std::string& name : r.suspect_set_aside) {
+    out += "<p>SUSPECT, set aside (not in the rows above): " + EscapeHtml(name) + "</p>\n";
+  }
+  return out;
+}
+
+std::string ExtrinsicTable(const proto::CalibrationResult& c) {
+  const Rigid3d t = ToEigen(c.imu_from_lidar());
+  const Eigen::Vector3d euler_deg =
+      geometry::Euler123FromRotation(t.rotation.toRotationMatrix()) * 180.0 / M_PI;
+  const auto& rs = c.rotation_sigma_deg();
+  const auto& ts = c.translation_sigma_m();
+  return fmt::format(
+      "<table class=\"extrinsic\">\n"
+      "<tr><th></th><th>x</th><th>y</th><th>z</th><th>w</th><th>1-σ (x y z)</th></tr>\n"
+      "<tr><td>C_bl quaternion</td><td class=\"qx\">{:.9f}</td><td class=\"qy\">{:.9f}</td>"
+      "<td class=\"qz\">{:.9f}</td><td class=\"qw\">{:.9f}</td>"
+      "<td>{:.3f} {:.3f} {:.3f} deg (about the LiDAR axes)</td></tr>\n"
+      "<tr><td>C_bl 1-2-3 Euler, deg</td><td>{:.3f}</td><td>{:.3f}</td><td>{:.3f}</td>"
+      "<td></td><td></td></tr>\n"
+      "<tr><td>r_b^{{lb}}, m</td><td class=\"tx\">{:.9f}</td><td class=\"ty\">{:.9f}</td>"
+      "<td class=\"tz\">{:.9f}</td><td></td><td>{:.4f} {:.4f} {:.4f} m</td></tr>\n"
+      "<tr><td>τ, s (t_imu = t_lidar + τ)</td><td class=\"tau\">{:.9f}</td><td></td><td></td>"
+      "<td></td><td>{:.6f} s</td></tr>\n</table>\n",
+      t.rotation.x(), t.rotation.y(), t.rotation.z(), t.rotation.w(), rs.x(), rs.y(), rs.z(),
+      euler_deg.x(), euler_deg.y(), euler_deg.z(), t.translation.x(), t.translation.y(),
+      t.translation.z(), ts.x(), ts.y(), ts.z(), c.time_offset_s(), c.time_offset_sigma_s());
+}
+
+std::string SharpnessTable(const proto::CalibrationResult& c) {
+  const double rig_m = c.map_sharpness_rig().median_thickness_m();
+  const double est_m = c.map_sharpness_estimate().median_thickness_m();
+  return fmt::format(
+      "<table class=\"sharpness\">\n<tr><th>map</th><th>median surfel thickness, mm</th>"
+      "<th>planar surfels</th></tr>\n"
+      "<tr><td>rig's extrinsic (before)</td><td class=\"before\">{:.2f}</td><td>{}</td></tr>\n"
+      "<tr><td>estimate (after)</td><td class=\"after\">{:.2f}</td><td>{}</td></tr>\n"
+      "</table>\n<p>after / before: {}; the estimate moved {:.3f} deg and {:.1f} mm from the "
+      "rig.</p>\n",
+      1e3 * rig_m, c.map_sharpness_rig().planar_surfels(), 1e3 * est_m,
+      c.map_sharpness_estimate().planar_surfels(),
+      rig_m > 0 ? fmt::format("{:.3f}", est_m / rig_m) : std::string("n/a"),
+      c.rotation_from_rig_deg(), 1e3 * c.translation_from_rig_m());
+}
+
+std::string FilesList(const SequencePage& s) {
+  std::string out = "<ul class=\"files\">\n";
+  out += fmt::format("<li>calibration: <a href=\"{0}\">{0}</a></li>\n",
+                     EscapeHtml(s.calibration_link));
+  for (const auto& [label, link] : {std::pair<const char*, const std::string&>{
+                                        "map with the rig's extrinsic", s.map_rig_link},
+                                    {"map with the estimate", s.map_calibrated_link}}) {
+    out += link.empty() ? fmt::format("<li>{}: not written</li>\n", label)
+                        : fmt::format("<li>{0} (PCD, pcl_viewer or CloudCompare): <a "
+                                      "class=\"pcd\" href=\"{1}\">{1}</a></li>\n",
+                                      label, EscapeHtml(link));
+  }
+  out += fmt::format(
+      "<li>paste into FAST-LIO, LIO-SAM, URDF, tf, Kalibr: <code>tiltcal_export "
+      "--calibration={} --format=fast_lio</code> (README.md, Using the result)</li>\n</ul>\n",
+      EscapeHtml(s.calibration_link));
+  return out;
+}
+
+std::string SequenceSection(const SequencePage& s) {
+  const proto::CalibrationResult& c = s.calibration;
+  const std::string verdict = VerdictName(c);
+  std::string out = fmt::format(
+      "<section class=\"sequence\" id=\"sequence-{0}\">\n<h2>{0}: <span class=\"verdict "
+      "verdict-{1}\">{1}</span>{2}</h2>\n",
+      EscapeHtml(s.name), verdict, s.set_aside ? " (set aside)" : "");
+  out += "<ul class=\"reasons\">\n";
+  for (const std::string& reason : c.verdict_reasons()) {
+    out += "<li>" + EscapeHtml(reason) + "</li>\n";
+  }
+  out += "</ul>\n" + ExtrinsicTable(c) + "<h3>Map sharpness</h3>\n" + SharpnessTable(c);
+  out += "<h3>Normalised residuals</h3>\n<div class=\"histograms\">\n";
+  for (const proto::ResidualStatistics& r : c.residual_statistics()) {
+    out += ResidualHistogramSvg(r);
+  }
+  out += "</div>\n<h3>Files</h3>\n" + FilesList(s) + "</section>\n";
+  return out;
+}
+
+}  // namespace
+
+std::string EscapeHtml(const std::string& text) {
+  std::string out;
+  out.reserve(text.size());
+  for (const char ch : text) {
+    switch (ch) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      default: out += ch;
+    }
+  }
+  return out;
+}
+
+std::string FormatHtml(const std::string& title, const Repeatability& repeatability,
+                       const std::vector<SequencePage>& sequences) {
+  std::string out = fmt::format(
+      "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
+      "<title>{0}</title>\n<style>{1}</style>\n</head>\n<body>\n<h1>{0}</h1>\n",
+      EscapeHtml(title.empty() ? "tiltcal report" : title), kStyle);
+  out += RepeatabilityTable(repeatability);
+  for (const SequencePage& s : sequences) out += SequenceSection(s);
+  out += "</body>\n</html>\n";
+  return out;
+}
+
+}  // namespace tiltcal::report
