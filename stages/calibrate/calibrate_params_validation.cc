@@ -56,6 +56,25 @@ Status ValidateSurfelMapParams(const proto::SurfelMapParams& params, const std::
   return MustBePositive(params.voxel_m(), path + ".voxel_m");
 }
 
+Status ValidateLidarOdometryParams(const proto::LidarOdometryParams& params) {
+  TILTCAL_RETURN_IF_ERROR(ValidateSurfelMapParams(params.quality_map(), "odometry.quality_map"));
+  if (params.method() != proto::LidarOdometryParams::VOXEL_ICP) return Status::Ok();
+  if (!params.has_voxel_icp()) {
+    return Status::Error("params: odometry.voxel_icp is required with odometry.method VOXEL_ICP");
+  }
+  const proto::VoxelIcpParams& icp = params.voxel_icp();
+  TILTCAL_RETURN_IF_ERROR(
+      MustBePositive(icp.max_correspondence_m(), "odometry.voxel_icp.max_correspondence_m"));
+  TILTCAL_RETURN_IF_ERROR(MustBePositive(icp.kernel_scale_m(), "odometry.voxel_icp.kernel_scale_m"));
+  TILTCAL_RETURN_IF_ERROR(
+      MustBePositive(icp.max_plane_thickness_m(), "odometry.voxel_icp.max_plane_thickness_m"));
+  if (icp.min_plane_points() > icp.max_points_per_cell()) {
+    return Status::Error(
+        "params: odometry.voxel_icp.min_plane_points must not exceed max_points_per_cell");
+  }
+  return Status::Ok();
+}
+
 Status ValidateAssociationParams(const proto::AssociationParams& params) {
   TILTCAL_RETURN_IF_ERROR(MustBePositive(params.max_distance_m(), "association.max_distance_m"));
   return MustBePositive(params.deskew_node_spacing_s(), "association.deskew_node_spacing_s");
@@ -83,8 +102,7 @@ Status ValidateCalibrateParams(const proto::CalibrateParams& params) {
   TILTCAL_RETURN_IF_ERROR(ValidateLidarScanParams(params.scans()));
   TILTCAL_RETURN_IF_ERROR(ValidateLidarResidualParams(params.lidar()));
   TILTCAL_RETURN_IF_ERROR(ValidateInitParams(params.init()));
-  TILTCAL_RETURN_IF_ERROR(
-      ValidateSurfelMapParams(params.odometry().quality_map(), "odometry.quality_map"));
+  TILTCAL_RETURN_IF_ERROR(ValidateLidarOdometryParams(params.odometry()));
   TILTCAL_RETURN_IF_ERROR(ValidateSurfelMapParams(params.map(), "map"));
   TILTCAL_RETURN_IF_ERROR(ValidateAssociationParams(params.association()));
   TILTCAL_RETURN_IF_ERROR(ValidateGroundResidualsParams(params.ground()));

@@ -22,6 +22,8 @@ Status ValidateLidarResidualParams(const proto::LidarResidualParams& params);
 Status ValidateInitParams(const proto::InitParams& params);
 // `path` names the message in the errors ("map", "odometry.quality_map").
 Status ValidateSurfelMapParams(const proto::SurfelMapParams& params, const std::string& path);
+// odometry.quality_map, and odometry.voxel_icp when the method is VOXEL_ICP.
+Status ValidateLidarOdometryParams(const proto::LidarOdometryParams& params);
 Status ValidateAssociationParams(const proto::AssociationParams& params);
 Status ValidateGroundResidualsParams(const proto::GroundResidualsParams& params);
 Status ValidateVerdictParams(const proto::VerdictParams& params);

@@ -1,5 +1,8 @@
 #include "stages/calibrate/lidar_odometry.h"
 
+#include "common/registration/point_to_plane_icp.h"
+#include "common/registration/voxel_downsample.h"
+#include "common/registration/voxel_hash_map.h"
 #include "stages/calibrate/surfel_map.h"
 
 #include <chrono>
@@ -43,6 +46,91 @@ Eigen::Isometry3d Orthonormalised(const Eigen::Matrix4d& m) {
   return t;
 }
 
+registration::VoxelHashMapOptions VoxelMapOptions(const proto::VoxelIcpParams& p) {
+  registration::VoxelHashMapOptions options;
+  options.voxel_m = p.cell_m();
+  options.max_points_per_voxel = static_cast<int>(p.max_points_per_cell());
+  options.min_plane_points = static_cast<int>(p.min_plane_points());
+  options.max_plane_thickness_m = p.max_plane_thickness_m();
+  options.min_plane_spread_ratio = p.min_plane_spread_ratio();
+  return options;
+}
+
+registration::PointToPlaneIcpOptions IcpOptions(const proto::LidarOdometryParams& p) {
+  registration::PointToPlaneIcpOptions options;
+  options.max_iterations = static_cast<int>(p.max_iterations());
+  options.max_correspondence_m = p.voxel_icp().max_correspondence_m();
+  options.kernel_scale_m = p.voxel_icp().kernel_scale_m();
+  options.convergence_rotation_rad = p.voxel_icp().convergence_rotation_rad();
+  options.convergence_translation_m = p.voxel_icp().convergence_translation_m();
+  options.min_correspondences = static_cast<int>(p.voxel_icp().min_correspondences());
+  options.num_threads = static_cast<int>(p.voxel_icp().num_threads());
+  return options;
+}
+
+std::vector<Eigen::Vector3d> Transformed(const Eigen::Isometry3d& t,
+                                         const std::vector<Eigen::Vector3d>& points) {
+  std::vector<Eigen::Vector3d> out;
+  out.reserve(points.size());
+  for (const Eigen::Vector3d& p : points) out.push_back(t * p);
+  return out;
+}
+
+// VOXEL_ICP: every scan is registered against the voxel hash map, then its
+// points (at map_voxel_m) enter the map; a scan counts as a keyframe when it
+// is the first one.
+class VoxelIcpOdometry {
+ public:
+  VoxelIcpOdometry(const proto::LidarOdometryParams& params, const proto::LidarScanParams& scans)
+      : params_(params), scans_(scans), map_(VoxelMapOptions(params.voxel_icp())),
+        icp_options_(IcpOptions(params)) {}
+
+  // Registers the cropped scan from `guess` (unless it is the first scan or
+  // the map is empty), fills pose's registration fields and adds the scan.
+  void Register(const std::vector<Eigen::Vector3f>& points_lidar, const Eigen::Isometry3d& guess,
+                LidarOdometryPose* pose) {
+    std::vector<Eigen::Vector3d> cropped;
+    cropped.reserve(points_lidar.size());
+    const float min_sq = static_cast<float>(scans_.min_range_m() * scans_.min_range_m());
+    const float max_sq = static_cast<float>(scans_.max_range_m() * scans_.max_range_m());
+    for (const Eigen::Vector3f& p : points_lidar) {
+      const float r_sq = p.squaredNorm();
+      if (!p.allFinite() || r_sq < min_sq || r_sq > max_sq) continue;
+      cropped.push_back(p.cast<double>());
+    }
+    const std::vector<Eigen::Vector3d> for_map = registration::VoxelDownsample(cropped, params_.map_voxel_m());
+    const std::vector<Eigen::Vector3d> source = registration::VoxelDownsample(for_map, params_.scan_voxel_m());
+    pose->num_source_points = static_cast<int>(source.size());
+    pose->l0_from_lidar = guess;
+    if (map_.empty()) {
+      pose->keyframe = !for_map.empty();
+    } else if (source.size() >= 10) {
+      const registration::PointToPlaneIcpResult result =
+          registration::AlignPointToPlane(source, map_, guess, icp_options_);
+      pose->converged = result.converged;
+      pose->num_quality_points = result.num_correspondences;
+      pose->inlier_fraction = result.num_correspondences > 0
+                                  ? static_cast<double>(result.num_inliers) / result.num_correspondences
+                                  : 0.0;
+      pose->fitness_rms_m = result.inlier_rms_m;
+      if (result.registered && result.map_from_source.matrix().allFinite()) {
+        pose->l0_from_lidar = result.map_from_source;
+        pose->registered = true;
+      }
+    }
+    if (map_.empty() || pose->registered) {
+      map_.AddPoints(Transformed(pose->l0_from_lidar, for_map));
+      map_.RemoveFarFrom(pose->l0_from_lidar.translation(), params_.voxel_icp().map_radius_m());
+    }
+  }
+
+ private:
+  proto::LidarOdometryParams params_;
+  proto::LidarScanParams scans_;
+  registration::VoxelHashMap map_;
+  registration::PointToPlaneIcpOptions icp_options_;
+};
+
 }  // namespace
 
 struct LidarOdometry::Impl {
@@ -62,9 +150,13 @@ struct LidarOdometry::Impl {
   std::unique_ptr<SurfelMap> quality_map;  // surfels of the local map, frame l0
   pcl::GeneralizedIterativeClosestPoint<pcl::PointXYZ, pcl::PointXYZ> gicp;
   pcl::NormalDistributionsTransform<pcl::PointXYZ, pcl::PointXYZ> ndt;
+  std::unique_ptr<VoxelIcpOdometry> voxel_icp;  // set for method VOXEL_ICP
 
   Impl(const proto::LidarOdometryParams& p, const proto::LidarScanParams& s)
       : params(p), scans(s) {
+    if (p.method() == proto::LidarOdometryParams::VOXEL_ICP) {
+      voxel_icp = std::make_unique<VoxelIcpOdometry>(p, s);
+    }
     const int max_iterations = static_cast<int>(p.max_iterations());
     gicp.setMaximumIterations(max_iterations);
     gicp.setTransformationEpsilon(p.transformation_epsilon());
@@ -186,6 +278,15 @@ const LidarOdometryPose& LidarOdometry::AddScan(double time_s,
   const auto start = std::chrono::steady_clock::now();
   LidarOdometryPose pose;
   pose.time_s = time_s;
+  if (m.voxel_icp) {
+    const Eigen::Isometry3d guess =
+        m.poses.empty() ? Eigen::Isometry3d::Identity() : m.Predict(time_s, rotation_prior);
+    m.voxel_icp->Register(points_lidar, guess, &pose);
+    pose.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    m.poses.push_back(pose);
+    m.priors.push_back(rotation_prior);
+    return m.poses.back();
+  }
   std::vector<Eigen::Vector3f> cropped;
   const Cloud::Ptr source = m.Preprocess(points_lidar, &cropped);
   pose.num_source_points = static_cast<int>(source->size());

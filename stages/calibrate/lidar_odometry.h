@@ -9,19 +9,28 @@
 // (deskewed). Poses are T_{l0 lk} = (C_{l0 lk}, r_{l0}^{lk l0}), i.e.
 // l0_from_lidar, with l0 the first scan's LiDAR frame (so pose 0 = identity).
 //
-// Per scan: a range crop (LidarScanParams min_range_m, max_range_m) and voxel
-// downsampling (scan_voxel_m); prediction
+// Per scan: a range crop (LidarScanParams min_range_m, max_range_m);
+// prediction
 //   C_pred = C_{l0 l(k-1)} C_prior(k-1)^T C_prior(k)   when a rotation prior
 //            (e.g. gyro mapped through the measured extrinsic, see
 //            LidarRotationPriorFromImu) is given, else constant rotation rate;
 //   r_pred = r_{k-1} + (C_{k-1} C_{k-2}^T)(r_{k-1} - r_{k-2}) * dt_k / dt_{k-1}
 //            (constant body-frame velocity);
-// then PCL registration (GICP or NDT) against a local map made of the last
-// local_map_keyframes keyframes (a scan becomes a keyframe when it moved more
-// than keyframe_distance_m or keyframe_angle_deg from the last keyframe),
-// voxel-downsampled at map_voxel_m. PCL only appears in the .cc file.
-// Cost: a VLP-16 scan (~29k points) downsampled at 0.5-0.6 m leaves ~1.5-2k
-// points; GICP then takes ~10-20 ms of one core per scan.
+// then registration by odometry.method:
+// - VOXEL_ICP: the scan downsampled at scan_voxel_m is aligned by
+//   point-to-plane ICP (common/registration/point_to_plane_icp.h) to a voxel
+//   hash map in l0 (common/registration/voxel_hash_map.h); the scan
+//   downsampled at map_voxel_m then enters the map, and cells beyond
+//   voxel_icp.map_radius_m are dropped. Quality fields come from the ICP's
+//   last linearisation. Cost on a VLP-16 scan (~2.3k points at 0.5 m):
+//   ~6.5 iterations, ~8 ms of one core.
+// - GICP (default) or NDT (PCL) against a local map made of the last
+//   local_map_keyframes keyframes (a scan becomes a keyframe when it moved
+//   more than keyframe_distance_m or keyframe_angle_deg from the last
+//   keyframe), voxel-downsampled at map_voxel_m; quality against the surfels
+//   of the full-resolution keyframes. GICP takes ~10-20 ms of one core per
+//   scan plus the keyframe maps.
+// PCL only appears in the .cc file.
 
 #include <memory>
 #include <optional>
@@ -41,11 +50,13 @@ struct LidarOdometryPose {
   bool converged = false;    // the registration reported convergence
   bool keyframe = false;
   int num_source_points = 0;  // after downsampling and cropping
-  // Quality after alignment, against planar surfels of the local map (the
-  // keyframes at full resolution, surfel map quality_map): of the source
-  // points that fall in a surfel voxel (num_quality_points), the fraction
-  // within quality_inlier_distance_m of the plane and their RMS point-to-plane
-  // distance (m). A good registration gives ~1 and ~the range noise.
+  // Quality after alignment. GICP / NDT: against planar surfels of the local
+  // map (the keyframes at full resolution, surfel map quality_map): of the
+  // source points that fall in a surfel voxel (num_quality_points), the
+  // fraction within quality_inlier_distance_m of the plane and their RMS
+  // point-to-plane distance (m). VOXEL_ICP: the point-to-plane
+  // correspondences, the fraction within voxel_icp.kernel_scale_m and their
+  // RMS. A good registration gives ~1 and ~the range noise.
   int num_quality_points = 0;
   double fitness_rms_m = 0.0;
   double inlier_fraction = 0.0;

@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "common/io/atomic_file.h"
+#include "common/io/params.h"
 #include "stages/calibrate/bias_segments.h"
 #include "stages/calibrate/calibrate.h"
 #include "stages/calibrate/calibrate_params_validation.h"
@@ -91,6 +92,14 @@ TEST(CalibrateParamsTest, EachRuleNamesItsField) {
       {"init { odometry_position_sigma_m: 0 }", "init.odometry_position_sigma_m"},
       {"init { deskew_node_spacing_s: 0 }", "init.deskew_node_spacing_s"},
       {"odometry { quality_map { voxel_m: 0 } }", "odometry.quality_map.voxel_m"},
+      {"odometry { method: VOXEL_ICP voxel_icp { max_correspondence_m: 0 } }",
+       "odometry.voxel_icp.max_correspondence_m"},
+      {"odometry { method: VOXEL_ICP voxel_icp { kernel_scale_m: 0 } }",
+       "odometry.voxel_icp.kernel_scale_m"},
+      {"odometry { method: VOXEL_ICP voxel_icp { max_plane_thickness_m: 0 } }",
+       "odometry.voxel_icp.max_plane_thickness_m"},
+      {"odometry { method: VOXEL_ICP voxel_icp { min_plane_points: 30 max_points_per_cell: 20 } }",
+       "odometry.voxel_icp.min_plane_points"},
       {"map { voxel_m: 0 }", "map.voxel_m"},
       {"association { max_distance_m: 0 }", "association.max_distance_m"},
       {"association { deskew_node_spacing_s: 0 }", "association.deskew_node_spacing_s"},
@@ -137,6 +146,20 @@ TEST(CalibrateParamsTest, BiasSegmentsBeyondTheirCountAreAnErrorNotACrash) {
   ASSERT_TRUE(bias.Split(0.0, 60.0, 10.0, "f").ok());
   EXPECT_EQ(bias.size(), 6);
   EXPECT_EQ(bias.Index(std::nan("")), 0);
+}
+
+TEST(CalibrateParamsTest, VoxelIcpNeedsItsSettingsOnlyWhenChosen) {
+  proto::CalibrateParams params = tiltcal::testing::DefaultCalibrateParamsWith();
+  params.mutable_odometry()->clear_voxel_icp();
+  params.mutable_odometry()->set_method(proto::LidarOdometryParams::VOXEL_ICP);
+  const Status status = ValidateCalibrateParams(params);
+  ASSERT_FALSE(status.ok());
+  EXPECT_EQ(status.message(),
+            "params: odometry.voxel_icp is required with odometry.method VOXEL_ICP");
+  // A params file written for GICP (before VOXEL_ICP existed) stays valid.
+  params.mutable_odometry()->set_method(proto::LidarOdometryParams::GICP);
+  EXPECT_TRUE(ValidateCalibrateParams(params).ok());
+  EXPECT_TRUE(ValidateAgainstSchema(params).ok());
 }
 
 }  // namespace

@@ -1,0 +1,115 @@
+#!/usr/bin/env bash
+# Scaling and anchor comparison of tiltcal_calibrate (docs/design.md §13).
+# For each duration (default 20 40 80 160 s) it simulates one sequence of
+# the scenario (default: the 10 x 5 m VLP-16 figure-eight,
+# stages/simulate/scenarios/flat_vlp16_40s.txtpb, with duration_s replaced),
+# runs decode -> ground -> gravity once, then tiltcal_calibrate of this
+# build and of an anchor build (e.g. main's) on the same inputs, alternating
+# which runs first, each under GNU time -v. It prints per run: wall, cpu
+# (user + sys), peak resident memory, the odometry and solve phases (from
+# calibration.txtpb), wall / duration, and the errors against the truth;
+# then per binary the exponent b of a log-log fit wall = a duration^b
+# (1 = linear) and the anchor / this ratios. The machine load (uptime) is
+# printed before and after: the machine is shared, so compare the ratios of
+# one run, not absolute times across runs.
+#
+# Usage: bench/calibrate/run_scaling_bench.sh [options]
+#   --build_dir DIR    this build (default <repo>/build)
+#   --anchor_bin DIR   the anchor's bin/ directory (default: none, this build only)
+#   --durations "S.."  sequence durations, s (default "20 40 80 160")
+#   --scenario FILE    simulate params (default flat_vlp16_40s.txtpb)
+#   --seed N           simulator seed (default: the scenario's)
+#   --params FILE      calibrate params of this build (default its default_params.txtpb)
+#   --anchor_params F  calibrate params of the anchor (default: --params)
+#   --threads N        num_threads of the calibrator (default 2)
+#   --scratch DIR      work directory (default /tmp/tiltcal_scaling_bench)
+# Ground residuals are off (LiDAR + IMU only), as in run_calibrate_bench.sh.
+set -euo pipefail
+
+REPO=$(cd "$(dirname "$0")/../.." && pwd)
+BUILD_DIR="$REPO/build"
+ANCHOR_BIN=""
+DURATIONS="20 40 80 160"
+SCENARIO="$REPO/stages/simulate/scenarios/flat_vlp16_40s.txtpb"
+SEED=""
+PARAMS="$REPO/stages/calibrate/default_params.txtpb"
+ANCHOR_PARAMS=""
+THREADS=2
+SCRATCH=/tmp/tiltcal_scaling_bench
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --build_dir) BUILD_DIR=$2; shift 2 ;;
+    --anchor_bin) ANCHOR_BIN=$2; shift 2 ;;
+    --durations) DURATIONS=$2; shift 2 ;;
+    --scenario) SCENARIO=$2; shift 2 ;;
+    --seed) SEED=$2; shift 2 ;;
+    --params) PARAMS=$2; shift 2 ;;
+    --anchor_params) ANCHOR_PARAMS=$2; shift 2 ;;
+    --threads) THREADS=$2; shift 2 ;;
+    --scratch) SCRATCH=$2; shift 2 ;;
+    -h|--help) sed -n '2,/^set -euo/p' "$0" | sed '$d'; exit 0 ;;
+    *) echo "run_scaling_bench: unknown argument $1" >&2; exit 2 ;;
+  esac
+done
+[ -n "$ANCHOR_PARAMS" ] || ANCHOR_PARAMS=$PARAMS
+BIN="$BUILD_DIR/bin"
+for b in tiltcal_simulate tiltcal_decode tiltcal_ground tiltcal_gravity tiltcal_calibrate; do
+  [ -x "$BIN/$b" ] || { echo "run_scaling_bench: $BIN/$b missing (build it first)" >&2; exit 2; }
+done
+if [ -n "$ANCHOR_BIN" ] && [ ! -x "$ANCHOR_BIN/tiltcal_calibrate" ]; then
+  echo "run_scaling_bench: $ANCHOR_BIN/tiltcal_calibrate missing" >&2; exit 2
+fi
+mkdir -p "$SCRATCH"
+
+calibrate_params() {  # in, out: threads set, ground residuals off
+  sed -e "s/^num_threads: .*/num_threads: $THREADS/" \
+      -e "s/mode: AUTO/mode: OFF/; s/mode: ON/mode: OFF/" "$1" > "$2"
+}
+
+run_calibrate() {  # label, bin dir, params, work dir
+  local label=$1 bin=$2 params=$3 w=$4
+  /usr/bin/time -v -o "$w/time_$label.txt" "$bin/tiltcal_calibrate" --imu="$w/imu.binpb" \
+    --scans="$w/scans.binpb.lz4" --ground="$w/ground.binpb" --gravity="$w/gravity.txtpb" \
+    --rig="$w/rig.txtpb" --params="$params" --out="$w/calibration_$label.txtpb" \
+    2> "$w/log_$label.txt" || {
+      echo "run_scaling_bench: $label calibrate failed:" >&2; tail -3 "$w/log_$label.txt" >&2; exit 1; }
+}
+
+echo "load before: $(uptime)"
+RESULTS="$SCRATCH/results.tsv"
+: > "$RESULTS"
+round=0
+for d in $DURATIONS; do
+  w="$SCRATCH/d$d"
+  mkdir -p "$w"
+  sed -e 's/write_gravity_flat: false/write_gravity_flat: true/' \
+      -e 's/gravity_reference: ".*"/gravity_reference: ""/' \
+      -e "s/^duration_s: .*/duration_s: $d/" "$SCENARIO" > "$w/scenario.txtpb"
+  [ -n "$SEED" ] && sed -i -e "s/^seed: .*/seed: $SEED/" "$w/scenario.txtpb"
+  "$BIN/tiltcal_simulate" --params="$w/scenario.txtpb" --out_bag="$w/seq.bag" \
+    --out_truth="$w/truth.txtpb" --out_rig="$w/rig.txtpb" 2> "$w/log_simulate.txt"
+  "$BIN/tiltcal_decode" --bag="$w/seq.bag" --params="$REPO/stages/decode/default_params.txtpb" \
+    --rig="$w/rig.txtpb" --out_imu="$w/imu.binpb" --out_scans="$w/scans.binpb.lz4" 2> "$w/log_decode.txt"
+  rm -f "$w/seq.bag"
+  "$BIN/tiltcal_ground" --imu="$w/imu.binpb" --scans="$w/scans.binpb.lz4" --rig="$w/rig.txtpb" \
+    --params="$REPO/stages/ground/default_params.txtpb" --out_ground="$w/ground.binpb" 2> "$w/log_ground.txt"
+  "$BIN/tiltcal_gravity" --imu="$w/imu.binpb" --ground="$w/ground.binpb" --rig="$w/rig.txtpb" \
+    --params="$REPO/stages/gravity/default_params.txtpb" --out="$w/gravity.txtpb" 2> "$w/log_gravity.txt"
+  calibrate_params "$PARAMS" "$w/params_this.txtpb"
+  calibrate_params "$ANCHOR_PARAMS" "$w/params_anchor.txtpb"
+  labels="this"
+  if [ -n "$ANCHOR_BIN" ]; then
+    if [ $((round % 2)) -eq 0 ]; then labels="anchor this"; else labels="this anchor"; fi
+  fi
+  for label in $labels; do
+    if [ "$label" = this ]; then
+      run_calibrate this "$BIN" "$w/params_this.txtpb" "$w"
+    else
+      run_calibrate anchor "$ANCHOR_BIN" "$w/params_anchor.txtpb" "$w"
+    fi
+    printf '%s\t%s\t%s\n' "$d" "$label" "$w" >> "$RESULTS"
+  done
+  round=$((round + 1))
+done
+echo "load after:  $(uptime)"
+python3 "$REPO/bench/calibrate/scaling_report.py" "$RESULTS"

@@ -1,0 +1,63 @@
+#ifndef TILTCAL_COMMON_REGISTRATION_POINT_TO_PLANE_ICP_H_
+#define TILTCAL_COMMON_REGISTRATION_POINT_TO_PLANE_ICP_H_
+
+// Point-to-plane ICP of a point set against a VoxelHashMap.
+//
+// Pose T = (R, t) = map_from_source. A source point p moved to the map,
+// p' = R p + t, pairs with its nearest map point q (within the gate) whose
+// voxel has a plane of unit normal n; the residual is
+//   r = n . (p' - q)   (m).
+// The update is a left (map-frame) perturbation delta = (dt, dphi):
+//   T <- (Exp(dphi), dt) * T,   i.e. p' <- Exp(dphi) p' + dt,
+// so dr/d(dt) = n^T and dr/d(dphi) = (p' x n)^T at delta = 0.
+// Each iteration solves the 6x6 normal equations sum w J^T J delta = -sum w J^T r
+// with the Geman-McClure weight w = (s^2 / (s^2 + r^2))^2 of kernel scale s,
+// and stops when |dphi| and |dt| fall below the convergence thresholds.
+// Correspondences are searched on num_threads threads (OpenMP).
+
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "common/registration/voxel_hash_map.h"
+
+namespace tiltcal::registration {
+
+struct PointToPlaneIcpOptions {
+  int max_iterations = 20;
+  double max_correspondence_m = 1.0;       // nearest-neighbour gate, m
+  double kernel_scale_m = 0.1;             // Geman-McClure s, m
+  double convergence_rotation_rad = 1e-4;
+  double convergence_translation_m = 1e-4;
+  int min_correspondences = 20;
+  int num_threads = 1;
+};
+
+struct PointToPlaneIcpResult {
+  Eigen::Isometry3d map_from_source = Eigen::Isometry3d::Identity();
+  bool registered = false;       // at least min_correspondences and a solvable system
+  bool converged = false;        // the last update was below the thresholds
+  int iterations = 0;
+  // Of the last linearisation (at the pose before the last update, which is
+  // below the thresholds when converged): correspondences found, those with
+  // |r| <= kernel scale, and the RMS residual of the latter, m.
+  int num_correspondences = 0;
+  int num_inliers = 0;
+  double inlier_rms_m = 0.0;
+};
+
+// r = n . (p_map - q) and its Jacobian [n^T, (p_map x n)^T] with respect to
+// the left perturbation (dt, dphi) of the pose that produced p_map.
+double PointToPlaneResidual(const Eigen::Vector3d& p_map, const Eigen::Vector3d& q,
+                            const Eigen::Vector3d& n, Eigen::Matrix<double, 1, 6>* jacobian);
+
+// Aligns `source` (source frame) to `map` starting from `initial`.
+PointToPlaneIcpResult AlignPointToPlane(const std::vector<Eigen::Vector3d>& source,
+                                        const VoxelHashMap& map,
+                                        const Eigen::Isometry3d& initial,
+                                        const PointToPlaneIcpOptions& options);
+
+}  // namespace tiltcal::registration
+
+#endif  // TILTCAL_COMMON_REGISTRATION_POINT_TO_PLANE_ICP_H_
