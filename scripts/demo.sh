@@ -79,6 +79,9 @@ for dataset in "$FLAT" "$TILTED"; do
   echo
 done
 echo "Report pages (open in a browser): $FLAT/out/report.html $TILTED/out/report.html" | sed "s#$ROOT/##g"
+echo "One calibration per dataset (the joint row above): $TILTED/out/calibration.txtpb;" \
+  "for FAST-LIO: build/bin/tiltcal_export --calibration=$TILTED/out/calibration.txtpb" \
+  "--format=fast_lio" | sed "s#$ROOT/##g"
 echo "Plots:"
 ls -1 "$FLAT"/out/*.png "$TILTED"/out/*.png "$FLAT"/out/*/*.png "$TILTED"/out/*/*.png 2>/dev/null |
   sed "s#^$ROOT/##; s#^#  #"
