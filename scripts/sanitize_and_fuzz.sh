@@ -16,7 +16,11 @@ TESTS=(io_test checked_conversion_test imu_test ros1_unit_test ros1_bags_test
        decode_unit_test decode_bags_test)
 
 if [ ! -f "$BUILD_DIR/build.ninja" ]; then
+  # -O1 and line tables only: half the compile time of -O2 -g, still
+  # symbolised reports.
   cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only -DNDEBUG" \
+    -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only -DNDEBUG" \
     -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ \
     -DTILTCAL_SANITIZE=address,undefined -DTILTCAL_FUZZ=ON -DTILTCAL_BUILD_BENCHMARKS=OFF \
     >/dev/null
