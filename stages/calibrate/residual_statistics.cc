@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 
 #include "stages/calibrate/accel_cost_function.h"
 #include "stages/calibrate/ground_cost_functions.h"
@@ -53,7 +54,59 @@ void FillHistogram(const std::vector<double>& values, proto::ResidualStatistics*
   s->set_histogram_above(above);
 }
 
+// The rank-ceil(q n) value of `sorted` (nearest rank, q in (0, 1]).
+double NearestRank(const std::vector<double>& sorted, double q) {
+  const size_t rank = static_cast<size_t>(std::ceil(q * static_cast<double>(sorted.size())));
+  return sorted[std::clamp<size_t>(rank, 1, sorted.size()) - 1];
+}
+
+// The time of a residual block: the middle of the spline segment of its
+// first parameter block when that is a rotation knot; false otherwise.
+bool BlockTime(ceres::Problem* problem, ceres::ResidualBlockId id, const CalibrationState& state,
+               double* time_s) {
+  std::vector<double*> blocks;
+  problem->GetParameterBlocksForResidualBlock(id, &blocks);
+  const auto& trajectory = state.trajectory;
+  const double* first = trajectory.rotation_knot(0);
+  const double* last = trajectory.rotation_knot(trajectory.num_knots() - 1);
+  const std::less<const double*> before;
+  if (blocks.empty() || before(blocks.front(), first) || before(last, blocks.front())) return false;
+  const auto knot = static_cast<double>((blocks.front() - first) / 4);
+  *time_s = trajectory.grid().t0_s() + (knot + 0.5) * trajectory.grid().dt_s();
+  return true;
+}
+
 }  // namespace
+
+void FillTimeSeries(const std::vector<TimedResidual>& values, double start_s, double end_s,
+                    int bins, proto::ResidualStatistics* s) {
+  bins = std::max(1, bins);
+  const double width = (end_s - start_s) / bins;
+  std::vector<std::vector<double>> by_bin(static_cast<size_t>(bins));
+  for (const TimedResidual& v : values) {
+    const double bin = width > 0 ? std::floor((v.time_s - start_s) / width) : 0.0;
+    by_bin[static_cast<size_t>(std::clamp(bin, 0.0, bins - 1.0))].push_back(v.value);
+  }
+  s->set_time_start_s(start_s);
+  s->set_time_bin_s(width);
+  for (std::vector<double>& bin : by_bin) {
+    s->add_time_bin_count(static_cast<int>(bin.size()));
+    if (bin.empty()) {
+      for (auto* field : {s->mutable_time_bin_rms(), s->mutable_time_bin_p05(),
+                          s->mutable_time_bin_median(), s->mutable_time_bin_p95()}) {
+        field->Add(0.0f);
+      }
+      continue;
+    }
+    double sum_squares = 0.0;
+    for (const double v : bin) sum_squares += v * v;
+    std::sort(bin.begin(), bin.end());
+    s->add_time_bin_rms(static_cast<float>(std::sqrt(sum_squares / bin.size())));
+    s->add_time_bin_p05(static_cast<float>(NearestRank(bin, 0.05)));
+    s->add_time_bin_median(static_cast<float>(NearestRank(bin, 0.5)));
+    s->add_time_bin_p95(static_cast<float>(NearestRank(bin, 0.95)));
+  }
+}
 
 proto::ResidualStatistics SummariseResiduals(const char* type, std::vector<double> values) {
   proto::ResidualStatistics s;
@@ -73,7 +126,12 @@ proto::ResidualStatistics SummariseResiduals(const char* type, std::vector<doubl
   return s;
 }
 
-std::vector<proto::ResidualStatistics> ComputeResidualStatistics(ceres::Problem* problem) {
+std::vector<proto::ResidualStatistics> ComputeResidualStatistics(
+    ceres::Problem* problem, const CalibrationState& state,
+    const proto::ResidualTimeSeriesParams& params) {
+  const spline::UniformKnotGrid& grid = state.trajectory.grid();
+  const double start_s = grid.t0_s();
+  const double end_s = grid.t0_s() + grid.num_segments() * grid.dt_s();
   std::vector<ceres::ResidualBlockId> blocks;
   problem->GetResidualBlocks(&blocks);
   std::vector<ceres::ResidualBlockId> by_type[kOther];
@@ -90,7 +148,20 @@ std::vector<proto::ResidualStatistics> ComputeResidualStatistics(ceres::Problem*
     double cost = 0.0;
     std::vector<double> residuals;
     if (!problem->Evaluate(options, &cost, &residuals, nullptr, nullptr)) continue;
-    out.push_back(SummariseResiduals(kTypeNames[t], std::move(residuals)));
+    // Evaluate lists the residuals block by block in the order given.
+    std::vector<TimedResidual> timed;
+    size_t offset = 0;
+    for (ceres::ResidualBlockId id : by_type[t]) {
+      const int size = problem->GetCostFunctionForResidualBlock(id)->num_residuals();
+      double time_s = 0.0;
+      if (BlockTime(problem, id, state, &time_s)) {
+        for (int k = 0; k < size; ++k) timed.push_back({time_s, residuals[offset + k]});
+      }
+      offset += static_cast<size_t>(size);
+    }
+    proto::ResidualStatistics s = SummariseResiduals(kTypeNames[t], std::move(residuals));
+    FillTimeSeries(timed, start_s, end_s, static_cast<int>(params.bins()), &s);
+    out.push_back(std::move(s));
   }
   return out;
 }

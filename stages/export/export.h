@@ -5,6 +5,7 @@
 #include <string>
 
 #include "common/status.h"
+#include "tiltcal/proto/calibration.pb.h"
 
 namespace tiltcal::exporter {
 
@@ -21,6 +22,12 @@ struct ExportOptions {
   std::string imu_frame = "imu_link";
   std::string lidar_frame = "lidar_link";
 };
+
+// The text of `calibration` in `options.format` (what Run writes), with
+// `source` (the file's name as given) in its header; refuses a SUSPECT
+// calibration unless allowed. Used by tiltcal_report for the page's exports.
+Status ExportText(const proto::CalibrationResult& calibration, const std::string& source,
+                  const ExportOptions& options, std::string* text);
 
 // Reads the calibration, refuses a SUSPECT one unless allowed, and writes
 // the extrinsic and τ in `options.format` to paths.out (atomically) or to

@@ -2,6 +2,8 @@
 #include <iostream>
 
 #include "common/cli/command_line.h"
+#include "common/io/params.h"
+#include "stages/report/default_params_text.h"
 #include "stages/report/report.h"
 
 int main(int argc, char** argv) {
@@ -15,6 +17,9 @@ int main(int argc, char** argv) {
   cli.AddFlag("out_html", "output: the dataset's page (self-contained HTML)");
   cli.AddFlag("rig", "input: the dataset's rig.txtpb, for the measured extrinsic row");
   cli.AddFlag("title", "first line of the table");
+  cli.AddFlag("params",
+              "input: params, text format (default: stages/report/default_params.txtpb, "
+              "compiled in)");
   cli.AddFlag("dataset_calibration",
               "input: the dataset's calibration.txtpb (tiltcal_dataset_calibration), for the joint "
               "row and the consistency column");
@@ -31,5 +36,9 @@ int main(int argc, char** argv) {
   paths.out_html = cli.Get("out_html");
   paths.title = cli.Get("title");
   paths.dataset_calibration = cli.Get("dataset_calibration");
-  return cli.Finish(tiltcal::report::Run(paths, &std::cout));
+  tiltcal::proto::ReportParams params;
+  const tiltcal::Status status = tiltcal::LoadParamsOrDefaults(
+      cli.Get("params"), tiltcal::report::DefaultParamsText(), &params);
+  if (!status.ok()) return cli.Finish(status);
+  return cli.Finish(tiltcal::report::Run(paths, params, &std::cout));
 }

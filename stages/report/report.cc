@@ -9,6 +9,7 @@
 #include "common/geometry/so3.h"
 #include "common/io/atomic_file.h"
 #include "common/io/eigen_proto.h"
+#include "common/io/params.h"
 #include "common/io/rig.h"
 #include "common/io/text_proto.h"
 #include "stages/report/report_page.h"
@@ -57,14 +58,25 @@ std::string Fixed(double value, int decimals) {
 
 // The sections of the page: every directory's calibration.txtpb or
 // calibration.suspect.txtpb and its maps, linked relative to the page.
-Status ReadSequencePages(const ReportPaths& paths, std::vector<SequencePage>* pages) {
+// `file` relative to the folder of the page `page`.
+std::string RelativeToPage(const std::string& page, const std::string& file) {
   const std::filesystem::path page_dir =
-      std::filesystem::absolute(paths.out_html).lexically_normal().parent_path();
+      std::filesystem::absolute(page).lexically_normal().parent_path();
+  return std::filesystem::absolute(file).lexically_normal().lexically_relative(page_dir).string();
+}
+
+// The maps' vertical in frame a: -g_a / |g_a| (z when the file has no g_a).
+Eigen::Vector3d UpOf(const proto::CalibrationResult& c) {
+  const Eigen::Vector3d g(c.gravity_in_world().x(), c.gravity_in_world().y(),
+                          c.gravity_in_world().z());
+  return g.norm() > 0 && g.allFinite() ? Eigen::Vector3d(-g.normalized())
+                                       : Eigen::Vector3d::UnitZ();
+}
+
+Status ReadSequencePages(const ReportPaths& paths, const proto::ReportParams& params,
+                         std::vector<SequencePage>* pages) {
   auto link = [&](const std::string& file) {
-    return std::filesystem::exists(file)
-               ? std::filesystem::absolute(file).lexically_normal().lexically_relative(page_dir)
-                     .string()
-               : std::string();
+    return std::filesystem::exists(file) ? RelativeToPage(paths.out_html, file) : std::string();
   };
   for (const std::string& dir : paths.sequence_dirs) {
     SequencePage page;
@@ -76,6 +88,15 @@ Status ReadSequencePages(const ReportPaths& paths, std::vector<SequencePage>* pa
     page.calibration_link = link(file);
     page.map_rig_link = link(dir + "/map_rig.pcd");
     page.map_calibrated_link = link(dir + "/map_calibrated.pcd");
+    if (!page.map_rig_link.empty() && !page.map_calibrated_link.empty()) {
+      TILTCAL_RETURN_IF_ERROR(MakeWallSnapshots(dir + "/map_rig.pcd", dir + "/map_calibrated.pcd",
+                                                UpOf(page.calibration), params.wall_snapshot(),
+                                                &page.snapshots));
+    } else {
+      page.snapshots.note = "the maps were not written (tiltcal_calibrate --out_map_rig, "
+                            "--out_map_calibrated)";
+    }
+    page.exports = MakePageExports(page.calibration, file, &page.exports_note);
     pages->push_back(std::move(page));
   }
   return Status::Ok();
@@ -258,10 +279,11 @@ Status ReadCalibrationAnswer(const std::string& path, Answer* answer) {
 
 }  // namespace
 
-Status Run(const ReportPaths& paths, std::ostream* log) {
+Status Run(const ReportPaths& paths, const proto::ReportParams& params, std::ostream* log) {
   if (paths.sequence_dirs.empty()) {
     return Status::Error("no sequence directories given");
   }
+  TILTCAL_RETURN_IF_ERROR(ValidateAgainstSchema(params).WithContext("report params"));
   TILTCAL_RETURN_IF_ERROR(CheckOutputPath(paths.out));
   if (!paths.out_csv.empty()) TILTCAL_RETURN_IF_ERROR(CheckOutputPath(paths.out_csv));
   std::vector<SequenceResult> results;
@@ -289,10 +311,12 @@ Status Run(const ReportPaths& paths, std::ostream* log) {
   }
   Repeatability repeatability = ComputeRepeatability(results, paths.rig.empty() ? nullptr : &rig);
   repeatability.suspect_set_aside = suspect_set_aside;
+  std::optional<DatasetPage> dataset;
   if (!paths.dataset_calibration.empty()) {
-    proto::CalibrationResult dataset;
-    TILTCAL_RETURN_IF_ERROR(ReadTextProto(paths.dataset_calibration, &dataset));
-    AddDatasetCalibration(dataset, results, &repeatability);
+    dataset.emplace();
+    TILTCAL_RETURN_IF_ERROR(
+        ReadCalibrationAnswer(paths.dataset_calibration, &dataset->calibration));
+    AddDatasetCalibration(dataset->calibration, results, &repeatability);
   }
   const std::string table = FormatTable(repeatability, paths.title);
   TILTCAL_RETURN_IF_ERROR(WriteFileAtomically(paths.out, table));
@@ -301,9 +325,15 @@ Status Run(const ReportPaths& paths, std::ostream* log) {
   }
   if (!paths.out_html.empty()) {
     std::vector<SequencePage> pages;
-    TILTCAL_RETURN_IF_ERROR(ReadSequencePages(paths, &pages));
-    TILTCAL_RETURN_IF_ERROR(
-        WriteFileAtomically(paths.out_html, FormatHtml(paths.title, repeatability, pages)));
+    TILTCAL_RETURN_IF_ERROR(ReadSequencePages(paths, params, &pages));
+    if (dataset) {
+      dataset->calibration_link = RelativeToPage(paths.out_html, paths.dataset_calibration);
+      dataset->exports = MakePageExports(dataset->calibration, paths.dataset_calibration,
+                                         &dataset->exports_note);
+    }
+    TILTCAL_RETURN_IF_ERROR(WriteFileAtomically(
+        paths.out_html,
+        FormatHtml(paths.title, repeatability, pages, dataset ? &*dataset : nullptr)));
   }
   if (log != nullptr) *log << table;
   return Status::Ok();

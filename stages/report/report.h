@@ -10,6 +10,7 @@
 
 #include "common/status.h"
 #include "tiltcal/proto/calibration.pb.h"
+#include "tiltcal/proto/report_params.pb.h"
 #include "tiltcal/proto/rig.pb.h"
 #include "tiltcal/proto/truth.pb.h"
 
@@ -85,9 +86,11 @@ struct ReportPaths {
 // directory (a directory with only calibration.suspect.txtpb, a SUSPECT
 // result Makefile.pipeline set aside, is listed as such and left out of the
 // rows), computes the repeatability, writes the table, the CSV and the page
-// (where the set-aside sequences have their section too), and prints the
-// table to `log` (nullptr: silent).
-Status Run(const ReportPaths& paths, std::ostream* log);
+// (where the set-aside sequences have their section too: with the wall
+// snapshots of <dir>/map_rig.pcd and map_calibrated.pcd when both exist,
+// drawn with params.wall_snapshot, and the exports of each calibration and
+// of the dataset's), and prints the table to `log` (nullptr: silent).
+Status Run(const ReportPaths& paths, const proto::ReportParams& params, std::ostream* log);
 
 }  // namespace tiltcal::report
 

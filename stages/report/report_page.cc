@@ -7,6 +7,7 @@
 #include "common/geometry/euler_angles.h"
 #include "common/io/eigen_proto.h"
 #include "stages/report/residual_histogram_svg.h"
+#include "stages/report/residual_time_svg.h"
 
 namespace tiltcal::report {
 namespace {
@@ -17,7 +18,11 @@ constexpr char kStyle[] =
     "td,th{border:1px solid #ccc;padding:2px 8px;text-align:right}"
     "th:first-child,td:first-child{text-align:left}"
     ".verdict-OK{color:#1e7b34}.verdict-WEAK{color:#a06800}.verdict-SUSPECT{color:#b00020}"
-    ".histograms{display:flex;flex-wrap:wrap;gap:1em}"
+    ".histograms,.time-series-plots,.side-views{display:flex;flex-wrap:wrap;gap:1em}"
+    "figure{margin:0.3em 0}figcaption{font-size:90%}"
+    "img.snapshot{border:1px solid #999;image-rendering:pixelated;display:block}"
+    "pre.export{border:1px solid #ddd;padding:6px;overflow-x:auto;user-select:all}"
+    "section{border-top:2px solid #ccc;margin-top:2em}"
     "code,pre{background:#f4f4f4;padding:1px 4px}";
 
 std::string VerdictName(const proto::CalibrationResult& c) {
@@ -26,7 +31,7 @@ std::string VerdictName(const proto::CalibrationResult& c) {
              : proto::CalibrationResult::Verdict_Name(c.verdict());
 }
 
-std::string RowCells(const Row& row, bool errors) {
+std::string RowCells(const Row& row, bool errors, bool consistency) {
   std::string cells = "<td>" + EscapeHtml(row.label) + "</td>";
   for (int i = 0; i < 3; ++i) cells += fmt::format("<td>{:.2f}</td>", row.translation_cm[i]);
   for (int i = 0; i < 3; ++i) cells += fmt::format("<td>{:.3f}</td>", row.euler123_deg[i]);
@@ -43,6 +48,7 @@ std::string RowCells(const Row& row, bool errors) {
     }
   }
   cells += fmt::format("<td class=\"verdict-{0}\">{0}</td>", EscapeHtml(row.verdict));
+  if (consistency) cells += "<td>" + EscapeHtml(row.consistency) + "</td>";
   return "<tr>" + cells + "</tr>\n";
 }
 
@@ -56,10 +62,14 @@ std::string RepeatabilityTable(const Repeatability& r) {
       "<th>sequence</th><th>r_x</th><th>r_y</th><th>r_z</th><th>θ1</th><th>θ2</th><th>θ3</th>"
       "<th>τ</th>";
   if (errors) out += "<th>rot err</th><th>x err</th><th>y err</th><th>z err</th><th>τ err</th>";
-  out += "<th>verdict</th></tr>\n";
-  for (const Row& row : r.sequences) out += RowCells(row, errors);
-  out += RowCells(r.mean, errors) + RowCells(r.sigma, errors);
-  if (r.measured) out += RowCells(*r.measured, errors);
+  const bool consistency = r.joint.has_value();
+  out += consistency ? "<th>verdict</th><th>consistency with the joint value (χ² / limit)</th>"
+                       "</tr>\n"
+                     : "<th>verdict</th></tr>\n";
+  for (const Row& row : r.sequences) out += RowCells(row, errors, consistency);
+  out += RowCells(r.mean, errors, consistency) + RowCells(r.sigma, errors, consistency);
+  if (r.measured) out += RowCells(*r.measured, errors, consistency);
+  if (r.joint) out += RowCells(*r.joint, errors, consistency);
   out += "</table>\n";
   for (const std::string& name : r.suspect_set_aside) {
     out += "<p>SUSPECT, set aside (not in the rows above): " + EscapeHtml(name) + "</p>\n";
@@ -118,10 +128,105 @@ std::string FilesList(const SequencePage& s) {
                                       "class=\"pcd\" href=\"{1}\">{1}</a></li>\n",
                                       label, EscapeHtml(link));
   }
-  out += fmt::format(
-      "<li>paste into FAST-LIO, LIO-SAM, URDF, tf, Kalibr: <code>tiltcal_export "
-      "--calibration={} --format=fast_lio</code> (README.md, Using the result)</li>\n</ul>\n",
-      EscapeHtml(s.calibration_link));
+  return out + "</ul>\n";
+}
+
+std::string SnapshotFigure(const SnapshotImage& image, const std::string& classes,
+                           const std::string& caption) {
+  return fmt::format(
+      "<figure><img class=\"snapshot {0}\" src=\"{1}\" width=\"{2}\" height=\"{3}\" "
+      "alt=\"{4}\"><figcaption>{4}</figcaption></figure>\n",
+      classes, image.data_uri, image.width, image.height, EscapeHtml(caption));
+}
+
+// The wall from above and from the side, rig's extrinsic and estimate.
+std::string SnapshotsBlock(const SequencePage& s) {
+  const WallSnapshots& w = s.snapshots;
+  if (!w.note.empty() || w.top_rig.data_uri.empty()) {
+    return "<p class=\"no-snapshots\">Wall snapshots: " +
+           EscapeHtml(w.note.empty() ? "maps not written" : w.note) + "</p>\n";
+  }
+  const proto::CalibrationResult& c = s.calibration;
+  const std::string before =
+      fmt::format("rig's extrinsic (before), map median surfel thickness {:.2f} mm",
+                  1e3 * c.map_sharpness_rig().median_thickness_m());
+  const std::string after =
+      fmt::format("estimate (after), map median surfel thickness {:.2f} mm",
+                  1e3 * c.map_sharpness_estimate().median_thickness_m());
+  const double height_m = w.slab.top_m - w.slab.bottom_m;
+  std::string out = fmt::format(
+      "<div class=\"snapshots\">\n<p>The largest vertical planar surface of the calibrated map "
+      "({} cells, {} points, centre {:.2f} {:.2f} {:.2f} m in frame a), the same slab of both "
+      "maps: {:.1f} m along the wall, {:.2f} m across, {:.2f} m high; 1 pixel = {:.1f} mm, "
+      "darker = more points (the same shading for both). A wrong extrinsic shows as a thick "
+      "or doubled wall.</p>\n<h4>From above (along the wall left to right, across it bottom "
+      "to top)</h4>\n",
+      w.slab.cells, w.slab.points, w.slab.center.x(), w.slab.center.y(), w.slab.center.z(),
+      w.slab.length_m, w.slab.depth_m, height_m,
+      w.top_rig.width > 0 ? 1e3 * w.slab.length_m / w.top_rig.width : 0.0);
+  out += SnapshotFigure(w.top_rig, "top rig", before);
+  out += SnapshotFigure(w.top_calibrated, "top calibrated", after);
+  out += "<h4>From the side (looking along the wall: across it left to right, up)</h4>\n"
+         "<div class=\"side-views\">\n";
+  out += SnapshotFigure(w.side_rig, "side rig", "before (rig)");
+  out += SnapshotFigure(w.side_calibrated, "side calibrated", "after (estimate)");
+  out += "</div>\n</div>\n";
+  return out;
+}
+
+// The export texts, each in its own block; collapsed unless `open`.
+std::string ExportsBlock(const std::vector<PageExport>& exports, const std::string& note,
+                         const std::string& calibration_link, bool open) {
+  if (exports.empty()) {
+    return "<p class=\"no-exports\">Exports: " + EscapeHtml(note.empty() ? "none" : note) +
+           "</p>\n";
+  }
+  std::string out = fmt::format(
+      "<details class=\"exports\"{}>\n<summary>Exports for FAST-LIO, LIO-SAM, URDF, tf, Kalibr "
+      "(<code>tiltcal_export --calibration={} --format=NAME</code>; README.md, Using the "
+      "result)</summary>\n",
+      open ? " open" : "", EscapeHtml(calibration_link));
+  for (const PageExport& e : exports) {
+    out += fmt::format("<h4>{0}</h4>\n<pre class=\"export\" data-format=\"{0}\">{1}</pre>\n",
+                       EscapeHtml(e.format), EscapeHtml(e.text));
+  }
+  return out + "</details>\n";
+}
+
+std::string YesNo(bool value) { return value ? "yes" : "no"; }
+
+// The joint value of tiltcal_dataset_calibration: extrinsic with σ, each
+// sequence's consistency with it, the exports.
+std::string DatasetSection(const DatasetPage& d) {
+  const proto::CalibrationResult& c = d.calibration;
+  const std::string verdict = VerdictName(c);
+  std::string out = fmt::format(
+      "<section class=\"dataset\" id=\"dataset\">\n<h2>Dataset calibration: <span "
+      "class=\"verdict verdict-{0}\">{0}</span></h2>\n<p>One extrinsic from the sequences "
+      "(<a href=\"{1}\">{1}</a>, tiltcal_dataset_calibration): the value to use.</p>\n"
+      "<ul class=\"reasons\">\n",
+      verdict, EscapeHtml(d.calibration_link));
+  for (const std::string& reason : c.verdict_reasons()) {
+    out += "<li>" + EscapeHtml(reason) + "</li>\n";
+  }
+  out += "</ul>\n" + ExtrinsicTable(c);
+  out += "<h3>Sequences</h3>\n<table class=\"consistency\">\n<tr><th>sequence</th>"
+         "<th>verdict</th><th>used</th><th>χ²</th><th>dof</th><th>limit</th>"
+         "<th>consistent</th><th>largest disagreement / reason</th></tr>\n";
+  for (const proto::DatasetSequence& q : c.sequences()) {
+    out += fmt::format(
+        "<tr><td>{}</td><td>{}</td><td>{}</td><td>{:.1f}</td><td>{}</td><td>{:.1f}</td>"
+        "<td>{}</td><td>{}</td></tr>\n",
+        EscapeHtml(q.name()),
+        q.verdict() == proto::CalibrationResult::VERDICT_UNSET
+            ? std::string("UNSET")
+            : proto::CalibrationResult::Verdict_Name(q.verdict()),
+        YesNo(q.used()), q.consistency_chi2(), q.consistency_dof(), q.consistency_limit(),
+        YesNo(q.consistent()),
+        EscapeHtml(q.reason().empty() ? q.disagreement() : q.reason()));
+  }
+  out += "</table>\n<h3>Exports</h3>\n" +
+         ExportsBlock(d.exports, d.exports_note, d.calibration_link, true) + "</section>\n";
   return out;
 }
 
@@ -136,12 +241,17 @@ std::string SequenceSection(const SequencePage& s) {
   for (const std::string& reason : c.verdict_reasons()) {
     out += "<li>" + EscapeHtml(reason) + "</li>\n";
   }
-  out += "</ul>\n" + ExtrinsicTable(c) + "<h3>Map sharpness</h3>\n" + SharpnessTable(c);
+  out += "</ul>\n" + ExtrinsicTable(c) + "<h3>Map sharpness</h3>\n" + SharpnessTable(c) +
+         SnapshotsBlock(s);
   out += "<h3>Normalised residuals</h3>\n<div class=\"histograms\">\n";
   for (const proto::ResidualStatistics& r : c.residual_statistics()) {
     out += ResidualHistogramSvg(r);
   }
-  out += "</div>\n<h3>Files</h3>\n" + FilesList(s) + "</section>\n";
+  out += "</div>\n<h4>Over time</h4>\n<div class=\"time-series-plots\">\n";
+  for (const proto::ResidualStatistics& r : c.residual_statistics()) out += ResidualTimeSvg(r);
+  out += "</div>\n<h3>Exports</h3>\n" +
+         ExportsBlock(s.exports, s.exports_note, s.calibration_link, false) +
+         "<h3>Files</h3>\n" + FilesList(s) + "</section>\n";
   return out;
 }
 
@@ -163,11 +273,12 @@ std::string EscapeHtml(const std::string& text) {
 }
 
 std::string FormatHtml(const std::string& title, const Repeatability& repeatability,
-                       const std::vector<SequencePage>& sequences) {
+                       const std::vector<SequencePage>& sequences, const DatasetPage* dataset) {
   std::string out = fmt::format(
       "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
       "<title>{0}</title>\n<style>{1}</style>\n</head>\n<body>\n<h1>{0}</h1>\n",
       EscapeHtml(title.empty() ? "tiltcal report" : title), kStyle);
+  if (dataset != nullptr) out += DatasetSection(*dataset);
   out += RepeatabilityTable(repeatability);
   for (const SequencePage& s : sequences) out += SequenceSection(s);
   out += "</body>\n</html>\n";

@@ -4,6 +4,8 @@
 #include <string>
 #include <vector>
 
+#include "stages/report/map_snapshots.h"
+#include "stages/report/page_exports.h"
 #include "stages/report/report.h"
 #include "tiltcal/proto/calibration.pb.h"
 
@@ -19,15 +21,33 @@ struct SequencePage {
   std::string calibration_link;
   std::string map_rig_link;         // map_rig.pcd
   std::string map_calibrated_link;  // map_calibrated.pcd
+  // The wall drawn from both maps (note "maps not written" when absent).
+  WallSnapshots snapshots;
+  // The exports of its calibration (none for a SUSPECT one: exports_note).
+  std::vector<PageExport> exports;
+  std::string exports_note;
+};
+
+// The dataset's joint calibration (tiltcal_dataset_calibration's
+// out/calibration.txtpb) and its exports.
+struct DatasetPage {
+  proto::CalibrationResult calibration;
+  std::string calibration_link;
+  std::vector<PageExport> exports;
+  std::string exports_note;
 };
 
 // The dataset's report page: one self-contained HTML file (inline CSS and
-// SVG, no script, no network) with the repeatability table and, per
-// sequence, the verdict and its reasons, the extrinsic and τ with σ, the map
-// sharpness with the rig's extrinsic and with the estimate, the normalised
-// residual histograms against N(0,1), and the map PCDs and export commands.
+// SVG, PNG as data: URIs; no script, no network): the dataset's calibration
+// with σ, its per-sequence consistency and its exports (when `dataset` is
+// given), the repeatability table and, per sequence, the verdict and its
+// reasons, the extrinsic and τ with σ, the map sharpness with the rig's
+// extrinsic and with the estimate and the wall snapshots of both maps, the
+// normalised residuals as histograms against N(0,1) and over time, the
+// exports, and the links to the calibration and the map PCDs.
 std::string FormatHtml(const std::string& title, const Repeatability& repeatability,
-                       const std::vector<SequencePage>& sequences);
+                       const std::vector<SequencePage>& sequences,
+                       const DatasetPage* dataset = nullptr);
 
 // Text with & < > " escaped for HTML.
 std::string EscapeHtml(const std::string& text);

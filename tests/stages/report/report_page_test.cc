@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
 
 #include <gmock/gmock.h>
@@ -11,7 +12,11 @@
 #include "common/io/atomic_file.h"
 #include "common/io/text_proto.h"
 #include "stages/report/report.h"
+#include "stages/export/export.h"
 #include "stages/report/residual_histogram_svg.h"
+#include "stages/report/residual_time_svg.h"
+#include "tests/stages/report/synthetic_wall.h"
+#include "tests/stages/report/report_params_text.h"
 #include "tests/testing/test_env.h"
 
 namespace tiltcal::report {
@@ -35,6 +40,14 @@ proto::ResidualStatistics Histogram(const std::string& type) {
   s.set_histogram_bin_width(0.25);
   for (int i = 0; i < 40; ++i) s.add_histogram_counts(i == 20 ? 60 : (i == 19 ? 38 : 0));
   s.set_histogram_above(2);
+  // Over time: 4 bins of 10 s from 0, the third empty.
+  s.set_time_start_s(0.0);
+  s.set_time_bin_s(10.0);
+  for (const int count : {30, 40, 0, 30}) s.add_time_bin_count(count);
+  for (const float v : {1.0f, 1.1f, 0.0f, 0.9f}) s.add_time_bin_rms(v);
+  for (const float v : {-1.6f, -1.7f, 0.0f, -1.5f}) s.add_time_bin_p05(v);
+  for (const float v : {0.0f, 0.1f, 0.0f, -0.1f}) s.add_time_bin_median(v);
+  for (const float v : {1.6f, 6.0f, 0.0f, 1.5f}) s.add_time_bin_p95(v);
   return s;
 }
 
@@ -56,6 +69,7 @@ proto::CalibrationResult Calibration(proto::CalibrationResult::Verdict verdict) 
   c.mutable_map_sharpness_rig()->set_planar_surfels(900);
   c.mutable_map_sharpness_estimate()->set_median_thickness_m(0.0121);
   c.mutable_map_sharpness_estimate()->set_planar_surfels(1100);
+  c.mutable_gravity_in_world()->set_z(-9.81);
   for (const char* type : {"gyro", "accel", "lidar", "ground"}) {
     *c.add_residual_statistics() = Histogram(type);
   }
@@ -78,6 +92,24 @@ TEST(ResidualHistogramSvg, BarsCurveAndMarks) {
   EXPECT_THAT(ResidualHistogramSvg(old), HasSubstr("gyro: no histogram in the calibration file"));
 }
 
+// Two runs of non-empty bins (0-1 and 3): two bands, two medians, two RMS
+// lines; bin 1's p95 of 6 is clipped to +5 (the top of the plot, y = 22).
+TEST(ResidualTimeSvg, BandsMedianRmsAndMarks) {
+  const std::string svg = ResidualTimeSvg(Histogram("gyro"));
+  EXPECT_EQ(Count(svg, "<polygon class=\"band\""), 2u);
+  EXPECT_EQ(Count(svg, "<polyline class=\"median\""), 2u);
+  EXPECT_EQ(Count(svg, "<polyline class=\"rms\""), 2u);
+  EXPECT_EQ(Count(svg, "class=\"sigma3\""), 2u);
+  // x of bin i's middle: 30 + (10 i + 5) / 40 * 480; y of r: 82 - 12 r.
+  EXPECT_THAT(svg, HasSubstr("<polygon class=\"band\" points=\"90.0,62.8 210.0,22.0 "
+                             "210.0,102.4 90.0,101.2\""));
+  EXPECT_THAT(svg, HasSubstr("<polyline class=\"median\" points=\"450.0,83.2\""));
+  EXPECT_THAT(svg, HasSubstr("<line class=\"sigma3\" x1=\"30\" y1=\"118.0\""));
+  proto::ResidualStatistics old;
+  old.set_type("lidar");
+  EXPECT_THAT(ResidualTimeSvg(old), HasSubstr("lidar: no residuals over time"));
+}
+
 TEST(ReportPage, SectionsShowVerdictExtrinsicSharpnessAndEscapedReasons) {
   SequencePage page;
   page.name = "run1";
@@ -96,12 +128,14 @@ TEST(ReportPage, SectionsShowVerdictExtrinsicSharpnessAndEscapedReasons) {
   EXPECT_THAT(html, HasSubstr("<td class=\"after\">12.10</td>"));
   EXPECT_THAT(html, HasSubstr("after / before: 0.388"));
   EXPECT_EQ(Count(html, "<svg class=\"histogram\""), 4u);
+  EXPECT_EQ(Count(html, "<svg class=\"time-series\""), 4u);
+  EXPECT_THAT(html, HasSubstr("Wall snapshots: maps not written"));
   EXPECT_THAT(html, HasSubstr("<a class=\"pcd\" href=\"run1/map_rig.pcd\">"));
   EXPECT_THAT(html, HasSubstr("map with the estimate: not written"));
   // Self-contained: nothing fetched, nothing run.
   EXPECT_THAT(html, Not(HasSubstr("<script")));
   EXPECT_THAT(html, Not(HasSubstr("<link")));
-  EXPECT_THAT(html, Not(HasSubstr("src=")));
+  EXPECT_THAT(html, Not(HasSubstr("src=")));  // no maps: no images
 }
 
 // Two sequence folders as the pipeline leaves them: run1 calibrated (with
@@ -118,14 +152,35 @@ class ReportRunTest : public ::testing::Test {
     ASSERT_TRUE(WriteTextProto(dir_.File("run2/calibration.suspect.txtpb"),
                                Calibration(proto::CalibrationResult::SUSPECT))
                     .ok());
-    for (const char* map : {"run1/map_rig.pcd", "run1/map_calibrated.pcd"}) {
-      ASSERT_TRUE(WriteFileAtomically(dir_.File(map), "pcd").ok());
+    // Before: the wall doubled 10 cm behind itself; after: one 1.8 cm sheet.
+    const std::vector<double> sheet = {-0.009, -0.003, 0.003, 0.009};
+    std::vector<double> doubled = sheet;
+    for (const double dx : sheet) doubled.push_back(dx + 0.1);
+    ASSERT_TRUE(WriteFileAtomically(dir_.File("run1/map_rig.pcd"),
+                                    MapPcdBytes(SyntheticWallScene(doubled)))
+                    .ok());
+    ASSERT_TRUE(WriteFileAtomically(dir_.File("run1/map_calibrated.pcd"),
+                                    MapPcdBytes(SyntheticWallScene(sheet)))
+                    .ok());
+    proto::CalibrationResult dataset = Calibration(proto::CalibrationResult::OK);
+    dataset.mutable_imu_from_lidar()->mutable_translation()->set_x(0.125);
+    for (const char* name : {"run1", "run2"}) {
+      proto::DatasetSequence* s = dataset.add_sequences();
+      s->set_name(name);
+      s->set_verdict(proto::CalibrationResult::OK);
+      s->set_used(std::string(name) == "run1");
+      s->set_consistency_chi2(3.25);
+      s->set_consistency_dof(6);
+      s->set_consistency_limit(22.46);
+      s->set_consistent(true);
     }
+    ASSERT_TRUE(WriteTextProto(dir_.File("calibration.txtpb"), dataset).ok());
+    paths_.dataset_calibration = dir_.File("calibration.txtpb");
     paths_.sequence_dirs = {dir_.File("run1"), dir_.File("run2")};
     paths_.out = dir_.File("repeatability.txt");
     paths_.out_html = dir_.File("report.html");
     paths_.title = "two runs";
-    ASSERT_TRUE(report::Run(paths_, nullptr).ok());
+    ASSERT_TRUE(report::Run(paths_, DefaultReportParams(), nullptr).ok());
     ASSERT_TRUE(ReadFileToString(paths_.out_html, &html_).ok());
   }
 
@@ -143,6 +198,22 @@ TEST_F(ReportRunTest, PageHasEverySequenceAndRelativeLinks) {
   EXPECT_THAT(html_, HasSubstr("href=\"run1/map_rig.pcd\""));
   EXPECT_THAT(html_, HasSubstr("href=\"run1/map_calibrated.pcd\""));
   EXPECT_THAT(html_, HasSubstr("href=\"run2/calibration.suspect.txtpb\""));
+  // The dataset's section first, with its exports open; run1's exports
+  // collapsed; run2 (SUSPECT) not exported.
+  EXPECT_THAT(html_, HasSubstr("<section class=\"dataset\" id=\"dataset\">"));
+  EXPECT_LT(html_.find("id=\"dataset\""), html_.find("id=\"repeatability\""));
+  EXPECT_THAT(html_, HasSubstr("<td class=\"tx\">0.125000000</td>"));
+  EXPECT_THAT(html_, HasSubstr("<tr><td>run1</td><td>OK</td><td>yes</td><td>3.2</td><td>6</td>"
+                               "<td>22.5</td><td>yes</td>"));
+  EXPECT_THAT(html_, HasSubstr("<details class=\"exports\" open>"));
+  EXPECT_EQ(Count(html_, "<pre class=\"export\""), 12u);  // 6 formats, dataset and run1
+  EXPECT_THAT(html_, HasSubstr("verdict SUSPECT (the map with the estimate is &lt;not&gt; "
+                               "sharper &amp; that is bad); not exported without --allow_suspect"));
+  EXPECT_THAT(html_, HasSubstr("<td>chi2 3.2 / 22.5</td>"));
+  // Four snapshots of run1, every image a data: URI; none for run2.
+  EXPECT_EQ(Count(html_, "<img class=\"snapshot "), 4u);
+  EXPECT_EQ(Count(html_, "src="), Count(html_, "src=\"data:image/png;base64,"));
+  EXPECT_THAT(html_, HasSubstr("width=\"600\" height=\"90\""));  // 4 m x 0.6 m at 150 px/m
 }
 
 // The page in a real browser: Debian's chromium, headless, loads it from
@@ -152,24 +223,76 @@ TEST_F(ReportRunTest, ChromiumLoadsThePage) {
   if (testing::RunCommand("command -v chromium > /dev/null") != 0) {
     GTEST_SKIP() << "chromium is not installed (scripts/setup.sh installs it)";
   }
-  const std::string command =
-      "chromium --headless --no-sandbox --disable-gpu --no-first-run "
-      "--user-data-dir=" + dir_.File("profile") +
-      " --enable-logging=stderr --v=0 --dump-dom file://" + paths_.out_html +
-      " 2> " + dir_.File("chromium.log");
-  std::string dom;
-  ASSERT_EQ(testing::RunCommand(command, &dom), 0) << dom;
-  std::string log;
-  ASSERT_TRUE(ReadFileToString(dir_.File("chromium.log"), &log).ok());
+  // The page as written, and a copy with a checker appended that records,
+  // once the page has loaded, how many images it has and how many decoded
+  // (complete, naturalWidth > 0) in the DOM.
+  const std::string checked = dir_.File("report_checked.html");
+  ASSERT_TRUE(WriteFileAtomically(
+                  checked,
+                  html_ + "<script>window.addEventListener('load', () => { const images = "
+                          "[...document.images]; document.body.dataset.images = images.length; "
+                          "document.body.dataset.decoded = images.filter(i => i.complete && "
+                          "i.naturalWidth > 0).length; });</script>\n")
+                  .ok());
+  auto load = [&](const std::string& page, std::string* dom, std::string* log) {
+    const std::string command =
+        "chromium --headless --no-sandbox --disable-gpu --no-first-run "
+        "--user-data-dir=" + dir_.File("profile") +
+        " --enable-logging=stderr --v=0 --virtual-time-budget=2000 --dump-dom file://" + page +
+        " 2> " + dir_.File("chromium.log");
+    ASSERT_EQ(testing::RunCommand(command, dom), 0) << *dom;
+    ASSERT_TRUE(ReadFileToString(dir_.File("chromium.log"), log).ok());
+  };
+  std::string dom, log, checked_dom, checked_log;
+  load(paths_.out_html, &dom, &log);
   EXPECT_THAT(log, Not(HasSubstr("CONSOLE"))) << log;
+  load(checked, &checked_dom, &checked_log);
+  EXPECT_THAT(checked_log, Not(HasSubstr("CONSOLE"))) << checked_log;
+  EXPECT_THAT(checked_dom, HasSubstr("data-images=\"4\" data-decoded=\"4\""));
+  // The exports shown are tiltcal_export's output, byte for byte.
+  auto unescape = [](std::string text) {
+    for (const auto& [from, to] : {std::pair<std::string, std::string>{"&lt;", "<"},
+                                   {"&gt;", ">"}, {"&quot;", "\""}, {"&amp;", "&"}}) {
+      for (size_t i = text.find(from); i != std::string::npos; i = text.find(from, i + 1)) {
+        text.replace(i, from.size(), to);
+      }
+    }
+    return text;
+  };
+  size_t at = 0;
+  for (const std::string& calibration :
+       {paths_.dataset_calibration, paths_.sequence_dirs[0] + "/calibration.txtpb"}) {
+    for (const char* format : {"fast_lio", "lio_sam", "urdf", "tf_ros1", "tf_ros2", "kalibr"}) {
+      const std::string open = std::string("<pre class=\"export\" data-format=\"") + format + "\">";
+      at = dom.find(open, at);
+      ASSERT_NE(at, std::string::npos) << format;
+      at += open.size();
+      const std::string shown = unescape(dom.substr(at, dom.find("</pre>", at) - at));
+      std::ostringstream expected;
+      exporter::ExportOptions options;
+      options.format = format;
+      ASSERT_TRUE(exporter::Run({calibration, ""}, options, &expected).ok());
+      EXPECT_EQ(shown, expected.str()) << calibration << " " << format;
+    }
+  }
   EXPECT_EQ(Count(dom, "<section class=\"sequence\""), 2u) << dom.substr(0, 2000);
   EXPECT_EQ(Count(dom, "<svg class=\"histogram\""), 8u);
   EXPECT_EQ(Count(dom, "<polyline class=\"normal\""), 8u);
+  EXPECT_EQ(Count(dom, "<svg class=\"time-series\""), 8u);
   proto::CalibrationResult file;
   ASSERT_TRUE(ReadTextProto(dir_.File("run1/calibration.txtpb"), &file).ok());
   char qx[64];
   std::snprintf(qx, sizeof(qx), "<td class=\"qx\">%.9f</td>", file.imu_from_lidar().rotation().x());
   EXPECT_THAT(dom, HasSubstr(qx));
+  // The dataset's extrinsic shown equals its file's.
+  proto::CalibrationResult joint;
+  ASSERT_TRUE(ReadTextProto(paths_.dataset_calibration, &joint).ok());
+  const size_t dataset_at = dom.find("id=\"dataset\"");
+  ASSERT_NE(dataset_at, std::string::npos);
+  char tx[64];
+  std::snprintf(tx, sizeof(tx), "<td class=\"tx\">%.9f</td>",
+                joint.imu_from_lidar().translation().x());
+  EXPECT_EQ(dom.find(tx, dataset_at), dom.find("<td class=\"tx\">", dataset_at));
 }
 
 }  // namespace

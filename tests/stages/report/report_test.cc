@@ -12,6 +12,7 @@
 #include "common/io/atomic_file.h"
 #include "common/io/eigen_proto.h"
 #include "common/io/text_proto.h"
+#include "tests/stages/report/report_params_text.h"
 #include "tests/testing/test_env.h"
 
 namespace tiltcal::report {
@@ -84,7 +85,7 @@ TEST(Repeatability, RunWritesTableAndCsvAndFailsOnMissingResult) {
   paths.out = dir.File("repeatability.txt");
   paths.out_csv = dir.File("repeatability.csv");
   std::ostringstream log;
-  const Status status = report::Run(paths, &log);
+  const Status status = report::Run(paths, DefaultReportParams(), &log);
   ASSERT_TRUE(status.ok()) << status.message();
   const std::string table = log.str();
   std::string written;
@@ -100,7 +101,7 @@ TEST(Repeatability, RunWritesTableAndCsvAndFailsOnMissingResult) {
 
   paths.sequence_dirs.push_back(dir.File("missing"));
   paths.out = dir.File("other.txt");
-  const Status missing = report::Run(paths, nullptr);
+  const Status missing = report::Run(paths, DefaultReportParams(), nullptr);
   ASSERT_FALSE(missing.ok());
   EXPECT_NE(missing.message().find("missing/calibration.txtpb"), std::string::npos);
   EXPECT_FALSE(testing::FileExists(dir.File("other.txt")));
@@ -126,7 +127,7 @@ TEST(Repeatability, EmptyOrNanCalibrationAndTruthAreRefused) {
   };
   for (const auto& [text, error] : cases) {
     ASSERT_TRUE(WriteFileAtomically(calibration, text).ok());
-    Status status = report::Run(paths, nullptr);
+    Status status = report::Run(paths, DefaultReportParams(), nullptr);
     ASSERT_FALSE(status.ok()) << text;
     EXPECT_EQ(status.message().rfind(calibration + ": ", 0), 0u) << status.message();
     EXPECT_NE(status.message().find(error), std::string::npos) << status.message();
@@ -134,13 +135,13 @@ TEST(Repeatability, EmptyOrNanCalibrationAndTruthAreRefused) {
     // The same text as the truth, beside a good calibration.
     ASSERT_TRUE(WriteTextProto(calibration, good.calibration).ok());
     ASSERT_TRUE(WriteFileAtomically(truth, text).ok());
-    status = report::Run(paths, nullptr);
+    status = report::Run(paths, DefaultReportParams(), nullptr);
     ASSERT_FALSE(status.ok()) << text;
     EXPECT_EQ(status.message().rfind(truth + ": ", 0), 0u) << status.message();
     EXPECT_FALSE(testing::FileExists(paths.out));
     std::filesystem::remove(truth);
   }
-  ASSERT_TRUE(report::Run(paths, nullptr).ok());
+  ASSERT_TRUE(report::Run(paths, DefaultReportParams(), nullptr).ok());
 }
 
 // The verdict column, and a SUSPECT result the pipeline set aside
@@ -164,7 +165,7 @@ TEST(Repeatability, VerdictColumnAndSuspectSequencesSetAside) {
   paths.out = dir.File("repeatability.txt");
   paths.out_csv = dir.File("repeatability.csv");
   std::ostringstream log;
-  const Status status = report::Run(paths, &log);
+  const Status status = report::Run(paths, DefaultReportParams(), &log);
   ASSERT_TRUE(status.ok()) << status.message();
   const std::string table = log.str();
   EXPECT_NE(table.find("verdict"), std::string::npos) << table;
@@ -185,7 +186,7 @@ TEST(Repeatability, VerdictColumnAndSuspectSequencesSetAside) {
   EXPECT_EQ(csv.substr(csv.find('\n', mean + 1) - 11, 11), ",10,5,,,,,,") << csv;
 
   paths.sequence_dirs = {dir.File("bad")};
-  const Status none = report::Run(paths, nullptr);
+  const Status none = report::Run(paths, DefaultReportParams(), nullptr);
   ASSERT_FALSE(none.ok());
   EXPECT_NE(none.message().find("no usable calibration"), std::string::npos) << none.message();
 }
