@@ -48,7 +48,8 @@ std::string EncodePng(const GrayImage& image) {
   std::string header;
   AppendBigEndian32(static_cast<uint32_t>(image.width), &header);
   AppendBigEndian32(static_cast<uint32_t>(image.height), &header);
-  header += std::string("\x08\x00\x00\x00\x00", 5);  // depth 8, grey, deflate, filter 0, no interlace
+  // Bit depth 8, greyscale, deflate, filter method 0, no interlace.
+  header += std::string("\x08\x00\x00\x00\x00", 5);
   std::string png("\x89PNG\r\n\x1a\n", 8);
   AppendChunk("IHDR", header, &png);
   AppendChunk("IDAT", compressed, &png);

@@ -365,7 +365,8 @@ void FillVerdictFacts(const CalibrateInputs& inputs, const proto::CalibrateParam
                       const CalibrationState& state, proto::CalibrationResult* result) {
   const auto start = Clock::now();
   result->clear_residual_statistics();
-  for (proto::ResidualStatistics& s : ComputeResidualStatistics(problem->problem(), state, params.residual_time_series())) {
+  for (proto::ResidualStatistics& s :
+       ComputeResidualStatistics(problem->problem(), state, params.residual_time_series())) {
     *result->add_residual_statistics() = std::move(s);
   }
   result->set_time_offset_lower_bound_s(problem->time_offset_lower_s());

@@ -64,7 +64,9 @@ Status ParseMapPcd(const std::string& bytes, const std::string& path,
     }
     point_size += static_cast<size_t>(size) * static_cast<size_t>(count);
   }
-  if (fields.size() < 3) return Status::Error(path + ": PCD fields must start with x y z (float32)");
+  if (fields.size() < 3) {
+    return Status::Error(path + ": PCD fields must start with x y z (float32)");
+  }
   unsigned long long n = 0;
   if (std::sscanf(header["POINTS"][0].c_str(), "%llu", &n) != 1) {
     return Status::Error(path + ": PCD POINTS is not a number");

@@ -318,12 +318,10 @@ Status Run(const ReportPaths& paths, const proto::ReportParams& params, std::ost
         ReadCalibrationAnswer(paths.dataset_calibration, &dataset->calibration));
     AddDatasetCalibration(dataset->calibration, results, &repeatability);
   }
-  const std::string table = FormatTable(repeatability, paths.title);
-  TILTCAL_RETURN_IF_ERROR(WriteFileAtomically(paths.out, table));
-  if (!paths.out_csv.empty()) {
-    TILTCAL_RETURN_IF_ERROR(WriteFileAtomically(paths.out_csv, FormatCsv(repeatability)));
-  }
+  // Everything is read and computed before the first output is written.
+  std::string html;
   if (!paths.out_html.empty()) {
+    TILTCAL_RETURN_IF_ERROR(CheckOutputPath(paths.out_html));
     std::vector<SequencePage> pages;
     TILTCAL_RETURN_IF_ERROR(ReadSequencePages(paths, params, &pages));
     if (dataset) {
@@ -331,10 +329,14 @@ Status Run(const ReportPaths& paths, const proto::ReportParams& params, std::ost
       dataset->exports = MakePageExports(dataset->calibration, paths.dataset_calibration,
                                          &dataset->exports_note);
     }
-    TILTCAL_RETURN_IF_ERROR(WriteFileAtomically(
-        paths.out_html,
-        FormatHtml(paths.title, repeatability, pages, dataset ? &*dataset : nullptr)));
+    html = FormatHtml(paths.title, repeatability, pages, dataset ? &*dataset : nullptr);
   }
+  const std::string table = FormatTable(repeatability, paths.title);
+  TILTCAL_RETURN_IF_ERROR(WriteFileAtomically(paths.out, table));
+  if (!paths.out_csv.empty()) {
+    TILTCAL_RETURN_IF_ERROR(WriteFileAtomically(paths.out_csv, FormatCsv(repeatability)));
+  }
+  if (!paths.out_html.empty()) TILTCAL_RETURN_IF_ERROR(WriteFileAtomically(paths.out_html, html));
   if (log != nullptr) *log << table;
   return Status::Ok();
 }

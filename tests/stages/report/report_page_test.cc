@@ -216,6 +216,25 @@ TEST_F(ReportRunTest, PageHasEverySequenceAndRelativeLinks) {
   EXPECT_THAT(html_, HasSubstr("width=\"600\" height=\"90\""));  // 4 m x 0.6 m at 150 px/m
 }
 
+// A map that cannot be read, or params out of their bounds: one error
+// naming the file or the field, and no output written.
+TEST_F(ReportRunTest, MalformedMapOrParamsAreErrorsNamingThem) {
+  paths_.out = dir_.File("again.txt");
+  paths_.out_html = dir_.File("again.html");
+  proto::ReportParams params = DefaultReportParams();
+  params.mutable_wall_snapshot()->set_pixels_per_m(0);
+  const Status bad_params = report::Run(paths_, params, nullptr);
+  EXPECT_THAT(bad_params.message(), HasSubstr("pixels_per_m")) << bad_params.message();
+  ASSERT_TRUE(WriteFileAtomically(dir_.File("run1/map_rig.pcd"),
+                                  "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nPOINTS 5\nDATA binary\n")
+                  .ok());
+  const Status bad_map = report::Run(paths_, DefaultReportParams(), nullptr);
+  EXPECT_EQ(bad_map.message(),
+            dir_.File("run1/map_rig.pcd") + ": PCD truncated: POINTS 5, data for 0");
+  EXPECT_FALSE(std::filesystem::exists(paths_.out));
+  EXPECT_FALSE(std::filesystem::exists(paths_.out_html));
+}
+
 // The page in a real browser: Debian's chromium, headless, loads it from
 // disk without console errors, and the DOM it builds has the sections, the
 // histograms and the extrinsic of the calibration file.

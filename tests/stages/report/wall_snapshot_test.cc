@@ -78,7 +78,8 @@ TEST(WallSnapshot, ThicknessAndDoublingShowInPixels) {
   }
   EXPECT_EQ(columns, (std::vector<int>{29, 30}));
   // Doubled: a second sheet 10 cm further along +x (rows up the image).
-  const auto doubled = SyntheticWallScene({-0.009, -0.003, 0.003, 0.009, 0.091, 0.097, 0.103, 0.109});
+  const auto doubled =
+      SyntheticWallScene({-0.009, -0.003, 0.003, 0.009, 0.091, 0.097, 0.103, 0.109});
   EXPECT_EQ(OccupiedRows(RenderWallView(doubled, s, WallView::kTop, 100)),
             (std::vector<int>{19, 20, 29, 30}));
   // Shading: empty white, the saturation and above black.
