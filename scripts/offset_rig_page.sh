@@ -14,7 +14,7 @@ cd "$(dirname "$0")/.."
 DATASET=${1:-/tmp/tiltcal_offset_rig}
 BIN=build/bin
 for tool in tiltcal_simulate tiltcal_decode tiltcal_ground tiltcal_gravity tiltcal_calibrate \
-  tiltcal_dataset_calibration tiltcal_report tiltcal_inspect; do
+  tiltcal_dataset_calibration tiltcal_report; do
   [ -x "$BIN/$tool" ] || { echo "build $tool first (scripts/build.sh)" >&2; exit 1; }
 done
 rm -rf "$DATASET"
