@@ -13,6 +13,14 @@
 namespace tiltcal::report {
 namespace {
 
+// The defaults with a slab 4 m x 0.6 m (the pixel positions below).
+proto::WallSnapshotParams Params() {
+  proto::WallSnapshotParams params = DefaultReportParams().wall_snapshot();
+  params.set_slab_length_m(4.0);
+  params.set_slab_depth_m(0.6);
+  return params;
+}
+
 // Rows of the top view (across the wall) that hold any point.
 std::vector<int> OccupiedRows(const DensityImage& image) {
   std::vector<int> rows;
@@ -29,8 +37,7 @@ std::vector<int> OccupiedRows(const DensityImage& image) {
 
 TEST(WallSnapshot, FindsTheLargestVerticalPlaneNotTheGround) {
   const auto points = SyntheticWallScene({-0.009, -0.003, 0.003, 0.009});
-  const auto slab = FindWall(points, Eigen::Vector3d::UnitZ(),
-                             DefaultReportParams().wall_snapshot());
+  const auto slab = FindWall(points, Eigen::Vector3d::UnitZ(), Params());
   ASSERT_TRUE(slab.has_value());
   EXPECT_NEAR(std::abs(slab->across.x()), 1.0, 1e-6);  // the wall's normal
   EXPECT_NEAR(std::abs(slab->along.y()), 1.0, 1e-6);
@@ -51,7 +58,7 @@ TEST(WallSnapshot, FindsTheLargestVerticalPlaneNotTheGround) {
 // columns 29 and 30 of the side view; the same wall doubled 10 cm behind
 // fills two more rows 10 pixels further.
 TEST(WallSnapshot, ThicknessAndDoublingShowInPixels) {
-  proto::WallSnapshotParams params = DefaultReportParams().wall_snapshot();
+  const proto::WallSnapshotParams params = Params();
   const auto thin = SyntheticWallScene({-0.009, -0.003, 0.003, 0.009});
   const auto slab = FindWall(thin, Eigen::Vector3d::UnitZ(), params);
   ASSERT_TRUE(slab.has_value());
