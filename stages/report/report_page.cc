@@ -18,7 +18,8 @@ constexpr char kStyle[] =
     "td,th{border:1px solid #ccc;padding:2px 8px;text-align:right}"
     "th:first-child,td:first-child{text-align:left}"
     ".verdict-OK{color:#1e7b34}.verdict-WEAK{color:#a06800}.verdict-SUSPECT{color:#b00020}"
-    ".histograms,.time-series-plots,.side-views{display:flex;flex-wrap:wrap;gap:1em}"
+    ".histograms,.time-series-plots,.side-views,.snapshot-views{display:flex;flex-wrap:wrap;"
+    "gap:1em}"
     "figure{margin:0.3em 0}figcaption{font-size:90%}"
     "img.snapshot{border:1px solid #999;image-rendering:pixelated;display:block}"
     "pre.export{border:1px solid #ddd;padding:6px;overflow-x:auto;user-select:all}"
@@ -159,18 +160,18 @@ std::string SnapshotsBlock(const SequencePage& s) {
       "({} cells, {} points, centre {:.2f} {:.2f} {:.2f} m in frame a), the same slab of both "
       "maps: {:.1f} m along the wall, {:.2f} m across, {:.2f} m high; 1 pixel = {:.1f} mm, "
       "darker = more points (the same shading for both). A wrong extrinsic shows as a thick "
-      "or doubled wall.</p>\n<h4>From above (along the wall left to right, across it bottom "
-      "to top)</h4>\n",
+      "or doubled wall.</p>\n<div class=\"snapshot-views\">\n<div>\n<h4>From above (along "
+      "the wall left to right, across it bottom to top)</h4>\n",
       w.slab.cells, w.slab.points, w.slab.center.x(), w.slab.center.y(), w.slab.center.z(),
       w.slab.length_m, w.slab.depth_m, height_m,
       w.top_rig.width > 0 ? 1e3 * w.slab.length_m / w.top_rig.width : 0.0);
   out += SnapshotFigure(w.top_rig, "top rig", before);
   out += SnapshotFigure(w.top_calibrated, "top calibrated", after);
-  out += "<h4>From the side (looking along the wall: across it left to right, up)</h4>\n"
+  out += "</div>\n<div>\n<h4>Looking along the wall<br>(across it left to right)</h4>\n"
          "<div class=\"side-views\">\n";
-  out += SnapshotFigure(w.side_rig, "side rig", "before (rig)");
-  out += SnapshotFigure(w.side_calibrated, "side calibrated", "after (estimate)");
-  out += "</div>\n</div>\n";
+  out += SnapshotFigure(w.side_rig, "side rig", "before");
+  out += SnapshotFigure(w.side_calibrated, "side calibrated", "after");
+  out += "</div>\n</div>\n</div>\n</div>\n";
   return out;
 }
 
