@@ -78,7 +78,8 @@ for dataset in "$FLAT" "$TILTED"; do
   cat "$dataset/out/repeatability.txt"
   echo
 done
-echo "Report pages (open in a browser): $FLAT/out/report.html $TILTED/out/report.html" | sed "s#$ROOT/##g"
+echo "Report pages (open in a browser: calibration, exports, wall snapshots, residual plots):" \
+  "$FLAT/out/report.html $TILTED/out/report.html" | sed "s#$ROOT/##g"
 echo "One calibration per dataset (the joint row above): $TILTED/out/calibration.txtpb;" \
   "for FAST-LIO: build/bin/tiltcal_export --calibration=$TILTED/out/calibration.txtpb" \
   "--format=fast_lio" | sed "s#$ROOT/##g"
