@@ -45,6 +45,8 @@ Status MakeWallSnapshots(const std::string& map_rig_path, const std::string& map
     return Status::Ok();
   }
   snapshots->slab = *slab;
+  snapshots->spread_rig_m = WallSpread(rig, *slab);
+  snapshots->spread_calibrated_m = WallSpread(calibrated, *slab);
   const double ppm = params.pixels_per_m();
   for (const WallView view : {WallView::kTop, WallView::kSide}) {
     const DensityImage after = RenderWallView(calibrated, *slab, view, ppm);

@@ -27,6 +27,8 @@ struct WallSnapshots {
   std::string note;  // why there are no images ("" when there are)
   WallSlab slab;
   SnapshotImage top_rig, top_calibrated, side_rig, side_calibrated;
+  double spread_rig_m = 0.0;  // WallSpread of each map, m
+  double spread_calibrated_m = 0.0;
 };
 
 // `up`: the maps' vertical, frame a (unit). An unreadable or malformed map

@@ -148,19 +148,21 @@ std::string SnapshotsBlock(const SequencePage& s) {
            EscapeHtml(w.note.empty() ? "maps not written" : w.note) + "</p>\n";
   }
   const proto::CalibrationResult& c = s.calibration;
-  const std::string before =
-      fmt::format("rig's extrinsic (before), map median surfel thickness {:.2f} mm",
-                  1e3 * c.map_sharpness_rig().median_thickness_m());
-  const std::string after =
-      fmt::format("estimate (after), map median surfel thickness {:.2f} mm",
-                  1e3 * c.map_sharpness_estimate().median_thickness_m());
+  const std::string before = fmt::format(
+      "rig's extrinsic (before): this wall's spread {:.1f} mm; map median surfel thickness "
+      "{:.2f} mm",
+      1e3 * w.spread_rig_m, 1e3 * c.map_sharpness_rig().median_thickness_m());
+  const std::string after = fmt::format(
+      "estimate (after): this wall's spread {:.1f} mm; map median surfel thickness {:.2f} mm",
+      1e3 * w.spread_calibrated_m, 1e3 * c.map_sharpness_estimate().median_thickness_m());
   const double height_m = w.slab.top_m - w.slab.bottom_m;
   std::string out = fmt::format(
       "<div class=\"snapshots\">\n<p>The largest vertical planar surface of the calibrated map "
       "({} cells, {} points, centre {:.2f} {:.2f} {:.2f} m in frame a), the same slab of both "
       "maps: {:.1f} m along the wall, {:.2f} m across, {:.2f} m high; 1 pixel = {:.1f} mm, "
       "darker = more points (the same shading for both). A wrong extrinsic shows as a thick "
-      "or doubled wall.</p>\n<div class=\"snapshot-views\">\n<div>\n<h4>From above (along "
+      "or doubled wall. Spread: the robust σ of the points' distance across the wall, "
+      "1.4826 median |b − median b|.</p>\n<div class=\"snapshot-views\">\n<div>\n<h4>From above (along "
       "the wall left to right, across it bottom to top)</h4>\n",
       w.slab.cells, w.slab.points, w.slab.center.x(), w.slab.center.y(), w.slab.center.z(),
       w.slab.length_m, w.slab.depth_m, height_m,

@@ -170,6 +170,29 @@ DensityImage RenderWallView(const std::vector<Eigen::Vector3f>& points, const Wa
   return image;
 }
 
+double WallSpread(const std::vector<Eigen::Vector3f>& points, const WallSlab& slab) {
+  std::vector<double> across;
+  for (const Eigen::Vector3f& q : points) {
+    const Eigen::Vector3d d = q.cast<double>() - slab.center;
+    const double a = slab.along.dot(d);
+    const double b = slab.across.dot(d);
+    const double h = slab.up.dot(d);
+    if (std::abs(a) < 0.5 * slab.length_m && std::abs(b) < 0.5 * slab.depth_m &&
+        h >= slab.bottom_m && h < slab.top_m) {
+      across.push_back(b);
+    }
+  }
+  if (across.empty()) return 0.0;
+  auto median = [](std::vector<double>* v) {
+    const auto middle = v->begin() + static_cast<std::ptrdiff_t>(v->size() / 2);
+    std::nth_element(v->begin(), middle, v->end());
+    return *middle;
+  };
+  const double m = median(&across);
+  for (double& b : across) b = std::abs(b - m);
+  return 1.4826 * median(&across);
+}
+
 GrayImage ShadeDensity(const DensityImage& density, uint32_t saturation) {
   GrayImage image;
   image.width = density.width;

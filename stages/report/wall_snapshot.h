@@ -65,6 +65,12 @@ struct DensityImage {
 DensityImage RenderWallView(const std::vector<Eigen::Vector3f>& points, const WallSlab& slab,
                             WallView view, double pixels_per_m);
 
+// How thick the wall is in the slab: the robust σ of the points' distance
+// across it, 1.4826 median |b − median(b)| (m), over the points in the
+// slab; 0 when it holds none. A wrong extrinsic smears or doubles the wall
+// and raises it.
+double WallSpread(const std::vector<Eigen::Vector3f>& points, const WallSlab& slab);
+
 // Dark on white: 255 (1 - log(1 + c) / log(1 + saturation)), clamped at 0
 // (use the same saturation for images to be compared).
 GrayImage ShadeDensity(const DensityImage& density, uint32_t saturation);

@@ -214,6 +214,7 @@ TEST_F(ReportRunTest, PageHasEverySequenceAndRelativeLinks) {
   EXPECT_EQ(Count(html_, "<img class=\"snapshot "), 4u);
   EXPECT_EQ(Count(html_, "src="), Count(html_, "src=\"data:image/png;base64,"));
   EXPECT_THAT(html_, HasSubstr("width=\"600\" height=\"150\""));  // 4 m x 1 m at 150 px/m
+  EXPECT_THAT(html_, HasSubstr("rig's extrinsic (before): this wall's spread "));
 }
 
 // A map that cannot be read, or params out of their bounds: one error

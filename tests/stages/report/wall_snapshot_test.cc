@@ -89,6 +89,10 @@ TEST(WallSnapshot, ThicknessAndDoublingShowInPixels) {
       SyntheticWallScene({-0.009, -0.003, 0.003, 0.009, 0.091, 0.097, 0.103, 0.109});
   EXPECT_EQ(OccupiedRows(RenderWallView(doubled, s, WallView::kTop, 100)),
             (std::vector<int>{19, 20, 29, 30}));
+  // Spread: a 1.8 cm wall (sheets ±3, ±9 mm) about 9 mm, doubled 10 cm
+  // (half the points 10 cm away) about 7 cm.
+  EXPECT_NEAR(WallSpread(thin, s), 0.0089, 0.0005);
+  EXPECT_GT(WallSpread(doubled, s), 0.05);
   // Shading: empty white, the saturation and above black.
   DensityImage d;
   d.width = 3;
