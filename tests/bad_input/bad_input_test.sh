@@ -189,6 +189,21 @@ for f in "$BAD/empty" "$BAD/dir" "$BAD/garbage" "$BAD/nan_calibration.txtpb"; do
   done
 done
 
+# The maps the page draws (both must exist for the snapshots; the other one
+# is a valid PCD without points).
+for f in "$BAD/empty" "$BAD/dir" "$BAD/garbage"; do
+  for name in map_rig.pcd map_calibrated.pcd; do
+    rm -rf "$WORK/seq" && mkdir -p "$WORK/seq"
+    cp "$GOOD/calibration.txtpb" "$WORK/seq/calibration.txtpb"
+    for map in map_rig.pcd map_calibrated.pcd; do
+      printf 'FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nPOINTS 0\nDATA binary\n' > "$WORK/seq/$map"
+    done
+    rm -rf "$WORK/seq/$name" && cp -r "$f" "$WORK/seq/$name"
+    expect_failure "$WORK/seq/$name" "$BIN/tiltcal_report" --out="$OUT/repeatability.txt" \
+      --out_html="$OUT/report.html" "$WORK/seq"
+  done
+done
+
 # ---- tiltcal_inspect ----
 for cmd in info cat csv; do
   for f in $(generic_bad_files) "$BAD/bad_header.binpb"; do
