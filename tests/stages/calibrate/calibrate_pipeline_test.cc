@@ -452,6 +452,19 @@ TEST(CalibratePipelineTest, ShortFlatSequenceAgainstTruth) {
     int histogram_total = s.histogram_below() + s.histogram_above();
     for (const int c : s.histogram_counts()) histogram_total += c;
     EXPECT_EQ(histogram_total, s.count()) << s.type();
+    // Over time: every gyro, accel and LiDAR residual is dated (on a spline
+    // segment) and falls in one of the default 40 bins; the clean data's
+    // 5-95 % band stays within the noise model's ±3.
+    ASSERT_EQ(s.time_bin_count_size(), 40) << s.type();
+    int time_total = 0;
+    for (int i = 0; i < s.time_bin_count_size(); ++i) {
+      time_total += s.time_bin_count(i);
+      if (s.time_bin_count(i) == 0) continue;
+      EXPECT_GT(s.time_bin_p05(i), -3.0f) << s.type() << " bin " << i;
+      EXPECT_LT(s.time_bin_p95(i), 3.0f) << s.type() << " bin " << i;
+    }
+    EXPECT_EQ(time_total, s.count()) << s.type();
+    EXPECT_GT(s.time_bin_s(), 0.0);
   }
   // The before/after maps (map_export.h): the same scans moved with the rig's
   // extrinsic (off by 1.7 deg and 4.4 cm) and with the estimate, whose
