@@ -12,6 +12,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -76,11 +77,20 @@ int Decode(const std::string& bag, const std::string& out_dir, const std::string
                              output);
 }
 
-// The default params with `extra` appended.
+// The default params with each `replacements` pair (a line of the defaults,
+// its replacement) applied.
 std::string WriteParams(const testing::TempDir& dir, const std::string& name,
-                        const std::string& extra) {
-  std::ifstream defaults(testing::SourceDir() + "/stages/decode/default_params.txtpb");
-  std::ofstream(dir.File(name)) << defaults.rdbuf() << "\n" << extra << "\n";
+                        const std::vector<std::pair<std::string, std::string>>& replacements) {
+  std::ifstream in(testing::SourceDir() + "/stages/decode/default_params.txtpb");
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string params = text.str();
+  for (const auto& [from, to] : replacements) {
+    const size_t at = params.find(from);
+    EXPECT_NE(at, std::string::npos) << "'" << from << "' not in the default params";
+    if (at != std::string::npos) params.replace(at, from.size(), to);
+  }
+  std::ofstream(dir.File(name)) << params;
   return dir.File(name);
 }
 
@@ -177,7 +187,9 @@ TEST_F(DecodeLivox, Ros1BagsOfBothDriversDecodeToWhatTheOracleWrote) {
   }
   // Another mask and minimum range: only the return-number bits drop points.
   const std::string params =
-      WriteParams(dir_, "mask.txtpb", "min_range_m: 2\nlivox { noise_tag_mask: 48 }");
+      WriteParams(dir_, "mask.txtpb",
+                  {{"min_range_m: 0.5", "min_range_m: 2"},
+                   {"noise_tag_mask: 15", "noise_tag_mask: 48"}});
   std::string output;
   ASSERT_EQ(Decode(dir_.File("livox_ros_driver.bag"), dir_.File("out_mask"), params, &output), 0)
       << output;
@@ -255,7 +267,8 @@ TEST_F(DecodeLivoxBadInput, PointNumTruncationDefinitionAndClockAreOneErrorLine)
                      {dir_.File("definition.bag"), topic + "0", "runs past its record: points"});
   // Message 2's timebase is 3 ms before its stamp.
   const std::string params =
-      WriteParams(dir_, "strict.txtpb", "livox { max_timebase_stamp_difference_s: 0.001 }");
+      WriteParams(dir_, "strict.txtpb",
+                  {{"max_timebase_stamp_difference_s: 0.1", "max_timebase_stamp_difference_s: 0.001"}});
   ExpectCleanFailure(WriteBag("clock", ""),
                      {dir_.File("clock.bag"), topic + "2", "-0.003000 s from header.stamp",
                       "livox.max_timebase_stamp_difference_s"},
@@ -263,7 +276,8 @@ TEST_F(DecodeLivoxBadInput, PointNumTruncationDefinitionAndClockAreOneErrorLine)
 }
 
 TEST_F(DecodeLivoxBadInput, NoiseTagMaskOutOfRangeIsAnError) {
-  const std::string params = WriteParams(dir_, "bad_mask.txtpb", "livox { noise_tag_mask: 256 }");
+  const std::string params =
+      WriteParams(dir_, "bad_mask.txtpb", {{"noise_tag_mask: 15", "noise_tag_mask: 256"}});
   ExpectCleanFailure(WriteBag("ok", ""), {"livox.noise_tag_mask"}, params);
 }
 
