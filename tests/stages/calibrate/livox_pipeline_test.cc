@@ -5,10 +5,13 @@
 // of decode may assume a ring order: every ground plane must match the
 // simulator's truth and the extrinsic and time offset must be recovered
 // within the tolerances of the VLP-16 sequence it is made from
-// (calibrate_pipeline_test, short_flat_vlp16.txtpb).
+// (calibrate_pipeline_test, short_flat_vlp16.txtpb). A short Avia sequence
+// (forward-looking rosette) on tilted ground checks decode and ground only.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -23,6 +26,7 @@
 #include "tiltcal/proto/calibration.pb.h"
 #include "tiltcal/proto/ground.pb.h"
 #include "tiltcal/proto/scan.pb.h"
+
 #include "tiltcal/proto/truth.pb.h"
 
 namespace tiltcal {
@@ -34,50 +38,78 @@ double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   return std::atan2(a.cross(b).norm(), a.dot(b)) * 180.0 / M_PI;
 }
 
-TEST(LivoxPipelineTest, Mid360SequenceGroundAndCalibrationAgainstTruth) {
-  for (const char* tool :
-       {"tiltcal_simulate", "tiltcal_decode", "tiltcal_ground", "tiltcal_calibrate"}) {
-    ASSERT_TRUE(testing::FileExists(ToolPath(tool))) << "build " << tool << " first";
-  }
-  testing::TempDir dir;
-  const std::string src = testing::SourceDir();
-  const std::string decode_log = dir.File("decode.log");
-  const std::vector<std::string> commands = {
-      ToolPath("tiltcal_simulate") + " --quiet --params=" + src +
-          "/tests/stages/calibrate/short_flat_mid360.txtpb --out_bag=" + dir.File("s.bag") +
-          " --out_truth=" + dir.File("truth.txtpb") + " --out_rig=" + dir.File("rig.txtpb"),
-      ToolPath("tiltcal_decode") + " --bag=" + dir.File("s.bag") + " --rig=" +
-          dir.File("rig.txtpb") + " --out_imu=" + dir.File("imu.binpb") + " --out_scans=" +
-          dir.File("scans.binpb.lz4") + " 2> " + decode_log,
-      ToolPath("tiltcal_ground") + " --imu=" + dir.File("imu.binpb") + " --scans=" +
-          dir.File("scans.binpb.lz4") + " --rig=" + dir.File("rig.txtpb") + " --out_ground=" +
-          dir.File("ground.binpb"),
-      ToolPath("tiltcal_calibrate") + " --imu=" + dir.File("imu.binpb") + " --scans=" +
-          dir.File("scans.binpb.lz4") + " --ground=" + dir.File("ground.binpb") + " --rig=" +
-          dir.File("rig.txtpb") + " --out=" + dir.File("calibration.txtpb")};
+// Runs the commands in turn; false (and a failure recorded) when one fails.
+bool RunAll(const std::vector<std::string>& commands) {
   for (const std::string& command : commands) {
     std::string output;
-    ASSERT_EQ(testing::RunCommand(command + " 2>&1", &output), 0) << command << "\n" << output;
+    if (testing::RunCommand(command + " 2>&1", &output) != 0) {
+      ADD_FAILURE() << command << "\n" << output;
+      return false;
+    }
   }
+  return true;
+}
+
+// Simulates `scenario` (text, a SimulateParams) into dir, decodes it and
+// runs tiltcal_ground with `ground_params` ("" = defaults).
+bool SimulateDecodeGround(const testing::TempDir& dir, const std::string& scenario,
+                          const std::string& ground_params) {
+  for (const char* tool : {"tiltcal_simulate", "tiltcal_decode", "tiltcal_ground"}) {
+    if (!testing::FileExists(ToolPath(tool))) {
+      ADD_FAILURE() << "build " << tool << " first";
+      return false;
+    }
+  }
+  std::ofstream(dir.File("scenario.txtpb")) << scenario;
+  return RunAll({ToolPath("tiltcal_simulate") + " --quiet --params=" + dir.File("scenario.txtpb") +
+                     " --out_bag=" + dir.File("s.bag") + " --out_truth=" +
+                     dir.File("truth.txtpb") + " --out_rig=" + dir.File("rig.txtpb"),
+                 ToolPath("tiltcal_decode") + " --bag=" + dir.File("s.bag") + " --rig=" +
+                     dir.File("rig.txtpb") + " --out_imu=" + dir.File("imu.binpb") +
+                     " --out_scans=" + dir.File("scans.binpb.lz4"),
+                 ToolPath("tiltcal_ground") + " --imu=" + dir.File("imu.binpb") + " --scans=" +
+                     dir.File("scans.binpb.lz4") + " --rig=" + dir.File("rig.txtpb") +
+                     (ground_params.empty() ? "" : " --params=" + ground_params) +
+                     " --out_ground=" + dir.File("ground.binpb")});
+}
+
+std::string ReadText(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// `text` with `from` replaced by `to` (a failure when `from` is absent).
+std::string Replace(std::string text, const std::string& from, const std::string& to) {
+  const size_t at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << "'" << from << "' not found";
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+  return text;
+}
+
+// Checks the decoded scans (Livox point times, lines up to max_line
+// interleaved point by point, noise dropped) and every valid ground plane
+// against the truth of its scan; at least min_valid_fraction valid.
+void ExpectScansAndGroundMatchTruth(const testing::TempDir& dir, const char* label,
+                                    uint32_t max_line, double min_valid_fraction) {
   proto::SimulationTruth truth;
   ASSERT_TRUE(ReadTextProto(dir.File("truth.txtpb"), &truth).ok());
-
-  // Decode: Livox point times, lines 0-3 in no ring order, noise dropped.
   std::vector<proto::Scan> scans;
   ASSERT_TRUE(ReadAllRecords<proto::Scan>(dir.File("scans.binpb.lz4"), &scans).ok());
   ASSERT_EQ(scans.size(), static_cast<size_t>(truth.scans_size()));
   uint64_t noise = 0;
-  int ring_changes = 0;
+  int64_t ring_changes = 0, points = 0;
   for (const proto::Scan& scan : scans) {
     EXPECT_EQ(scan.time_source(), proto::POINT_TIME_LIVOX_CUSTOM_MSG);
     noise += scan.num_dropped_noise_tag();
+    points += scan.ring_size();
     for (int i = 1; i < scan.ring_size(); ++i) ring_changes += scan.ring(i) != scan.ring(i - 1);
-    EXPECT_LE(*std::max_element(scan.ring().begin(), scan.ring().end()), 3u);
+    EXPECT_LE(*std::max_element(scan.ring().begin(), scan.ring().end()), max_line);
   }
-  EXPECT_GT(noise, 1000u);
-  EXPECT_GT(ring_changes, 100000);  // lines interleaved point by point
+  EXPECT_GT(noise, 1000u) << label;
+  EXPECT_GT(ring_changes, points / 2) << label << ": lines not interleaved";
 
-  // Ground: every scan's plane against the truth at its capture time.
   std::vector<proto::GroundPlane> planes;
   ASSERT_TRUE(ReadAllRecords<proto::GroundPlane>(dir.File("ground.binpb"), &planes).ok());
   ASSERT_EQ(planes.size(), scans.size());
@@ -93,13 +125,43 @@ TEST(LivoxPipelineTest, Mid360SequenceGroundAndCalibrationAgainstTruth) {
     worst_height_cm =
         std::max(worst_height_cm, std::abs(planes[k].height_m() - t.ground_height_m()) * 100);
   }
-  std::printf("Mid-360: %d / %zu ground planes valid, worst normal %.3f deg, height %.2f cm, "
+  std::printf("%s: %d / %zu ground planes valid, worst normal %.3f deg, height %.2f cm, "
               "%llu noise points dropped\n",
-              valid, planes.size(), worst_normal_deg, worst_height_cm,
+              label, valid, planes.size(), worst_normal_deg, worst_height_cm,
               static_cast<unsigned long long>(noise));
-  EXPECT_GE(valid, static_cast<int>(planes.size() * 95 / 100));
-  EXPECT_LT(worst_normal_deg, 0.5);
-  EXPECT_LT(worst_height_cm, 2.0);
+  EXPECT_GE(valid, static_cast<int>(planes.size() * min_valid_fraction)) << label;
+  EXPECT_LT(worst_normal_deg, 0.5) << label;
+  EXPECT_LT(worst_height_cm, 2.0) << label;
+}
+
+// The forward-looking Avia (70 deg of azimuth) on tilted ground: its planes
+// cover a fifth of the azimuth, so the ground params accept a coverage of 0.1.
+TEST(LivoxPipelineTest, AviaTiltedGroundPlanesAgainstTruth) {
+  testing::TempDir dir;
+  const std::string src = testing::SourceDir();
+  std::string scenario = ReadText(src + "/stages/simulate/scenarios/short_test_vlp16.txtpb");
+  scenario = Replace(scenario, "model: VLP_16", "model: LIVOX_AVIA");
+  scenario = Replace(scenario, "append_surface_label: true", "livox_noise_fraction: 0.02");
+  std::ofstream(dir.File("ground_params.txtpb"))
+      << Replace(ReadText(src + "/stages/ground/default_params.txtpb"),
+                 "min_azimuth_coverage: 0.25", "min_azimuth_coverage: 0.1");
+  ASSERT_TRUE(SimulateDecodeGround(dir, scenario, dir.File("ground_params.txtpb")));
+  ExpectScansAndGroundMatchTruth(dir, "Avia", 5, 0.95);
+}
+
+TEST(LivoxPipelineTest, Mid360SequenceGroundAndCalibrationAgainstTruth) {
+  ASSERT_TRUE(testing::FileExists(ToolPath("tiltcal_calibrate"))) << "build tiltcal_calibrate";
+  testing::TempDir dir;
+  ASSERT_TRUE(SimulateDecodeGround(
+      dir, ReadText(testing::SourceDir() + "/tests/stages/calibrate/short_flat_mid360.txtpb"),
+      ""));
+  ExpectScansAndGroundMatchTruth(dir, "Mid-360", 3, 0.95);
+  ASSERT_TRUE(RunAll({ToolPath("tiltcal_calibrate") + " --imu=" + dir.File("imu.binpb") +
+                      " --scans=" + dir.File("scans.binpb.lz4") + " --ground=" +
+                      dir.File("ground.binpb") + " --rig=" + dir.File("rig.txtpb") +
+                      " --out=" + dir.File("calibration.txtpb")}));
+  proto::SimulationTruth truth;
+  ASSERT_TRUE(ReadTextProto(dir.File("truth.txtpb"), &truth).ok());
 
   // Calibration, with the error split as in calibrate_pipeline_test.
   proto::CalibrationResult result;
