@@ -23,6 +23,7 @@
 #include "stages/decode/clock_domains.h"
 #include "stages/decode/decode_params.h"
 #include "stages/decode/imu_units_resolution.h"
+#include "stages/decode/livox_conversion.h"
 #include "stages/decode/message_sinks.h"
 #include "tiltcal/proto/rig.pb.h"
 #include "tiltcal/proto/scan.pb.h"
@@ -133,7 +134,7 @@ void PrintSummary(std::ostream* log, const DecodePaths& paths,
                                 s.scans_non_monotonic_dropped, s.scans_empty_dropped));
   *log << fmt::format("  points: {} written; dropped {} NaN/Inf, {} zero/short range{}\n",
                       s.points_written, s.points_dropped_invalid, s.points_dropped_range,
-                      s.lidar_type.find("CustomMsg") == std::string::npos
+                      !IsLivoxCustomMsgType(s.lidar_type)
                           ? ""
                           : fmt::format(", {} tagged as noise (Livox tag & {:#04x})",
                                         s.points_dropped_noise_tag,

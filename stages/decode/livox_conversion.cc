@@ -6,9 +6,16 @@
 
 #include <fmt/format.h>
 
+#include "bag/ros1/messages.h"
+#include "bag/ros2/messages.h"
 #include "stages/decode/point_cloud_conversion.h"
 
 namespace tiltcal {
+
+bool IsLivoxCustomMsgType(const std::string& type) {
+  return type == ros1::kLivoxCustomMsgType || type == ros1::kLivox2CustomMsgType ||
+         type == ros2::kLivox2CustomMsgType || type == ros2::kLivoxInterfacesCustomMsgType;
+}
 
 Status ConvertLivoxCustomMsgToScan(const bag::LivoxCustomMessage& msg,
                                    const proto::LivoxParams& params, double min_range_m,

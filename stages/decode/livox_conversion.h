@@ -17,12 +17,19 @@
 // or a point time whose offset from the stamp does not fit int32 ns, is an
 // error (the caller adds file, topic and message).
 
+#include <string>
+
 #include "bag/sensor_messages.h"
 #include "common/status.h"
 #include "tiltcal/proto/decode_params.pb.h"
 #include "tiltcal/proto/scan.pb.h"
 
 namespace tiltcal {
+
+// True for the Livox CustomMsg type names decode reads: livox_ros_driver/CustomMsg,
+// livox_ros_driver2/CustomMsg (ROS 1), livox_ros_driver2/msg/CustomMsg,
+// livox_interfaces/msg/CustomMsg (ROS 2).
+bool IsLivoxCustomMsgType(const std::string& type);
 
 // Fills stamp_ns, frame_id, the point columns, time_source and the dropped
 // counts of `scan` (cleared first; index and record_stamp_ns are the caller's).

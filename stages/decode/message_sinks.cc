@@ -190,7 +190,7 @@ ScanSink::ScanSink(const std::string& bag, const proto::DecodeParams& params,
     : bag_(bag),
       params_(params),
       lidar_type_(lidar_type),
-      livox_(lidar_type.find("CustomMsg") != std::string::npos),
+      livox_(IsLivoxCustomMsgType(lidar_type)),
       writer_(writer),
       stamp_shift_ns_(std::llround(params.lidar_stamp_shift_s() * 1e9)) {
   conversion_.min_range_m = params.min_range_m();
