@@ -6,6 +6,7 @@
 // what the oracle wrote, with the drop rule of stages/decode/livox_conversion.h
 // applied here independently; bad Livox input is one error line naming the
 // file and the message, exit 1, no output.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
@@ -147,7 +148,9 @@ void ExpectScansMatch(const std::vector<ExpectedMessage>& expected,
     EXPECT_EQ(scan.num_dropped_noise_tag(), noise);
     total_noise += noise;
   }
-  if (noise_mask != 0) EXPECT_GT(total_noise, 0) << label << ": the oracle wrote no noise tag";
+  if (noise_mask != 0) {
+    EXPECT_GT(total_noise, 0) << label << ": the oracle wrote no noise tag";
+  }
 }
 
 class DecodeLivox : public ::testing::Test {

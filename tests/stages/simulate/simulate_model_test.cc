@@ -306,7 +306,9 @@ TEST(SimScanSimulatorTest, LivoxFramesAreNonRepetitiveWithinTheFieldOfView) {
       for (size_t j = 0; j < scan.points.size(); ++j) {
         const ScanPoint& p = scan.points[j];
         EXPECT_EQ(p.ring, j % lines);
-        if (j > 0) EXPECT_GT(p.time_ns, scan.points[j - 1].time_ns);
+        if (j > 0) {
+          EXPECT_GT(p.time_ns, scan.points[j - 1].time_ns);
+        }
         if (!p.valid) {
           EXPECT_TRUE(p.x == 0.0f && p.y == 0.0f && p.z == 0.0f);
           continue;
