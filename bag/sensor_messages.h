@@ -3,7 +3,7 @@
 
 // The in-memory form of the sensor messages decode reads, whatever the bag
 // format: std_msgs/Header, sensor_msgs/Imu, sensor_msgs/PointCloud2 and
-// PointField. ROS 1 (bag/ros1/messages.h, the ROS 1 wire format) and ROS 2
+// PointField, and the Livox CustomMsg. ROS 1 (bag/ros1/messages.h, the ROS 1 wire format) and ROS 2
 // (bag/ros2/messages.h, CDR) decode into these same structs, so the decode
 // stage's sinks do not know which format a message came from.
 
@@ -80,6 +80,33 @@ struct PointCloud2View {
   const uint8_t* data = nullptr;
   uint32_t data_size = 0;
   bool is_dense = false;
+};
+
+
+// One point of a Livox CustomMsg (livox_ros_driver/CustomPoint, identical in
+// livox_ros_driver2 and livox_interfaces).
+struct LivoxPoint {
+  uint32_t offset_time = 0;  // ns after the message's timebase
+  float x = 0, y = 0, z = 0;  // m, LiDAR frame
+  uint8_t reflectivity = 0;   // 0..255
+  // Livox point tag (Livox SDK, "tag information"): bits 0-1 noise judged
+  // from the spatial position (00 none, 01 high, 10 moderate, 11 low
+  // confidence that the point is noise: rain, fog, dust), bits 2-3 noise
+  // judged from the intensity (same coding), bits 4-5 the return number,
+  // bits 6-7 reserved.
+  uint8_t tag = 0;
+  uint8_t line = 0;  // laser (line) number: 0-5 Avia, 0-3 Mid-360
+};
+
+// livox_ros_driver/CustomMsg, livox_ros_driver2 CustomMsg (ROS 1 and ROS 2),
+// livox_interfaces/msg/CustomMsg: the same fields in the same order.
+struct LivoxCustomMessage {
+  Header header;
+  uint64_t timebase = 0;   // ns, the time of the first point (sensor or synchronised clock)
+  uint32_t point_num = 0;  // the driver's count; the decoders require it to equal points.size()
+  uint8_t lidar_id = 0;
+  uint8_t rsvd[3] = {};
+  std::vector<LivoxPoint> points;
 };
 
 }  // namespace tiltcal::bag

@@ -142,6 +142,40 @@ const MessageType& PointCloud2MessageType() {
   return kType;
 }
 
+// livox_ros_driver msg/CustomMsg.msg and msg/CustomPoint.msg; the MD5 is
+// the one genpy computes from this text (that of the driver's messages).
+const char kLivoxCustomMsgDefinitionTop[] = R"msgdef(# Livox publish pointcloud msg format.
+
+Header header             # ROS standard message header
+uint64 timebase           # The time of first point
+uint32 point_num          # Total number of pointclouds
+uint8  lidar_id           # Lidar device id number
+uint8[3]  rsvd            # Reserved use
+CustomPoint[] points      # Pointcloud data
+
+)msgdef";
+
+const char kLivoxCustomPointDefinition[] = R"msgdef(================================================================================
+MSG: livox_ros_driver/CustomPoint
+# Livox costom pointcloud format.
+
+uint32 offset_time      # offset time relative to the base time
+float32 x               # X axis, unit:m
+float32 y               # Y axis, unit:m
+float32 z               # Z axis, unit:m
+uint8 reflectivity      # reflectivity, 0~255
+uint8 tag               # livox tag
+uint8 line              # laser number in lidar
+)msgdef";
+
+const MessageType& LivoxCustomMsgMessageType() {
+  static const std::string kDefinition =
+      std::string(kLivoxCustomMsgDefinitionTop) + kHeaderDefinition + kLivoxCustomPointDefinition;
+  static const MessageType kType{kLivoxCustomMsgType, "e4d6829bdfe657cb6c21a746c86b21a6",
+                                 kDefinition.c_str()};
+  return kType;
+}
+
 namespace {
 
 void AppendString(std::string* out, const std::string& s) {
@@ -217,6 +251,29 @@ bool SerializePointCloud2(uint32_t seq, int64_t stamp_ns, const std::string& fra
   AppendU32Le(out, static_cast<uint32_t>(data.size()));
   out->append(data);
   out->push_back(is_dense ? 1 : 0);
+  return true;
+}
+
+bool SerializeLivoxCustomMsg(uint32_t seq, int64_t timebase_ns, const std::string& frame_id,
+                             uint8_t lidar_id, const std::vector<LivoxPoint>& points,
+                             std::string* out) {
+  out->clear();
+  out->reserve(points.size() * 19 + 64 + frame_id.size());
+  if (timebase_ns < 0 || !AppendHeader(out, seq, timebase_ns, frame_id)) return false;
+  AppendLe(out, static_cast<uint64_t>(timebase_ns));
+  AppendU32Le(out, static_cast<uint32_t>(points.size()));  // point_num
+  out->push_back(static_cast<char>(lidar_id));
+  out->append(3, '\0');  // rsvd
+  AppendU32Le(out, static_cast<uint32_t>(points.size()));
+  for (const LivoxPoint& p : points) {
+    AppendU32Le(out, p.offset_time);
+    AppendLe(out, p.x);
+    AppendLe(out, p.y);
+    AppendLe(out, p.z);
+    out->push_back(static_cast<char>(p.reflectivity));
+    out->push_back(static_cast<char>(p.tag));
+    out->push_back(static_cast<char>(p.line));
+  }
   return true;
 }
 

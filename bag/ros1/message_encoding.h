@@ -23,6 +23,8 @@ struct MessageType {
 };
 const MessageType& ImuMessageType();
 const MessageType& PointCloud2MessageType();
+// livox_ros_driver/CustomMsg (its CustomPoint as dependency).
+const MessageType& LivoxCustomMsgMessageType();
 
 // std_msgs/Header: seq, stamp (u32 sec, u32 nsec), frame_id.
 // Returns false when stamp_ns is not representable as ROS time.
@@ -40,6 +42,12 @@ bool SerializePointCloud2(uint32_t seq, int64_t stamp_ns, const std::string& fra
                           uint32_t height, uint32_t width, const std::vector<PointField>& fields,
                           uint32_t point_step, const std::string& data, bool is_dense,
                           std::string* out);
+
+// livox_ros_driver/CustomMsg: header.stamp = timebase (as the driver), the
+// points as given (point_num = points.size()).
+bool SerializeLivoxCustomMsg(uint32_t seq, int64_t timebase_ns, const std::string& frame_id,
+                             uint8_t lidar_id, const std::vector<LivoxPoint>& points,
+                             std::string* out);
 
 }  // namespace tiltcal::ros1
 

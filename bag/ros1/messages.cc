@@ -34,6 +34,12 @@ class WireReader {
     *v = LoadU32Le(p);
     return Status::Ok();
   }
+  Status U64(const char* what, uint64_t* v) {
+    const uint8_t* p = nullptr;
+    TILTCAL_RETURN_IF_ERROR(Take(8, what, &p));
+    std::memcpy(v, p, 8);
+    return Status::Ok();
+  }
   Status F64s(const char* what, double* v, size_t n) {
     const uint8_t* p = nullptr;
     TILTCAL_RETURN_IF_ERROR(Take(8 * n, what, &p));
@@ -114,6 +120,36 @@ Status DecodePointCloud2(const uint8_t* data, size_t size, PointCloud2View* clou
   TILTCAL_RETURN_IF_ERROR(r.U8("is_dense", &flag));
   cloud->is_dense = flag != 0;
   return r.ExpectEnd("sensor_msgs/PointCloud2");
+}
+
+Status DecodeLivoxCustomMsg(const uint8_t* data, size_t size, LivoxCustomMessage* msg) {
+  constexpr size_t kPointBytes = 19;
+  WireReader r(data, size);
+  TILTCAL_RETURN_IF_ERROR(r.Header(&msg->header));
+  TILTCAL_RETURN_IF_ERROR(r.U64("timebase", &msg->timebase));
+  TILTCAL_RETURN_IF_ERROR(r.U32("point_num", &msg->point_num));
+  TILTCAL_RETURN_IF_ERROR(r.U8("lidar_id", &msg->lidar_id));
+  for (uint8_t& b : msg->rsvd) TILTCAL_RETURN_IF_ERROR(r.U8("rsvd", &b));
+  uint32_t count = 0;
+  TILTCAL_RETURN_IF_ERROR(r.U32("points", &count));
+  const uint8_t* p = nullptr;
+  TILTCAL_RETURN_IF_ERROR(r.Take(static_cast<size_t>(count) * kPointBytes, "points", &p));
+  if (count != msg->point_num) {
+    return Status::Error("point_num is " + std::to_string(msg->point_num) +
+                         " but the points array holds " + std::to_string(count) + " points");
+  }
+  msg->points.resize(count);
+  for (LivoxPoint& point : msg->points) {
+    std::memcpy(&point.offset_time, p, 4);
+    std::memcpy(&point.x, p + 4, 4);
+    std::memcpy(&point.y, p + 8, 4);
+    std::memcpy(&point.z, p + 12, 4);
+    point.reflectivity = p[16];
+    point.tag = p[17];
+    point.line = p[18];
+    p += kPointBytes;
+  }
+  return r.ExpectEnd(kLivoxCustomMsgType);
 }
 
 }  // namespace tiltcal::ros1

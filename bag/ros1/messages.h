@@ -21,9 +21,14 @@ namespace tiltcal::ros1 {
 
 inline constexpr char kImuType[] = "sensor_msgs/Imu";
 inline constexpr char kPointCloud2Type[] = "sensor_msgs/PointCloud2";
+// Livox CustomMsg of livox_ros_driver and of livox_ros_driver2 built for ROS 1.
+inline constexpr char kLivoxCustomMsgType[] = "livox_ros_driver/CustomMsg";
+inline constexpr char kLivox2CustomMsgType[] = "livox_ros_driver2/CustomMsg";
 
 // The message structs are shared with ROS 2 (bag/sensor_messages.h).
 using bag::Header;
+using bag::LivoxCustomMessage;
+using bag::LivoxPoint;
 using bag::ImuMessage;
 using bag::PointCloud2View;
 using bag::PointField;
@@ -45,6 +50,11 @@ using bag::kUint8;
 // (the record holds another type). `cloud` may be reused between calls.
 Status DecodeImu(const uint8_t* data, size_t size, ImuMessage* imu);
 Status DecodePointCloud2(const uint8_t* data, size_t size, PointCloud2View* cloud);
+// Livox CustomMsg: header, u64 timebase, u32 point_num, u8 lidar_id,
+// u8[3] rsvd, CustomPoint[] (19 bytes each: u32 offset_time, f32 x y z,
+// u8 reflectivity tag line). point_num differing from the array's length is
+// an error. `msg->points` may be reused between calls.
+Status DecodeLivoxCustomMsg(const uint8_t* data, size_t size, LivoxCustomMessage* msg);
 
 }  // namespace tiltcal::ros1
 

@@ -80,6 +80,20 @@ Status CdrReader::I32(const char* what, int32_t* v) {
   return Status::Ok();
 }
 
+Status CdrReader::U64(const char* what, uint64_t* v) {
+  const uint8_t* p = nullptr;
+  TILTCAL_RETURN_IF_ERROR(Take(8, 8, what, &p));
+  *v = Load<uint64_t>(p, big_endian_);
+  return Status::Ok();
+}
+
+Status CdrReader::F32(const char* what, float* v) {
+  const uint8_t* p = nullptr;
+  TILTCAL_RETURN_IF_ERROR(Take(4, 4, what, &p));
+  *v = Load<float>(p, big_endian_);
+  return Status::Ok();
+}
+
 Status CdrReader::F64s(const char* what, double* v, size_t n) {
   const uint8_t* p = nullptr;
   TILTCAL_RETURN_IF_ERROR(Take(8, 8 * n, what, &p));

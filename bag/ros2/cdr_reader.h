@@ -34,6 +34,8 @@ class CdrReader {
   Status Bool(const char* what, bool* v);
   Status U32(const char* what, uint32_t* v);
   Status I32(const char* what, int32_t* v);
+  Status U64(const char* what, uint64_t* v);
+  Status F32(const char* what, float* v);
   Status F64s(const char* what, double* v, size_t n);
   Status String(const char* what, std::string* s);
   // A uint8[] sequence: its count, then a view of its bytes (no copy).

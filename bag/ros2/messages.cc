@@ -64,4 +64,36 @@ Status DecodePointCloud2(const uint8_t* data, size_t size, bag::PointCloud2View*
   return r.ExpectEnd(kPointCloud2Type);
 }
 
+Status DecodeLivoxCustomMsg(const uint8_t* data, size_t size, bag::LivoxCustomMessage* msg) {
+  CdrReader r;
+  TILTCAL_RETURN_IF_ERROR(r.Open(data, size));
+  TILTCAL_RETURN_IF_ERROR(ReadHeader(&r, &msg->header));
+  TILTCAL_RETURN_IF_ERROR(r.U64("timebase", &msg->timebase));
+  TILTCAL_RETURN_IF_ERROR(r.U32("point_num", &msg->point_num));
+  TILTCAL_RETURN_IF_ERROR(r.U8("lidar_id", &msg->lidar_id));
+  for (uint8_t& b : msg->rsvd) TILTCAL_RETURN_IF_ERROR(r.U8("rsvd", &b));
+  uint32_t count = 0;
+  TILTCAL_RETURN_IF_ERROR(r.U32("points", &count));
+  // A CustomPoint takes at least 19 bytes; refuse absurd counts before resizing.
+  if (count > size / 19) {
+    return Status::Error("message runs past its end: " + std::to_string(count) +
+                         " points cannot fit in " + std::to_string(size) + " bytes");
+  }
+  if (count != msg->point_num) {
+    return Status::Error("point_num is " + std::to_string(msg->point_num) +
+                         " but the points array holds " + std::to_string(count) + " points");
+  }
+  msg->points.resize(count);
+  for (bag::LivoxPoint& p : msg->points) {
+    TILTCAL_RETURN_IF_ERROR(r.U32("points.offset_time", &p.offset_time));
+    TILTCAL_RETURN_IF_ERROR(r.F32("points.x", &p.x));
+    TILTCAL_RETURN_IF_ERROR(r.F32("points.y", &p.y));
+    TILTCAL_RETURN_IF_ERROR(r.F32("points.z", &p.z));
+    TILTCAL_RETURN_IF_ERROR(r.U8("points.reflectivity", &p.reflectivity));
+    TILTCAL_RETURN_IF_ERROR(r.U8("points.tag", &p.tag));
+    TILTCAL_RETURN_IF_ERROR(r.U8("points.line", &p.line));
+  }
+  return r.ExpectEnd(kLivox2CustomMsgType);
+}
+
 }  // namespace tiltcal::ros2

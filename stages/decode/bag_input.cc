@@ -54,15 +54,27 @@ Status OpenWith(std::unique_ptr<Reader> r, const std::string& path,
 
 }  // namespace
 
+std::vector<std::string> SensorTypes::Lidar() const {
+  std::vector<std::string> types = {point_cloud2};
+  types.insert(types.end(), livox.begin(), livox.end());
+  return types;
+}
+
 SensorTypes SensorTypesOf(const bag::MessageReader& reader) {
+  const SensorTypes ros1_types = {ros1::kImuType, ros1::kPointCloud2Type,
+                                  {ros1::kLivoxCustomMsgType, ros1::kLivox2CustomMsgType}};
+  const SensorTypes ros2_types = {
+      ros2::kImuType,
+      ros2::kPointCloud2Type,
+      {ros2::kLivox2CustomMsgType, ros2::kLivoxInterfacesCustomMsgType}};
   // A ROS 1 bag, or an MCAP with the ROS 1 type names, is read as ROS 1.
   for (const bag::TopicInfo& t : reader.topics()) {
-    if (t.type == ros1::kImuType || t.type == ros1::kPointCloud2Type) {
-      return {ros1::kImuType, ros1::kPointCloud2Type};
+    for (const std::string& type : ros1_types.Lidar()) {
+      if (t.type == ros1::kImuType || t.type == type) return ros1_types;
     }
   }
-  if (reader.format_name() == "ROS 1 bag") return {ros1::kImuType, ros1::kPointCloud2Type};
-  return {ros2::kImuType, ros2::kPointCloud2Type};
+  if (reader.format_name() == "ROS 1 bag") return ros1_types;
+  return ros2_types;
 }
 
 Status OpenBagInput(const std::string& path, size_t chunk_cache_size,

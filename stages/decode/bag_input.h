@@ -12,6 +12,7 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "bag/message_reader.h"
 #include "common/status.h"
@@ -22,6 +23,9 @@ namespace tiltcal::decode {
 struct SensorTypes {
   const char* imu;
   const char* point_cloud2;
+  std::vector<std::string> livox;  // the Livox CustomMsg types of the format
+  // The LiDAR types: point_cloud2, then the Livox types.
+  std::vector<std::string> Lidar() const;
 };
 SensorTypes SensorTypesOf(const bag::MessageReader& reader);
 

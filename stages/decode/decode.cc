@@ -23,6 +23,7 @@
 #include "stages/decode/clock_domains.h"
 #include "stages/decode/decode_params.h"
 #include "stages/decode/imu_units_resolution.h"
+#include "stages/decode/livox_conversion.h"
 #include "stages/decode/message_sinks.h"
 #include "tiltcal/proto/rig.pb.h"
 #include "tiltcal/proto/scan.pb.h"
@@ -39,12 +40,19 @@ std::string Join(const std::vector<std::string>& items) {
   return out.empty() ? "(none)" : out;
 }
 
-// Chooses the topic of message type `type`: the params' topic, else the
-// rig's, else the only topic of that type in the bag.
-Status ChooseTopic(const bag::MessageReader& reader, const std::string& type,
+// Chooses the topic of one of the message types `types`: the params'
+// topic, else the rig's, else the only topic of those types in the bag.
+// *type is the chosen topic's type.
+Status ChooseTopic(const bag::MessageReader& reader, const std::vector<std::string>& types,
                    const std::string& params_topic, const std::string& rig_topic,
-                   const char* params_field, std::string* topic) {
-  const std::vector<std::string> candidates = reader.TopicsOfType(type);
+                   const char* params_field, std::string* topic, std::string* type) {
+  std::vector<std::string> candidates;
+  for (const std::string& t : types) {
+    for (const std::string& name : reader.TopicsOfType(t)) candidates.push_back(name);
+  }
+  std::sort(candidates.begin(), candidates.end());
+  std::string type_names;  // "sensor_msgs/PointCloud2 or livox_ros_driver/CustomMsg"
+  for (const std::string& t : types) type_names += (type_names.empty() ? "" : " or ") + t;
   auto describe = [&](const std::vector<std::string>& topics) {
     std::vector<std::string> items;
     for (const std::string& t : topics) {
@@ -58,27 +66,32 @@ Status ChooseTopic(const bag::MessageReader& reader, const std::string& type,
     const std::string actual = reader.TopicType(requested);
     if (actual.empty()) {
       return Status::Error(reader.path() + ": no topic '" + requested + "' (" + params_field +
-                           " from the " + origin + ") in the bag; " + type +
+                           " from the " + origin + ") in the bag; " + type_names +
                            " topics: " + describe(candidates));
     }
-    if (actual != type) {
+    if (std::find(types.begin(), types.end(), actual) == types.end()) {
       return Status::Error(reader.path() + ": topic '" + requested + "' (" + params_field +
                            " from the " + origin + ") has type " + actual + ", expected " +
-                           type);
+                           type_names);
     }
     *topic = requested;
+    *type = actual;
     return Status::Ok();
   }
   if (candidates.empty()) {
-    return Status::Error(reader.path() + ": no " + type + " topic in the bag (topics: " +
-                         Join(reader.TopicNames()) + ")");
+    std::string others;  // "sensor_msgs/PointCloud2 topic (nor livox_ros_driver/CustomMsg)"
+    for (size_t i = 1; i < types.size(); ++i) others += (i == 1 ? "" : ", ") + types[i];
+    return Status::Error(reader.path() + ": no " + types[0] + " topic" +
+                         (others.empty() ? "" : " (nor " + others + ")") +
+                         " in the bag (topics: " + Join(reader.TopicNames()) + ")");
   }
   if (candidates.size() > 1) {
-    return Status::Error(reader.path() + ": several " + type + " topics: " +
+    return Status::Error(reader.path() + ": several " + type_names + " topics: " +
                          describe(candidates) + "; choose one with " + params_field +
                          " in the params or the rig");
   }
   *topic = candidates[0];
+  *type = reader.TopicType(*topic);
   return Status::Ok();
 }
 
@@ -99,8 +112,9 @@ std::string TopicLine(const char* label, const std::string& topic, int64_t messa
                      static_cast<double>(last_ns - first_ns) * 1e-9, dropped);
 }
 
-void PrintSummary(std::ostream* log, const DecodePaths& paths, double shift_s,
-                  const DecodeSummary& s) {
+void PrintSummary(std::ostream* log, const DecodePaths& paths,
+                  const proto::DecodeParams& params, const DecodeSummary& s) {
+  const double shift_s = params.lidar_stamp_shift_s();
   if (log == nullptr) return;
   const double mb = static_cast<double>(s.bag_bytes) * 1e-6;
   *log << fmt::format("tiltcal_decode: {}: {:.1f} MB, {}\n", paths.bag, mb,
@@ -118,8 +132,13 @@ void PrintSummary(std::ostream* log, const DecodePaths& paths, double shift_s,
                     s.scan_first_stamp_ns, s.scan_last_stamp_ns,
                     fmt::format("{} non-monotonic + {} empty scans",
                                 s.scans_non_monotonic_dropped, s.scans_empty_dropped));
-  *log << fmt::format("  points: {} written; dropped {} NaN/Inf, {} zero/short range\n",
-                      s.points_written, s.points_dropped_invalid, s.points_dropped_range);
+  *log << fmt::format("  points: {} written; dropped {} NaN/Inf, {} zero/short range{}\n",
+                      s.points_written, s.points_dropped_invalid, s.points_dropped_range,
+                      !IsLivoxCustomMsgType(s.lidar_type)
+                          ? ""
+                          : fmt::format(", {} tagged as noise (Livox tag & {:#04x})",
+                                        s.points_dropped_noise_tag,
+                                        params.livox().noise_tag_mask()));
   *log << fmt::format("  clocks: IMU and LiDAR stamps overlap for {:.3f} s{}\n", s.stamp_overlap_s,
                       shift_s != 0.0
                           ? fmt::format(" (LiDAR stamps shifted by {:.3f} s, lidar_stamp_shift_s)",
@@ -194,10 +213,12 @@ Status OpenBag(const DecodePaths& paths, const proto::DecodeParams& params, cons
                          (s->salvage_note.empty() ? "" : " (" + s->salvage_note + ")"));
   }
   const decode::SensorTypes types = decode::SensorTypesOf(*reader);
-  TILTCAL_RETURN_IF_ERROR(ChooseTopic(*reader, types.imu, params.imu_topic(),
-                                      rig.imu_topic(), "imu_topic", &s->imu_topic));
-  TILTCAL_RETURN_IF_ERROR(ChooseTopic(*reader, types.point_cloud2, params.lidar_topic(),
-                                      rig.lidar_topic(), "lidar_topic", &s->lidar_topic));
+  std::string imu_type;
+  TILTCAL_RETURN_IF_ERROR(ChooseTopic(*reader, {types.imu}, params.imu_topic(), rig.imu_topic(),
+                                      "imu_topic", &s->imu_topic, &imu_type));
+  TILTCAL_RETURN_IF_ERROR(ChooseTopic(*reader, types.Lidar(), params.lidar_topic(),
+                                      rig.lidar_topic(), "lidar_topic", &s->lidar_topic,
+                                      &s->lidar_type));
   if (s->imu_topic == s->lidar_topic) {
     return Status::Error(paths.bag + ": imu and lidar topic are the same: " + s->imu_topic);
   }
@@ -301,7 +322,7 @@ Status Decode(const DecodePaths& paths, const proto::DecodeParams& params, std::
                                             proto::Scan::descriptor()->full_name(), provenance,
                                             /*compress=*/true));
   ImuSink imu(paths.bag, reader.MessageCount(s.imu_topic));
-  ScanSink scans(paths.bag, params, &scans_writer);
+  ScanSink scans(paths.bag, params, s.lidar_type, &scans_writer);
   {
     ProgressLine progress(log, reader.MessageCount(s.imu_topic) +
                                    reader.MessageCount(s.lidar_topic));
@@ -325,7 +346,7 @@ Status Decode(const DecodePaths& paths, const proto::DecodeParams& params, std::
   TILTCAL_RETURN_IF_ERROR(CommitTogether({imu_writer.file(), scans_writer.file()}));
   s.chunks_decompressed = reader.chunks_decompressed();
   s.wall_s = std::chrono::duration<double>(Clock::now() - t0).count();
-  PrintSummary(log, paths, params.lidar_stamp_shift_s(), s);
+  PrintSummary(log, paths, params, s);
   if (summary != nullptr) *summary = s;
   return Status::Ok();
 }

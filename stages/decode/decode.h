@@ -29,6 +29,7 @@ struct DecodePaths {
 struct DecodeSummary {
   std::string imu_topic;
   std::string lidar_topic;
+  std::string lidar_type;  // sensor_msgs/PointCloud2 or a Livox CustomMsg type, as in the bag
   bool indexed = true;
   int64_t salvaged_messages = 0;
   std::string salvage_note;
@@ -44,6 +45,7 @@ struct DecodeSummary {
   int64_t points_written = 0;
   int64_t points_dropped_invalid = 0;
   int64_t points_dropped_range = 0;
+  int64_t points_dropped_noise_tag = 0;  // Livox: tag flags noise (livox.noise_tag_mask)
   int64_t imu_first_stamp_ns = 0, imu_last_stamp_ns = 0;
   int64_t scan_first_stamp_ns = 0, scan_last_stamp_ns = 0;  // after lidar_stamp_shift_s
   double stamp_overlap_s = 0.0;  // time covered by both the IMU and the LiDAR stamps

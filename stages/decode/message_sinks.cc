@@ -9,6 +9,7 @@
 #include "bag/ros2/messages.h"
 #include "common/checked_conversion.h"
 #include "common/io/record_stream.h"
+#include "stages/decode/livox_conversion.h"
 #include "tiltcal/proto/imu.pb.h"
 
 namespace tiltcal {
@@ -19,6 +20,11 @@ namespace {
 std::string MessageContext(const std::string& bag, const bag::Message& m, int64_t index) {
   return bag + ": topic '" + *m.topic + "' message " + std::to_string(index) +
          " (record time " + FormatSeconds(m.time_ns) + " s, " + bag::DescribePosition(m) + ")";
+}
+
+Status DecodeLivoxCustomMsg(const bag::Message& m, bag::LivoxCustomMessage* msg) {
+  return m.encoding == bag::Encoding::kCdr ? ros2::DecodeLivoxCustomMsg(m.data, m.size, msg)
+                                           : ros1::DecodeLivoxCustomMsg(m.data, m.size, msg);
 }
 
 // The message's type name in its own format, for errors.
@@ -180,9 +186,11 @@ Status ImuSink::Write(const std::string& path, const proto::Provenance& provenan
 }
 
 ScanSink::ScanSink(const std::string& bag, const proto::DecodeParams& params,
-                   AsyncRecordWriter* writer)
+                   const std::string& lidar_type, AsyncRecordWriter* writer)
     : bag_(bag),
       params_(params),
+      lidar_type_(lidar_type),
+      livox_(IsLivoxCustomMsgType(lidar_type)),
       writer_(writer),
       stamp_shift_ns_(std::llround(params.lidar_stamp_shift_s() * 1e9)) {
   conversion_.min_range_m = params.min_range_m();
@@ -208,21 +216,30 @@ Status ScanSink::Add(const bag::Message& m, DecodeSummary* s) {
   return writer_->Submit(scan);
 }
 
+Status ScanSink::DecodeAndConvert(const bag::Message& m, proto::Scan* scan) {
+  if (livox_) {
+    TILTCAL_RETURN_IF_ERROR(DecodeLivoxCustomMsg(m, &livox_message_));
+    return ConvertLivoxCustomMsgToScan(livox_message_, params_.livox(), params_.min_range_m(),
+                                       scan);
+  }
+  TILTCAL_RETURN_IF_ERROR(DecodePointCloud2(m, &cloud_));
+  return ConvertPointCloud2ToScan(cloud_, conversion_, scan);
+}
+
 Status ScanSink::Convert(const bag::Message& m, int64_t index, proto::Scan* scan,
                          bool* keep, DecodeSummary* s) {
   *keep = false;
-  Status status = DecodePointCloud2(m, &cloud_);
-  if (status.ok()) status = ConvertPointCloud2ToScan(cloud_, conversion_, scan);
-  if (!status.ok()) {
-    return status.WithContext(MessageContext(bag_, m, index) + ": " + PointCloud2TypeName(m));
-  }
+  const std::string type_name = livox_ ? lidar_type_ : PointCloud2TypeName(m);
+  Status status = DecodeAndConvert(m, scan);
+  if (!status.ok()) return status.WithContext(MessageContext(bag_, m, index) + ": " + type_name);
   if (scan->stamp_ns() == 0) {
-    return Status::Error(MessageContext(bag_, m, index) +
-                         ": sensor_msgs/PointCloud2 header stamp is 0 (never set by its driver)");
+    return Status::Error(MessageContext(bag_, m, index) + ": " + type_name +
+                         " header stamp is 0 (never set by its driver)");
   }
   scan->set_stamp_ns(scan->stamp_ns() + stamp_shift_ns_);
   s->points_dropped_invalid += scan->num_dropped_invalid();
   s->points_dropped_range += scan->num_dropped_zero_range();
+  s->points_dropped_noise_tag += scan->num_dropped_noise_tag();
   if (scan->time_source() == proto::POINT_TIME_NONE) {
     if (params_.require_point_time()) {
       return Status::Error(MessageContext(bag_, m, index) + ": " + PointCloud2TypeName(m) +

@@ -76,13 +76,15 @@ class ImuSink {
   bag::ImuMessage message_;
 };
 
-// The sensor_msgs/PointCloud2 messages: each converted to a Scan, its stamp
+// The LiDAR messages (sensor_msgs/PointCloud2 or a Livox CustomMsg, as
+// `lidar_type` says): each converted to a Scan, its stamp
 // shifted by params.lidar_stamp_shift_s, and handed to the writer thread,
 // unless it has no valid point or its stamp does not advance (an error
 // unless params.drop_non_monotonic).
 class ScanSink {
  public:
-  ScanSink(const std::string& bag, const proto::DecodeParams& params, AsyncRecordWriter* writer);
+  ScanSink(const std::string& bag, const proto::DecodeParams& params,
+           const std::string& lidar_type, AsyncRecordWriter* writer);
 
   Status Add(const bag::Message& m, DecodeSummary* s);
 
@@ -90,15 +92,20 @@ class ScanSink {
   decode::StampSpan Span(const DecodeSummary& s) const;
 
  private:
+  // Decodes the message and converts it into *scan (its type's decoder).
+  Status DecodeAndConvert(const bag::Message& m, proto::Scan* scan);
   // Converts the message into *scan; *keep says whether it is written.
   Status Convert(const bag::Message& m, int64_t index, proto::Scan* scan, bool* keep,
                  DecodeSummary* s);
 
   std::string bag_;
   const proto::DecodeParams& params_;
+  std::string lidar_type_;
+  bool livox_ = false;  // the topic holds Livox CustomMsg
   AsyncRecordWriter* writer_;
   PointConversionOptions conversion_;
   bag::PointCloud2View cloud_;
+  bag::LivoxCustomMessage livox_message_;
   int64_t stamp_shift_ns_ = 0;
   int64_t last_stamp_ns_ = INT64_MIN;
   std::vector<int64_t> record_delays_ns_;  // record time − shifted stamp, per written scan

@@ -504,6 +504,53 @@ Status ConvertGeneric(const PointCloud2View& cloud, const CloudLayout& layout,
   return Status::Ok();
 }
 
+// Clears `scan` and sets the fields known before the points are read.
+void ResetScan(const PointCloud2View& cloud, proto::Scan* scan) {
+  scan->clear_x();
+  scan->clear_y();
+  scan->clear_z();
+  scan->clear_intensity();
+  scan->clear_ring();
+  scan->clear_time_offset_ns();
+  scan->set_stamp_ns(ros1::RosTimeToNs(cloud.header.stamp));
+  scan->set_frame_id(cloud.header.frame_id);
+  scan->set_num_dropped_invalid(0);
+  scan->set_num_dropped_zero_range(0);
+  scan->set_num_dropped_noise_tag(0);
+  scan->set_time_source(proto::POINT_TIME_NONE);
+}
+
+// Columns of n values written in place (no per-point allocation), truncated
+// to the points kept by FinishColumns.
+FastColumns ReserveColumns(int n, bool with_ring, proto::Scan* scan) {
+  auto reserve = [n](auto* column) {
+    column->Reserve(n);
+    return column->AddNAlreadyReserved(n);
+  };
+  FastColumns columns;
+  columns.x = reserve(scan->mutable_x());
+  columns.y = reserve(scan->mutable_y());
+  columns.z = reserve(scan->mutable_z());
+  columns.intensity = reserve(scan->mutable_intensity());
+  columns.ring = with_ring ? reserve(scan->mutable_ring()) : nullptr;
+  columns.time_offset_ns = reserve(scan->mutable_time_offset_ns());
+  return columns;
+}
+
+void FinishColumns(const FastResult& result, bool with_ring, proto::Scan* scan) {
+  const int k = result.count;
+  scan->mutable_x()->Truncate(k);
+  scan->mutable_y()->Truncate(k);
+  scan->mutable_z()->Truncate(k);
+  scan->mutable_intensity()->Truncate(k);
+  if (with_ring) scan->mutable_ring()->Truncate(k);
+  scan->mutable_time_offset_ns()->Truncate(k);
+  scan->set_num_dropped_invalid(result.dropped_invalid);
+  scan->set_num_dropped_zero_range(result.dropped_range);
+}
+
+}  // namespace
+
 // True when `text` is well-formed UTF-8 (no overlong forms, surrogates or
 // code points above U+10FFFF), as a protobuf string field must be: a
 // Scan with another frame_id would be written but could not be read back.
@@ -542,52 +589,6 @@ bool IsValidUtf8(const std::string& text) {
   }
   return true;
 }
-
-// Clears `scan` and sets the fields known before the points are read.
-void ResetScan(const PointCloud2View& cloud, proto::Scan* scan) {
-  scan->clear_x();
-  scan->clear_y();
-  scan->clear_z();
-  scan->clear_intensity();
-  scan->clear_ring();
-  scan->clear_time_offset_ns();
-  scan->set_stamp_ns(ros1::RosTimeToNs(cloud.header.stamp));
-  scan->set_frame_id(cloud.header.frame_id);
-  scan->set_num_dropped_invalid(0);
-  scan->set_num_dropped_zero_range(0);
-  scan->set_time_source(proto::POINT_TIME_NONE);
-}
-
-// Columns of n values written in place (no per-point allocation), truncated
-// to the points kept by FinishColumns.
-FastColumns ReserveColumns(int n, bool with_ring, proto::Scan* scan) {
-  auto reserve = [n](auto* column) {
-    column->Reserve(n);
-    return column->AddNAlreadyReserved(n);
-  };
-  FastColumns columns;
-  columns.x = reserve(scan->mutable_x());
-  columns.y = reserve(scan->mutable_y());
-  columns.z = reserve(scan->mutable_z());
-  columns.intensity = reserve(scan->mutable_intensity());
-  columns.ring = with_ring ? reserve(scan->mutable_ring()) : nullptr;
-  columns.time_offset_ns = reserve(scan->mutable_time_offset_ns());
-  return columns;
-}
-
-void FinishColumns(const FastResult& result, bool with_ring, proto::Scan* scan) {
-  const int k = result.count;
-  scan->mutable_x()->Truncate(k);
-  scan->mutable_y()->Truncate(k);
-  scan->mutable_z()->Truncate(k);
-  scan->mutable_intensity()->Truncate(k);
-  if (with_ring) scan->mutable_ring()->Truncate(k);
-  scan->mutable_time_offset_ns()->Truncate(k);
-  scan->set_num_dropped_invalid(result.dropped_invalid);
-  scan->set_num_dropped_zero_range(result.dropped_range);
-}
-
-}  // namespace
 
 std::string DescribeFields(const PointCloud2View& cloud) {
   std::string out;

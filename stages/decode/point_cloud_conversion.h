@@ -46,6 +46,10 @@ struct PointConversionOptions {
 Status ConvertPointCloud2ToScan(const ros1::PointCloud2View& cloud,
                                 const PointConversionOptions& options, proto::Scan* scan);
 
+// True when `text` is well-formed UTF-8 (no overlong forms, surrogates or
+// code points above U+10FFFF), as a protobuf string field must be.
+bool IsValidUtf8(const std::string& text);
+
 // "x:FLOAT32@0 y:FLOAT32@4 ..." for messages.
 std::string DescribeFields(const ros1::PointCloud2View& cloud);
 

@@ -75,4 +75,33 @@ LidarModel Os132Model(int columns) {
   return m;
 }
 
+LidarModel LivoxAviaModel() {
+  // Avia: 6 lines, 70.4 x 77.2 deg field of view, 240 000 points/s (first return).
+  LidarModel m;
+  m.name = "Livox Avia";
+  m.kind = LidarModel::Kind::kLivox;
+  m.livox.rosette = true;
+  m.livox.lines = 6;
+  m.livox.point_rate_hz = 240000.0;
+  m.livox.f1_hz = 97.3;
+  m.livox.f2_hz = -97.3 * std::sqrt(2.0) * 0.61;
+  m.livox.half_azimuth_rad = 35.2 * kDegToRad;
+  m.livox.half_elevation_rad = 38.6 * kDegToRad;
+  return m;
+}
+
+LidarModel LivoxMid360Model() {
+  // Mid-360: 4 lines, 360 x 59 deg (−7 .. +52 deg), 200 000 points/s.
+  LidarModel m;
+  m.name = "Livox Mid-360";
+  m.kind = LidarModel::Kind::kLivox;
+  m.livox.lines = 4;
+  m.livox.point_rate_hz = 200000.0;
+  m.livox.f1_hz = 10.0 * std::sqrt(1.03);
+  m.livox.f2_hz = 1000.0 / std::sqrt(2.0);
+  m.livox.min_elevation_rad = -7.0 * kDegToRad;
+  m.livox.max_elevation_rad = 52.0 * kDegToRad;
+  return m;
+}
+
 }  // namespace tiltcal::simulate

@@ -1,5 +1,6 @@
 #include "stages/simulate/point_cloud_layout.h"
 
+#include <algorithm>
 #include <cstring>
 #include <vector>
 
@@ -72,6 +73,23 @@ bool SerializeScan(const SimulatedScan& scan, bool ouster, bool append_label, ui
   const bool dense = !ouster || scan.num_valid == n;
   return ros1::SerializePointCloud2(seq, stamp_ns, frame_id, height, width, fields, step, data, dense,
                               message);
+}
+
+bool SerializeLivoxScan(const SimulatedScan& scan, uint32_t seq, int64_t stamp_ns,
+                        const std::string& frame_id, std::string* message) {
+  std::vector<ros1::LivoxPoint> points(scan.points.size());
+  for (size_t i = 0; i < points.size(); ++i) {
+    const ScanPoint& p = scan.points[i];
+    ros1::LivoxPoint& q = points[i];
+    q.offset_time = p.time_ns;
+    q.x = p.x;
+    q.y = p.y;
+    q.z = p.z;
+    q.reflectivity = static_cast<uint8_t>(std::min<uint16_t>(p.reflectivity, 255));
+    q.tag = p.tag;
+    q.line = static_cast<uint8_t>(p.ring);
+  }
+  return ros1::SerializeLivoxCustomMsg(seq, stamp_ns, frame_id, /*lidar_id=*/1, points, message);
 }
 
 }  // namespace tiltcal::simulate

@@ -23,6 +23,12 @@ namespace tiltcal::simulate {
 bool SerializeScan(const SimulatedScan& scan, bool ouster, bool append_label, uint32_t seq,
                    int64_t stamp_ns, const std::string& frame_id, std::string* message);
 
+// Serializes a simulated Livox frame as livox_ros_driver/CustomMsg:
+// header.stamp = timebase = `stamp_ns`, every point (no return at the
+// origin), offset_time = ScanPoint::time_ns, reflectivity, tag, line = ring.
+bool SerializeLivoxScan(const SimulatedScan& scan, uint32_t seq, int64_t stamp_ns,
+                        const std::string& frame_id, std::string* message);
+
 }  // namespace tiltcal::simulate
 
 #endif  // TILTCAL_STAGES_SIMULATE_POINT_CLOUD_LAYOUT_H_

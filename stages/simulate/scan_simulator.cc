@@ -32,6 +32,10 @@ float Intensity(Surface surface, double cos_incidence, uint16_t* reflectivity) {
 
 }  // namespace
 
+int LivoxPoints(const ScanConfig& config) {
+  return static_cast<int>(std::floor(config.model.livox.point_rate_hz / config.scan_rate_hz));
+}
+
 int64_t SweepStartNs(const ScanConfig& config, int k) {
   return std::llround((config.first_scan_time_s + k / config.scan_rate_hz) * 1e9);
 }
@@ -40,6 +44,9 @@ double SweepSpanS(const ScanConfig& config) {
   const LidarModel& m = config.model;
   if (m.kind == LidarModel::Kind::kOuster) {
     return (m.columns - 1) / (config.scan_rate_hz * m.columns);
+  }
+  if (m.kind == LidarModel::Kind::kLivox) {
+    return (LivoxPoints(config) - 1) / m.livox.point_rate_hz;
   }
   return (VelodyneSequences(config) - 1) * m.sequence_period_s +
          *std::max_element(m.firing_offset_s.begin(), m.firing_offset_s.end());
@@ -78,12 +85,17 @@ class LaserCaster {
   // when a surface is hit within the range limits after the noise).
   void Cast(const Eigen::Matrix3d& c_wl, const Eigen::Vector3d& r_wl, int i, double alpha,
             ScanPoint* p) {
-    // Unit direction of laser i at horizontal angle alpha, frame l.
-    const Eigen::Vector3d d_l(cos_el_[i] * std::cos(alpha), cos_el_[i] * std::sin(alpha),
-                              sin_el_[i]);
+    CastDirection(c_wl, r_wl, cos_el_[i], sin_el_[i], alpha, config_.model.ring[i], p);
+  }
+
+  // Casts a ray at elevation (cos_el, sin_el) and horizontal angle alpha,
+  // frame l, reported as `ring`.
+  void CastDirection(const Eigen::Matrix3d& c_wl, const Eigen::Vector3d& r_wl, double cos_el,
+                     double sin_el, double alpha, int ring, ScanPoint* p) {
+    const Eigen::Vector3d d_l(cos_el * std::cos(alpha), cos_el * std::sin(alpha), sin_el);
     const Eigen::Vector3d d_w = c_wl * d_l;
     RayHit hit;
-    p->ring = static_cast<uint16_t>(config_.model.ring[i]);
+    p->ring = static_cast<uint16_t>(ring);
     // Cast a little beyond the limits: noise may bring the range back inside.
     const double margin = 6.0 * config_.range_noise_m;
     if (!world_.Cast(r_wl, d_w, std::max(0.0, config_.min_range_m - margin),
@@ -100,6 +112,18 @@ class LaserCaster {
     p->range_mm = static_cast<uint32_t>(std::llround(range * 1000.0));
     p->label = static_cast<uint8_t>(hit.surface);
     p->valid = true;
+  }
+
+  // Livox noise: with probability `fraction`, a valid point is moved to a
+  // uniform random range along its ray and tagged 0x01.
+  void MaybeNoise(double fraction, ScanPoint* p) {
+    if (fraction <= 0.0 || rng_.Uniform(0.0, 1.0) >= fraction) return;
+    const double range = std::sqrt(double{p->x} * p->x + double{p->y} * p->y + double{p->z} * p->z);
+    const double scale = rng_.Uniform(config_.min_range_m, range) / range;
+    p->x = static_cast<float>(p->x * scale);
+    p->y = static_cast<float>(p->y * scale);
+    p->z = static_cast<float>(p->z * scale);
+    p->tag = 0x01;
   }
 
  private:
@@ -179,6 +203,50 @@ void SimulateOusterSweep(const ScanConfig& config, int64_t start_ns, LaserCaster
   }
 }
 
+// Livox: every point of the frame in time order; a point without a return
+// stays at the origin (the drivers publish it so).
+void SimulateLivoxSweep(const ScanConfig& config, int64_t start_ns, LaserCaster* caster,
+                        SimulatedScan* scan) {
+  const LivoxPattern& pattern = config.model.livox;
+  const int n = LivoxPoints(config);
+  scan->stamp_true_ns = start_ns;
+  scan->points.resize(static_cast<size_t>(n));
+  const double period_ns = 1e9 / pattern.point_rate_hz;
+  Eigen::Matrix3d c_wl;
+  Eigen::Vector3d r_wl;
+  for (int j = 0; j < n; ++j) {
+    const int64_t offset_ns = std::llround(j * period_ns);
+    const double t = (start_ns + offset_ns) * 1e-9;
+    caster->LidarPose(t, &c_wl, &r_wl);
+    const int line = j % pattern.lines;
+    const double phase = kTwoPi * line / pattern.lines;
+    double azimuth, elevation;
+    if (pattern.rosette) {
+      azimuth = pattern.half_azimuth_rad * 0.5 *
+                (std::cos(kTwoPi * pattern.f1_hz * t + phase) + std::cos(kTwoPi * pattern.f2_hz * t));
+      elevation = pattern.half_elevation_rad * 0.5 *
+                  (std::sin(kTwoPi * pattern.f1_hz * t + phase) - std::sin(kTwoPi * pattern.f2_hz * t));
+    } else {
+      azimuth = kTwoPi * pattern.f1_hz * t + phase;
+      elevation = pattern.min_elevation_rad +
+                  (pattern.max_elevation_rad - pattern.min_elevation_rad) * 0.5 *
+                      (1.0 - std::cos(kTwoPi * pattern.f2_hz * t + phase));
+    }
+    ScanPoint& p = scan->points[static_cast<size_t>(j)];
+    caster->CastDirection(c_wl, r_wl, std::cos(elevation), std::sin(elevation), azimuth, line, &p);
+    p.time_ns = static_cast<uint32_t>(offset_ns);
+    if (!p.valid) {
+      p.x = p.y = p.z = 0.0f;
+      continue;
+    }
+    caster->MaybeNoise(config.livox_noise_fraction, &p);
+    ++scan->num_valid;
+    if (p.tag == 0 && p.label == static_cast<uint8_t>(Surface::kGround)) ++scan->num_ground;
+  }
+  scan->rows = 1;
+  scan->columns = n;
+}
+
 }  // namespace
 
 SimulatedScan SimulateSweep(const ScanConfig& config, const PlanarTrajectory& trajectory,
@@ -188,6 +256,8 @@ SimulatedScan SimulateSweep(const ScanConfig& config, const PlanarTrajectory& tr
   const int64_t start_ns = SweepStartNs(config, k);
   if (config.model.kind == LidarModel::Kind::kVelodyne) {
     SimulateVelodyneSweep(config, start_ns, &caster, &scan);
+  } else if (config.model.kind == LidarModel::Kind::kLivox) {
+    SimulateLivoxSweep(config, start_ns, &caster, &scan);
   } else {
     SimulateOusterSweep(config, start_ns, &caster, &scan);
   }

@@ -20,7 +20,8 @@ struct ScanPoint {
   uint16_t ring = 0;
   uint16_t reflectivity = 0;  // Ouster
   float time_s = 0;           // Velodyne: firing time − stamp, s (float32 as the driver)
-  uint32_t time_ns = 0;       // Ouster: column time − stamp, ns
+  uint32_t time_ns = 0;       // Ouster: column time − stamp; Livox: offset_time, ns
+  uint8_t tag = 0;            // Livox: 0x01 for an injected noise point
   uint32_t range_mm = 0;      // Ouster: 0 = no return
   uint8_t label = 0;          // Surface
   bool valid = false;
@@ -31,7 +32,8 @@ struct SimulatedScan {
   // stamp is this minus τ.
   int64_t stamp_true_ns = 0;
   // Velodyne: valid returns in firing order. Ouster: rows x columns pixels,
-  // row-major (row = beam), invalid pixels included.
+  // row-major (row = beam), invalid pixels included. Livox: every point in
+  // time order, no return at the origin (as the drivers publish it).
   std::vector<ScanPoint> points;
   int rows = 1;
   int columns = 0;
@@ -47,10 +49,15 @@ struct ScanConfig {
   double range_noise_m = 0.01;
   bool velodyne_stamp_at_start = false;
   double first_scan_time_s = 0.1;  // true time of sweep 0's start
+  // Livox: fraction of points replaced by noise (a random range along the
+  // ray, tag 0x01: high confidence of noise by spatial position).
+  double livox_noise_fraction = 0.0;
   Eigen::Matrix3d imu_from_lidar_rotation = Eigen::Matrix3d::Identity();  // C_bl
   Eigen::Vector3d imu_from_lidar_translation = Eigen::Vector3d::Zero();   // r_b^{lb}
 };
 
+// Livox: points per frame (point rate / frame rate).
+int LivoxPoints(const ScanConfig& config);
 // Start of sweep k in true time, ns since the first IMU sample.
 int64_t SweepStartNs(const ScanConfig& config, int k);
 // Duration of one sweep's firings, s (first to last firing).

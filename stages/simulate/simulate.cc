@@ -139,7 +139,11 @@ Status MakeScanConfig(const proto::SimulateParams& params, ScanConfig* sc) {
       sc->model = Os132Model(static_cast<int>(columns));
       break;
     }
-    default: return Status::Error("field lidar.model must be VLP_16, VLP_32C or OS1_32");
+    case proto::SimLidarParams::LIVOX_AVIA: sc->model = LivoxAviaModel(); break;
+    case proto::SimLidarParams::LIVOX_MID360: sc->model = LivoxMid360Model(); break;
+    default:
+      return Status::Error(
+          "field lidar.model must be VLP_16, VLP_32C, OS1_32, LIVOX_AVIA or LIVOX_MID360");
   }
   if (lp.max_range_m() <= lp.min_range_m()) {
     return Status::Error("field lidar.max_range_m must exceed lidar.min_range_m");
@@ -148,6 +152,14 @@ Status MakeScanConfig(const proto::SimulateParams& params, ScanConfig* sc) {
   sc->min_range_m = lp.min_range_m();
   sc->max_range_m = lp.max_range_m();
   sc->range_noise_m = lp.range_noise_m();
+  sc->livox_noise_fraction = lp.livox_noise_fraction();
+  const bool livox = sc->model.kind == LidarModel::Kind::kLivox;
+  if (livox && lp.append_surface_label()) {
+    return Status::Error("field lidar.append_surface_label: a Livox CustomMsg has no label field");
+  }
+  if (!livox && lp.livox_noise_fraction() > 0) {
+    return Status::Error("field lidar.livox_noise_fraction applies to Livox models only");
+  }
   sc->velodyne_stamp_at_start = lp.velodyne_stamp_at_start();
   sc->first_scan_time_s = lp.first_scan_time_s();
   sc->imu_from_lidar_rotation =
@@ -519,14 +531,17 @@ class ScanWriter {
   void SimulateBatch(int first, int count) {
     const auto& lp = params_.lidar();
     const bool ouster = scenario_.scan.model.kind == LidarModel::Kind::kOuster;
+    const bool livox = scenario_.scan.model.kind == LidarModel::Kind::kLivox;
     auto work = [&](unsigned tid) {
       for (int j = static_cast<int>(tid); j < count; j += static_cast<int>(threads_)) {
         const int k = first + j;
         scans_[j] =
             SimulateSweep(scenario_.scan, *scenario_.trajectory, *scenario_.world, params_.seed(), k);
-        ok_[j] = SerializeScan(scans_[j], ouster, lp.append_surface_label(),
-                               static_cast<uint32_t>(k), StampNs(scans_[j]), lp.frame_id(),
-                               &messages_[j]);
+        ok_[j] = livox ? SerializeLivoxScan(scans_[j], static_cast<uint32_t>(k),
+                                            StampNs(scans_[j]), lp.frame_id(), &messages_[j])
+                       : SerializeScan(scans_[j], ouster, lp.append_surface_label(),
+                                       static_cast<uint32_t>(k), StampNs(scans_[j]),
+                                       lp.frame_id(), &messages_[j]);
         // Keep the counts; drop the points.
         scans_[j].points.clear();
         scans_[j].points.shrink_to_fit();
@@ -575,7 +590,9 @@ Status Run(const SimulatePaths& paths, const proto::SimulateParams& params, std:
   TILTCAL_RETURN_IF_ERROR(writer.Open(paths.out_bag, ToCompression(params.bag().compression()),
                                       params.bag().chunk_threshold_bytes(), threads));
   const ros1::MessageType& imu_type = ros1::ImuMessageType();
-  const ros1::MessageType& cloud_type = ros1::PointCloud2MessageType();
+  const ros1::MessageType& cloud_type =
+      scenario.scan.model.kind == LidarModel::Kind::kLivox ? ros1::LivoxCustomMsgMessageType()
+                                                           : ros1::PointCloud2MessageType();
   const uint32_t imu_conn = writer.AddConnection(params.imu().topic(), imu_type.type,
                                                  imu_type.md5sum, imu_type.definition);
   const uint32_t lidar_conn = writer.AddConnection(params.lidar().topic(), cloud_type.type,

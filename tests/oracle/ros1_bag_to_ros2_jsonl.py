@@ -1,15 +1,17 @@
 #!/usr/bin/python3
-"""Reads the sensor_msgs/Imu and sensor_msgs/PointCloud2 messages of a ROS1
+"""Reads the sensor_msgs/Imu, sensor_msgs/PointCloud2 and Livox CustomMsg messages of a ROS1
 bag with the real ROS library (Debian python3-rosbag) and prints them as the
 JSON lines write_ros2_bags.mjs --messages= takes, in record order: the same
 values as ROS 2 messages (std_msgs/Header without seq, stamp as
-{sec, nanosec}, the cloud's data in base64). Other topics are left out.
+{sec, nanosec}, the cloud's data in base64, the Livox points in base64 of
+their ROS 1 wire form). Other topics are left out.
 
-Usage: /usr/bin/python3 ros1_bag_to_ros2_jsonl.py BAG > messages.jsonl
+Usage: /usr/bin/python3 ros1_bag_to_ros2_jsonl.py BAG [--livox_type=TYPE] > messages.jsonl
 """
 
 import base64
 import json
+import struct
 import sys
 
 import rosbag
@@ -25,6 +27,11 @@ def vector(v):
 
 def main():
     out = sys.stdout
+    # The ROS 2 type of Livox CustomMsg (--livox_type=livox_interfaces/msg/CustomMsg).
+    livox_type = "livox_ros_driver2/msg/CustomMsg"
+    for a in sys.argv[2:]:
+        if a.startswith("--livox_type="):
+            livox_type = a[13:]
     with rosbag.Bag(sys.argv[1]) as bag:
         for topic, msg, t in bag.read_messages():
             record_ns = str(t.secs * 1000000000 + t.nsecs)
@@ -54,6 +61,18 @@ def main():
                     "is_dense": bool(msg.is_dense),
                 }
                 kind = "sensor_msgs/msg/PointCloud2"
+            elif msg._type in ("livox_ros_driver/CustomMsg", "livox_ros_driver2/CustomMsg"):
+                ros2 = {
+                    "header": header(msg.header),
+                    "timebase": str(msg.timebase),
+                    "point_num": msg.point_num,
+                    "lidar_id": msg.lidar_id,
+                    "rsvd": list(bytearray(msg.rsvd)),
+                    "points_b64": base64.b64encode(b"".join(
+                        struct.pack("<IfffBBB", p.offset_time, p.x, p.y, p.z, p.reflectivity,
+                                    p.tag, p.line) for p in msg.points)).decode("ascii"),
+                }
+                kind = livox_type
             else:
                 continue
             # repr() of a float round-trips; json.dumps uses it.

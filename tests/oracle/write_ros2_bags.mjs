@@ -19,14 +19,18 @@
 // /imu, 3 PointCloud2 in each of the Velodyne (/velodyne_points), Ouster
 // (/ouster/points) and Hesai (/hesai/pandar) layouts, 5 std_msgs/msg/String on
 // /chatter, interleaved in record time. --messages reads one JSON object per
-// line instead: {"topic", "type" ("sensor_msgs/msg/Imu" | "sensor_msgs/msg/PointCloud2"),
-// "record_ns" (string), "msg": the message with stamps as {sec, nanosec} and
-// the cloud's data in base64 as "data_b64"}.
+// line instead: {"topic", "type" ("sensor_msgs/msg/Imu" | "sensor_msgs/msg/PointCloud2" |
+// "livox_ros_driver2/msg/CustomMsg" | "livox_interfaces/msg/CustomMsg"), "record_ns"
+// (string), "msg": the message with stamps as {sec, nanosec}, the cloud's data
+// in base64 as "data_b64", a CustomMsg's timebase as a string and its points
+// in base64 as "points_b64" (19 bytes each, the ROS 1 wire form)}.
 // --expected writes what was serialized, one line per message in record order:
 //   imu TOPIC RECORD_NS SEC NANOSEC frame=FRAME 37 doubles (orientation xyzw,
 //       its covariance, angular velocity, covariance, linear acceleration, covariance)
 //   cloud TOPIC RECORD_NS SEC NANOSEC frame=FRAME HEIGHT WIDTH BIGENDIAN POINT_STEP
 //       ROW_STEP DENSE NFIELDS (NAME OFFSET DATATYPE COUNT)... DATA_HEX
+//   livox TOPIC RECORD_NS SEC NANOSEC frame=FRAME TIMEBASE POINT_NUM LIDAR_ID N
+//       (OFFSET_TIME X Y Z REFLECTIVITY TAG LINE)...
 //   string TOPIC RECORD_NS DATA
 // Doubles are printed by JavaScript's shortest round-trip form.
 
@@ -65,7 +69,16 @@ const DEFINITIONS = {
     "uint8 INT32=5\nuint8 UINT32=6\nuint8 FLOAT32=7\nuint8 FLOAT64=8\n" +
     "string name\nuint32 offset\nuint8 datatype\nuint32 count",
   "std_msgs/msg/String": "string data",
+  "livox_ros_driver2/msg/CustomMsg":
+    "std_msgs/Header header\nuint64 timebase\nuint32 point_num\nuint8 lidar_id\nuint8[3] rsvd\n" +
+    "livox_ros_driver2/CustomPoint[] points" + SEP + HEADER_DEFS + SEP +
+    "MSG: livox_ros_driver2/CustomPoint\nuint32 offset_time\nfloat32 x\nfloat32 y\nfloat32 z\n" +
+    "uint8 reflectivity\nuint8 tag\nuint8 line",
 };
+// livox_interfaces (livox_ros2_driver) has the same fields.
+DEFINITIONS["livox_interfaces/msg/CustomMsg"] = DEFINITIONS["livox_ros_driver2/msg/CustomMsg"]
+  .replaceAll("livox_ros_driver2/", "livox_interfaces/");
+const isLivox = (type) => type.endsWith("/msg/CustomMsg");
 
 function parseArgs(argv) {
   const args = { out: null, format: "mcap", compression: "none", summary: true,
@@ -206,8 +219,25 @@ async function* messagesFromJsonl(file) {
       j.msg.data = new Uint8Array(Buffer.from(j.msg.data_b64, "base64"));
       delete j.msg.data_b64;
     }
+    if (j.msg.points_b64 !== undefined) {
+      j.msg.points = livoxPointsFromBytes(Buffer.from(j.msg.points_b64, "base64"));
+      j.msg.timebase = BigInt(j.msg.timebase);
+      delete j.msg.points_b64;
+    }
     yield { topic: j.topic, type: j.type, recordNs: BigInt(j.record_ns), msg: j.msg };
   }
+}
+
+// Livox CustomPoints from their ROS 1 wire form (19 bytes each, little endian).
+function livoxPointsFromBytes(bytes) {
+  const view = new DataView(bytes.buffer, bytes.byteOffset, bytes.byteLength);
+  const points = [];
+  for (let o = 0; o + 19 <= bytes.byteLength; o += 19) {
+    points.push({ offset_time: view.getUint32(o, true), x: view.getFloat32(o + 4, true),
+                  y: view.getFloat32(o + 8, true), z: view.getFloat32(o + 12, true),
+                  reflectivity: bytes[o + 16], tag: bytes[o + 17], line: bytes[o + 18] });
+  }
+  return points;
 }
 
 // Big-endian CDR with the CdrWriter; alignment is the library's.
@@ -232,6 +262,15 @@ function writeBigEndian(type, m) {
     w.uint8(m.is_bigendian ? 1 : 0); w.uint32(m.point_step); w.uint32(m.row_step);
     w.uint8Array(m.data, true);
     w.uint8(m.is_dense ? 1 : 0);
+  } else if (isLivox(type)) {
+    header(m.header);
+    w.uint64(m.timebase); w.uint32(m.point_num); w.uint8(m.lidar_id);
+    for (const b of m.rsvd) w.uint8(b);
+    w.sequenceLength(m.points.length);
+    for (const p of m.points) {
+      w.uint32(p.offset_time); w.float32(p.x); w.float32(p.y); w.float32(p.z);
+      w.uint8(p.reflectivity); w.uint8(p.tag); w.uint8(p.line);
+    }
   } else {
     w.string(m.data);
   }
@@ -263,6 +302,14 @@ function expectedLine(m) {
     return `cloud ${m.topic} ${m.recordNs} ${h.stamp.sec} ${h.stamp.nanosec} frame=${h.frame_id} ` +
       `${c.height} ${c.width} ${c.is_bigendian ? 1 : 0} ${c.point_step} ${c.row_step} ` +
       `${c.is_dense ? 1 : 0} ${c.fields.length} ${fields} ${Buffer.from(c.data).toString("hex")}`;
+  }
+  if (isLivox(m.type)) {
+    const c = m.msg;
+    const f = (v) => (Number.isNaN(v) ? "nan" : String(v));
+    return `livox ${m.topic} ${m.recordNs} ${h.stamp.sec} ${h.stamp.nanosec} frame=${h.frame_id} ` +
+      `${c.timebase} ${c.point_num} ${c.lidar_id} ${c.points.length} ` +
+      c.points.map((p) => `${p.offset_time} ${f(p.x)} ${f(p.y)} ${f(p.z)} ${p.reflectivity} ` +
+                          `${p.tag} ${p.line}`).join(" ");
   }
   return `string ${m.topic} ${m.recordNs} ${m.msg.data}`;
 }

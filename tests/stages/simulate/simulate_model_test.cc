@@ -2,6 +2,8 @@
 // finite differences, planar-motion invariants, ray casting against a brute
 // force ray march, LiDAR firing patterns, random streams.
 #include <cmath>
+#include <set>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -280,6 +282,57 @@ TEST(SimScanSimulatorTest, PointTimesFollowTheStampConvention) {
     EXPECT_LT(a.points[i].time_ns, 100000000u);
   }
   EXPECT_EQ(same, a.points.size());
+}
+
+// Livox frames: every point in time order at the model's rate, lines taken
+// in turn, directions inside the field of view, no return at the origin, and
+// a pattern that does not repeat (three frames cover more directions than one).
+TEST(SimScanSimulatorTest, LivoxFramesAreNonRepetitiveWithinTheFieldOfView) {
+  TrajectoryConfig tc = TiltedConfig(false);
+  const PlanarTrajectory trajectory(tc);
+  World world(trajectory.NormalInWorld(), 20, 3);
+  for (const bool avia : {true, false}) {
+    SCOPED_TRACE(avia ? "Avia" : "Mid-360");
+    ScanConfig config;
+    config.model = avia ? LivoxAviaModel() : LivoxMid360Model();
+    const int lines = avia ? 6 : 4;
+    const size_t expected_points = avia ? 24000 : 20000;
+    std::set<std::pair<int, int>> one_frame, three_frames;  // 1 x 1 deg direction cells
+    for (int k = 2; k < 5; ++k) {
+      const SimulatedScan scan = SimulateSweep(config, trajectory, world, 5, k);
+      ASSERT_EQ(scan.points.size(), expected_points);
+      EXPECT_EQ(scan.stamp_true_ns, SweepStartNs(config, k));
+      int valid = 0;
+      for (size_t j = 0; j < scan.points.size(); ++j) {
+        const ScanPoint& p = scan.points[j];
+        EXPECT_EQ(p.ring, j % lines);
+        if (j > 0) {
+          EXPECT_GT(p.time_ns, scan.points[j - 1].time_ns);
+        }
+        if (!p.valid) {
+          EXPECT_TRUE(p.x == 0.0f && p.y == 0.0f && p.z == 0.0f);
+          continue;
+        }
+        ++valid;
+        const double az = std::atan2(p.y, p.x) * 180.0 / M_PI;
+        const double el = std::atan2(p.z, std::hypot(p.x, p.y)) * 180.0 / M_PI;
+        if (avia) {
+          EXPECT_LE(std::abs(az), 35.2 + 1e-3);
+          EXPECT_LE(std::abs(el), 38.6 + 1e-3);
+        } else {
+          EXPECT_GE(el, -7.0 - 1e-3);
+          EXPECT_LE(el, 52.0 + 1e-3);
+        }
+        const std::pair<int, int> cell(static_cast<int>(std::floor(az)),
+                                       static_cast<int>(std::floor(el)));
+        if (k == 2) one_frame.insert(cell);
+        three_frames.insert(cell);
+      }
+      EXPECT_GT(valid, static_cast<int>(expected_points / 4));
+      EXPECT_LT(scan.points.back().time_ns, 100000000u);
+    }
+    EXPECT_GT(three_frames.size(), one_frame.size() * 6 / 5);
+  }
 }
 
 TEST(SimRngTest, DeterministicAndNormal) {
