@@ -51,8 +51,10 @@ class McapReader : public bag::MessageReader {
   uint64_t size_bytes() const override { return file_size_; }
   std::string format_name() const override { return "MCAP"; }
   bool indexed() const override { return indexed_; }
+  // Only a recording cut short is salvaged; a complete file without a
+  // summary is read whole by the scan.
   int64_t num_salvaged_messages() const override {
-    return indexed_ ? 0 : static_cast<int64_t>(entries_.size());
+    return salvage_note_.empty() ? 0 : static_cast<int64_t>(entries_.size());
   }
   std::string salvage_note() const override { return salvage_note_; }
   uint64_t chunks_decompressed() const override { return chunks_decompressed_; }
