@@ -180,7 +180,9 @@ TEST(MergedMessageReader, FilesAreReadOnlyWhenTheMergeReachesThem) {
   int64_t count = 0;
   const Status status = reader.ReadMessages({}, [&](const Message& m) {
     for (int f = 1; f < 3; ++f) {
-      if (m.time_ns < f * 10000) EXPECT_FALSE(raw[f]->started) << "file " << f << " at " << m.time_ns;
+      if (m.time_ns < f * 10000) {
+        EXPECT_FALSE(raw[f]->started) << "file " << f << " at " << m.time_ns;
+      }
     }
     ++count;
     return Status::Ok();
