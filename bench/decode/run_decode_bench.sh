@@ -213,15 +213,15 @@ done
 
 # ---- Split row: the small bag as N bags split by record time. ----
 # python3-rosbag copies the messages raw (tests/oracle/split_ros1_bag.py,
-# parts alternating lz4 and uncompressed chunks); decode reads the folder as
-# one sequence, merging the files in record time.
+# lz4 chunks as the bag); decode reads the folder as one sequence, merging
+# the files in record time.
 if [ "$SPLIT_PARTS" -gt 1 ] && [ $HAVE_DECODE = 1 ]; then
-  split_dir="$WORK/$(basename "$SMALL_BAG" .bag)_split$SPLIT_PARTS"
+  split_dir="$WORK/$(basename "$SMALL_BAG" .bag)_lz4_split$SPLIT_PARTS"
   if [ ! -f "$split_dir.meta" ]; then
     log "splitting $(basename "$SMALL_BAG") into $SPLIT_PARTS bags"
     rm -rf "$split_dir"
     "$DEBIAN_PYTHON" "$REPO/tests/oracle/split_ros1_bag.py" "$SMALL_BAG" "$split_dir" \
-      --by=time --parts="$SPLIT_PARTS" >"$LOGS/split.log" 2>&1 &&
+      --by=time --parts="$SPLIT_PARTS" --compression=lz4 >"$LOGS/split.log" 2>&1 &&
       cp "$SMALL_BAG.meta" "$split_dir.meta" || log "splitting failed: no split row"
   else
     log "reusing $split_dir"

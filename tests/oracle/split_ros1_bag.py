@@ -9,10 +9,12 @@ python3-rosbag), the two ways recordings come split:
       topics) and OUT/lidar.bag (every other topic)
 
 Messages are copied raw (the serialized bytes and record times unchanged);
-parts alternate LZ4 and uncompressed chunks. Prints one line:
+parts alternate LZ4 and uncompressed chunks (--compression=alternate, the
+default), or all have lz4 or none. Prints one line:
 "messages M duplicated D" (D: messages written to two parts).
 
 Usage: /usr/bin/python3 split_ros1_bag.py BAG OUT --by=time|sensor [--parts=N] [--overlap_s=S]
+           [--compression=alternate|lz4|none]
 """
 
 import argparse
@@ -28,10 +30,12 @@ def main():
     p.add_argument("--by", choices=["time", "sensor"], required=True)
     p.add_argument("--parts", type=int, default=2)
     p.add_argument("--overlap_s", type=float, default=0.0)
+    p.add_argument("--compression", choices=["alternate", "lz4", "none"], default="alternate")
     a = p.parse_args()
     os.makedirs(a.out, exist_ok=True)
     name = os.path.splitext(os.path.basename(a.bag))[0]
-    compressions = [rosbag.Compression.LZ4, rosbag.Compression.NONE]
+    compressions = {"alternate": [rosbag.Compression.LZ4, rosbag.Compression.NONE],
+                    "lz4": [rosbag.Compression.LZ4], "none": [rosbag.Compression.NONE]}[a.compression]
     with rosbag.Bag(a.bag) as bag:
         start = bag.get_start_time()
         span = bag.get_end_time() - start
@@ -39,7 +43,7 @@ def main():
             files = ["%s_%d.bag" % (name, i) for i in range(a.parts)]
         else:
             files = ["imu.bag", "lidar.bag"]
-        outs = [rosbag.Bag(os.path.join(a.out, f), "w", compression=compressions[i % 2])
+        outs = [rosbag.Bag(os.path.join(a.out, f), "w", compression=compressions[i % len(compressions)])
                 for i, f in enumerate(files)]
         messages = duplicated = 0
         for topic, raw, t in bag.read_messages(raw=True):
