@@ -15,7 +15,8 @@
 // salvaged (indexed() false, salvage_note() says where it stopped).
 // ReadMessages() then yields the selected messages in (log time, chunk
 // position, offset) order, decompressing chunks on demand into a small LRU
-// cache: memory is bounded by the cache plus 24 bytes per message.
+// cache, emptied when it returns: memory is bounded by the cache plus 24
+// bytes per message.
 // The file is read with pread(); a chunk whose CRC or size does not match,
 // an unknown compression, a record that does not parse are errors naming
 // the file and the byte offset of the record.
