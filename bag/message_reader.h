@@ -56,6 +56,8 @@ class MessageReader {
 
   // The path given to the reader (a file or a folder).
   virtual const std::string& path() const = 0;
+  // Every file the reader reads, in its order (a single file: path()).
+  virtual std::vector<std::string> input_files() const { return {path()}; }
   // Bytes of every file read.
   virtual uint64_t size_bytes() const = 0;
   // The format, for the log: "ROS 1 bag", "rosbag2 sqlite3", "MCAP".
@@ -67,6 +69,9 @@ class MessageReader {
   virtual std::string salvage_note() const { return ""; }
   // Compressed chunks decompressed so far.
   virtual uint64_t chunks_decompressed() const { return 0; }
+  // Messages left out because another file of the sequence held the same
+  // message (bag/merged_message_reader.h), in the last ReadMessages().
+  virtual int64_t duplicates_dropped() const { return 0; }
 
   // Sorted by name.
   virtual const std::vector<TopicInfo>& topics() const = 0;

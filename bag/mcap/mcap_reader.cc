@@ -427,6 +427,9 @@ Status McapReader::ReadMessages(const bag::MessageSelection& selection,
     TILTCAL_RETURN_IF_ERROR(fn(m));
     ++m.sequence;
   }
+  // The decompressed chunks are freed once read (one file of a sequence
+  // split over many stays open while the others are read).
+  cache_.clear();
   return Status::Ok();
 }
 

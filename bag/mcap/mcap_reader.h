@@ -15,7 +15,8 @@
 // salvaged (indexed() false, salvage_note() says where it stopped).
 // ReadMessages() then yields the selected messages in (log time, chunk
 // position, offset) order, decompressing chunks on demand into a small LRU
-// cache: memory is bounded by the cache plus 24 bytes per message.
+// cache, emptied when it returns: memory is bounded by the cache plus 24
+// bytes per message.
 // The file is read with pread(); a chunk whose CRC or size does not match,
 // an unknown compression, a record that does not parse are errors naming
 // the file and the byte offset of the record.
@@ -51,8 +52,10 @@ class McapReader : public bag::MessageReader {
   uint64_t size_bytes() const override { return file_size_; }
   std::string format_name() const override { return "MCAP"; }
   bool indexed() const override { return indexed_; }
+  // Only a recording cut short is salvaged; a complete file without a
+  // summary is read whole by the scan.
   int64_t num_salvaged_messages() const override {
-    return indexed_ ? 0 : static_cast<int64_t>(entries_.size());
+    return salvage_note_.empty() ? 0 : static_cast<int64_t>(entries_.size());
   }
   std::string salvage_note() const override { return salvage_note_; }
   uint64_t chunks_decompressed() const override { return chunks_decompressed_; }

@@ -40,6 +40,7 @@ class SqliteBagReader : public bag::MessageReader {
   const std::vector<std::string>& files() const { return files_; }
 
   const std::string& path() const override { return path_; }
+  std::vector<std::string> input_files() const override { return files_; }
   uint64_t size_bytes() const override { return size_bytes_; }
   std::string format_name() const override { return "rosbag2 sqlite3"; }
   bool indexed() const override { return true; }

@@ -25,6 +25,10 @@
 #                        data only (default 0 = whole bag)
 #   --build_dir DIR      (default <repo>/build-bench)
 #   --ros2 0|1           the MCAP and sqlite3 rows (default 1)
+#   --ros2_large 0|1     also the large bag as MCAP (zstd chunks), for the memory
+#                        of the MCAP path against the bag size (default 1)
+#   --split_parts N      the small bag split by time into N bags in one folder,
+#                        decoded as one sequence (default 4; 0 = no split row)
 #   --clean              delete the generated bags at the end
 # Exit status is non-zero when a step fails; the table is still printed for
 # the steps that ran.
@@ -40,6 +44,8 @@ PYTHON_MAX_BYTES=0
 BUILD_DIR="$REPO/build-bench"
 CLEAN=0
 ROS2=1
+ROS2_LARGE=1
+SPLIT_PARTS=4
 while [ $# -gt 0 ]; do
   case "$1" in
     --scratch) SCRATCH=$2; shift 2 ;;
@@ -50,6 +56,8 @@ while [ $# -gt 0 ]; do
     --python_max_bytes) PYTHON_MAX_BYTES=$2; shift 2 ;;
     --build_dir) BUILD_DIR=$2; shift 2 ;;
     --ros2) ROS2=$2; shift 2 ;;
+    --ros2_large) ROS2_LARGE=$2; shift 2 ;;
+    --split_parts) SPLIT_PARTS=$2; shift 2 ;;
     --clean) CLEAN=1; shift ;;
     -h|--help) sed -n '2,/^set -euo/p' "$0" | sed '$d'; exit 0 ;;
     *) echo "run_decode_bench: unknown argument $1" >&2; exit 2 ;;
@@ -203,35 +211,55 @@ for ((r = 1; r <= REPEATS && HAVE_DECODE; ++r)); do
   run_decode tiltcal_decode "$SMALL_BAG" "$r"
 done
 
+# ---- Split row: the small bag as N bags split by record time. ----
+# python3-rosbag copies the messages raw (tests/oracle/split_ros1_bag.py,
+# lz4 chunks as the bag); decode reads the folder as one sequence, merging
+# the files in record time.
+if [ "$SPLIT_PARTS" -gt 1 ] && [ $HAVE_DECODE = 1 ]; then
+  split_dir="$WORK/$(basename "$SMALL_BAG" .bag)_lz4_split$SPLIT_PARTS"
+  if [ ! -f "$split_dir.meta" ]; then
+    log "splitting $(basename "$SMALL_BAG") into $SPLIT_PARTS bags"
+    rm -rf "$split_dir"
+    "$DEBIAN_PYTHON" "$REPO/tests/oracle/split_ros1_bag.py" "$SMALL_BAG" "$split_dir" \
+      --by=time --parts="$SPLIT_PARTS" --compression=lz4 >"$LOGS/split.log" 2>&1 &&
+      cp "$SMALL_BAG.meta" "$split_dir.meta" || log "splitting failed: no split row"
+  else
+    log "reusing $split_dir"
+  fi
+  if [ -f "$split_dir.meta" ]; then
+    cat "$split_dir"/*.bag >/dev/null
+    for ((r = 1; r <= REPEATS; ++r)); do
+      log "run $r/$REPEATS on $(basename "$split_dir")/"
+      run_decode "tiltcal_decode_split$SPLIT_PARTS" "$split_dir" "$r"
+    done
+  fi
+fi
+
 # ---- ROS 2 rows: the small bag as MCAP and as a rosbag2 .db3. ----
 # The same messages (python3-rosbag reads them, the npm libraries write
 # them), so the rows compare the formats; the converted files are reused
-# like the bags, with a copy of the bag's .meta.
-ros2_convert() {  # FORMAT OUT
+# like the bags, with a copy of the bag's .meta. The messages go from the
+# reader to the writer through a pipe (no JSON file on disk).
+ros2_convert() {  # FORMAT OUT SOURCE_BAG [COMPRESSION]
   if [ -e "$2" ] && [ -f "$2.meta" ]; then log "reusing $2"; return 0; fi
-  local jsonl="$WORK/$(basename "$SMALL_BAG" .bag).jsonl"
-  if [ ! -s "$jsonl" ]; then
-    log "converting $(basename "$SMALL_BAG") to ROS 2 messages"
-    "$DEBIAN_PYTHON" "$REPO/tests/oracle/ros1_bag_to_ros2_jsonl.py" "$SMALL_BAG" >"$jsonl.tmp" &&
-      mv "$jsonl.tmp" "$jsonl" || return 1
-  fi
-  log "writing $2"
+  log "writing $2 from $(basename "$3")"
+  local to_jsonl=("$DEBIAN_PYTHON" "$REPO/tests/oracle/ros1_bag_to_ros2_jsonl.py" "$3")
   if [ "$1" = mcap ]; then
-    node "$REPO/tests/oracle/write_ros2_bags.mjs" "$2" --format=mcap --compression=lz4 \
-      --messages="$jsonl" || return 1
+    "${to_jsonl[@]}" | node "$REPO/tests/oracle/write_ros2_bags.mjs" "$2" --format=mcap \
+      --compression="${4:-lz4}" --messages=/dev/stdin || return 1
   else
-    node "$REPO/tests/oracle/write_ros2_bags.mjs" "$2.dir" --format=sqlite3 \
-      --messages="$jsonl" && mv "$2.dir/$(basename "$2").dir_0.db3" "$2" && rm -rf "$2.dir" ||
+    "${to_jsonl[@]}" | node "$REPO/tests/oracle/write_ros2_bags.mjs" "$2.dir" --format=sqlite3 \
+      --messages=/dev/stdin && mv "$2.dir/$(basename "$2").dir_0.db3" "$2" && rm -rf "$2.dir" ||
       return 1
   fi
-  cp "$SMALL_BAG.meta" "$2.meta"
+  cp "$3.meta" "$2.meta"
 }
 if [ "$ROS2" = 1 ] && [ $HAVE_DECODE = 1 ]; then
   if [ -f "$REPO/tests/node_modules/@mcap/core/package.json" ] && command -v node >/dev/null; then
     small_base="$WORK/$(basename "$SMALL_BAG" .bag)"
     for format in mcap db3; do
       ros2_bag="$small_base.$format"
-      if ros2_convert "$format" "$ros2_bag"; then
+      if ros2_convert "$format" "$ros2_bag" "$SMALL_BAG"; then
         warm "$ros2_bag"
         for ((r = 1; r <= REPEATS; ++r)); do
           log "run $r/$REPEATS on $(basename "$ros2_bag")"
@@ -241,6 +269,20 @@ if [ "$ROS2" = 1 ] && [ $HAVE_DECODE = 1 ]; then
         log "could not convert the bag to $format: no $format row"
       fi
     done
+    # The large bag as MCAP with zstd chunks (lz4js, the JavaScript lz4 of
+    # the oracle, is slow on a GB): the MCAP path's memory against size.
+    if [ "$ROS2_LARGE" = 1 ]; then
+      large_mcap="$WORK/$(basename "$BAG" .bag).mcap"
+      if ros2_convert mcap "$large_mcap" "$BAG" zstd; then
+        warm "$large_mcap"
+        for ((r = 1; r <= REPEATS; ++r)); do
+          log "run $r/$REPEATS on $(basename "$large_mcap")"
+          run_decode tiltcal_decode_mcap "$large_mcap" "$r"
+        done
+      else
+        log "could not convert the large bag to MCAP: no large MCAP row"
+      fi
+    fi
   else
     log "no tests/node_modules (scripts/setup.sh) or node: no MCAP / sqlite3 rows"
   fi
@@ -274,14 +316,14 @@ awk -v big="$BAG" '
     if ($6 != 0) failed[key] = 1
   }
   END {
-    printf "\n%-40s %-21s %7s %7s %7s %9s %7s %7s %7s\n", "tool", "bag", "wall s", "cpu s", "MB/s", "Mpoints/s", "RSS MB", "vs C++", "cpu vs"
+    printf "\n%-40s %-25s %7s %7s %7s %9s %7s %7s %7s\n", "tool", "bag", "wall s", "cpu s", "MB/s", "Mpoints/s", "RSS MB", "vs C++", "cpu vs"
     anchor_key = "rosbag_cpp" SUBSEP big
     anchor = (anchor_key in walls) ? median(walls[anchor_key]) : 0
     anchor_cpu = (anchor_key in cpus) ? median(cpus[anchor_key]) : 0
     for (k = 1; k <= n; ++k) {
       key = order[k]; split(key, parts, SUBSEP)
       w = median(walls[key])
-      cmd = "stat -c %s " parts[2]; cmd | getline size; close(cmd)
+      cmd = "du -sb " parts[2]; cmd | getline size; close(cmd); size += 0  # a file or a folder
       name = parts[1]
       if (failed[key]) name = name " (FAILED)"
       c = median(cpus[key])
@@ -293,7 +335,7 @@ awk -v big="$BAG" '
       cmd = "sed -n s/^points=//p " parts[2] ".meta"; cmd | getline total; close(cmd)
       frac = (total > 0) ? points[key] / total : 1
       if (frac < 0.999) { name = name sprintf(" [%.0f%% prefix]", 100 * frac); if (ratio != "-") { ratio = sprintf("%.2fx", anchor * frac / w); cratio = sprintf("%.2fx", anchor_cpu * frac / c) } }
-      printf "%-40s %-21s %7.2f %7.2f %7.1f %9.2f %7.1f %7s %7s\n", name, bn, w, c,
+      printf "%-40s %-25s %7.2f %7.2f %7.1f %9.2f %7.1f %7s %7s\n", name, bn, w, c,
              (w > 0 ? size * frac / w / 1e6 : 0), (w > 0 ? points[key] / w / 1e6 : 0), rss[key] / 1024, ratio, cratio
     }
   }' "$RESULTS" | tee "$LOGS/table.txt"
@@ -306,7 +348,8 @@ awk '$6 != 0 { bad = 1 } END { exit bad }' "$RESULTS" || status=1
 if [ $CLEAN = 1 ]; then
   rm -f "$BAG" "$BAG.meta" "$SMALL_BAG" "$SMALL_BAG.meta"
   small_base="$WORK/$(basename "$SMALL_BAG" .bag)"
-  rm -f "$small_base".{mcap,db3}{,.meta} "$small_base.jsonl"
+  rm -f "$small_base".{mcap,db3}{,.meta} "$WORK/$(basename "$BAG" .bag)".mcap{,.meta}
+  rm -rf "$small_base"_split*
   log "removed the generated bags"
 fi
 exit $status

@@ -1,10 +1,13 @@
 #include "stages/decode/bag_input.h"
 
-#include <filesystem>
+#include <algorithm>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
+#include <vector>
 
 #include "bag/mcap/mcap_reader.h"
+#include "bag/merged_message_reader.h"
 #include "bag/ros1/messages.h"
 #include "bag/ros2/messages.h"
 #include "bag/ros2/sqlite_bag_reader.h"
@@ -20,28 +23,45 @@ namespace {
 constexpr char kSqliteMagic[16] = {'S', 'Q', 'L', 'i', 't', 'e', ' ', 'f',
                                    'o', 'r', 'm', 'a', 't', ' ', '3', '\0'};
 constexpr char kShapes[] =
-    "a .bag (ROS 1), a .mcap, a .db3 or a ROS 2 bag folder with metadata.yaml";
+    "a .bag (ROS 1), a .mcap, a .db3, a ROS 2 bag folder with metadata.yaml, or a folder of "
+    ".bag / .mcap / .db3 files";
 
 // The storage_identifier of a rosbag2 metadata.yaml ("sqlite3", "mcap"),
-// and its first relative_file_paths entry.
-void ReadStorage(const std::string& metadata, std::string* storage, std::string* first_file) {
+// and its relative_file_paths entries.
+void ReadStorage(const std::string& metadata, std::string* storage,
+                 std::vector<std::string>* files) {
   std::ifstream in(metadata);
   bool in_list = false;
   for (std::string line; std::getline(in, line);) {
     const size_t start = line.find_first_not_of(" \t");
     if (start == std::string::npos) continue;
-    const std::string t = line.substr(start);
-    if (in_list && t.rfind("- ", 0) == 0 && first_file->empty()) {
-      *first_file = t.substr(2);
+    std::string t = line.substr(start);
+    t.erase(t.find_last_not_of(" \t\r") + 1);
+    if (in_list && t.rfind("- ", 0) == 0) {
+      files->push_back(t.substr(2));
       continue;
     }
     in_list = t.rfind("relative_file_paths:", 0) == 0;
     if (t.rfind("storage_identifier:", 0) == 0) {
       *storage = t.substr(19);
       storage->erase(0, storage->find_first_not_of(" \t\"'"));
-      storage->erase(storage->find_last_not_of(" \t\"'\r") + 1);
+      storage->erase(storage->find_last_not_of(" \t\"'") + 1);
     }
   }
+}
+
+// The bag files directly in `folder` (.bag, .mcap, .db3), in name order.
+std::vector<std::string> BagFilesIn(const fs::path& folder) {
+  std::vector<std::string> files;
+  std::error_code ec;
+  for (const fs::directory_entry& e : fs::directory_iterator(folder, ec)) {
+    const std::string ext = e.path().extension().string();
+    if (e.is_regular_file(ec) && (ext == ".bag" || ext == ".mcap" || ext == ".db3")) {
+      files.push_back(e.path().string());
+    }
+  }
+  std::sort(files.begin(), files.end());
+  return files;
 }
 
 template <typename Reader>
@@ -49,6 +69,21 @@ Status OpenWith(std::unique_ptr<Reader> r, const std::string& path,
                 std::unique_ptr<bag::MessageReader>* reader) {
   TILTCAL_RETURN_IF_ERROR(r->Open(path));
   *reader = std::move(r);
+  return Status::Ok();
+}
+
+// Opens every file of `files` (each by its first bytes) and merges them;
+// a single file is opened alone.
+Status OpenFiles(const std::string& path, const std::vector<std::string>& files,
+                 size_t chunk_cache_size, std::unique_ptr<bag::MessageReader>* reader) {
+  if (files.size() == 1) return OpenBagFile(files[0], chunk_cache_size, reader);
+  std::vector<std::unique_ptr<bag::MessageReader>> readers(files.size());
+  for (size_t i = 0; i < files.size(); ++i) {
+    TILTCAL_RETURN_IF_ERROR(OpenBagFile(files[i], chunk_cache_size, &readers[i]));
+  }
+  auto merged = std::make_unique<bag::MergedMessageReader>();
+  TILTCAL_RETURN_IF_ERROR(merged->Open(path, std::move(readers)));
+  *reader = std::move(merged);
   return Status::Ok();
 }
 
@@ -81,24 +116,38 @@ Status OpenBagInput(const std::string& path, size_t chunk_cache_size,
                     std::unique_ptr<bag::MessageReader>* reader) {
   std::error_code ec;
   const fs::path p(path);
-  if (fs::is_directory(p, ec)) {
-    const fs::path metadata = p / "metadata.yaml";
-    if (!fs::exists(metadata, ec)) {
-      return Status::Error(path + ": a folder without metadata.yaml; expected " + kShapes);
+  if (!fs::is_directory(p, ec)) return OpenBagFile(path, chunk_cache_size, reader);
+  const fs::path metadata = p / "metadata.yaml";
+  if (!fs::exists(metadata, ec)) {
+    const std::vector<std::string> files = BagFilesIn(p);
+    if (files.empty()) {
+      return Status::Error(path + ": a folder with neither metadata.yaml nor bag files; expected " +
+                           kShapes);
     }
-    std::string storage, first_file;
-    ReadStorage(metadata.string(), &storage, &first_file);
-    if (storage == "mcap") {
-      if (first_file.empty()) return Status::Error(metadata.string() + ": no relative_file_paths");
-      return OpenWith(std::make_unique<mcap::McapReader>(),
-                      (p / fs::path(first_file).filename()).string(), reader);
-    }
-    if (!storage.empty() && storage != "sqlite3") {
-      return Status::Error(metadata.string() + ": storage_identifier '" + storage +
-                           "' (known: sqlite3, mcap)");
-    }
-    return OpenWith(std::make_unique<ros2::SqliteBagReader>(), path, reader);
+    return OpenFiles(path, files, chunk_cache_size, reader);
   }
+  std::string storage;
+  std::vector<std::string> relative_files;
+  ReadStorage(metadata.string(), &storage, &relative_files);
+  if (storage == "mcap") {
+    if (relative_files.empty()) {
+      return Status::Error(metadata.string() + ": no relative_file_paths");
+    }
+    std::vector<std::string> files;
+    for (const std::string& f : relative_files) {
+      files.push_back((p / fs::path(f).filename()).string());
+    }
+    return OpenFiles(path, files, chunk_cache_size, reader);
+  }
+  if (!storage.empty() && storage != "sqlite3") {
+    return Status::Error(metadata.string() + ": storage_identifier '" + storage +
+                         "' (known: sqlite3, mcap)");
+  }
+  return OpenWith(std::make_unique<ros2::SqliteBagReader>(), path, reader);
+}
+
+Status OpenBagFile(const std::string& path, size_t chunk_cache_size,
+                   std::unique_ptr<bag::MessageReader>* reader) {
   // A file is recognised by its first bytes, whatever its name; anything
   // that is neither MCAP nor sqlite3 goes to the ROS 1 reader, whose errors
   // say what is wrong with it.

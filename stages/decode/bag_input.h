@@ -7,8 +7,13 @@
 //   any other file                           ROS 1 bag (bag/ros1/), as before
 //   a folder with metadata.yaml              a rosbag2 bag: its .db3 files
 //                                            (storage sqlite3), or its .mcap
-//                                            file (storage mcap)
-// A folder without metadata.yaml is an error naming it and the shapes.
+//                                            files (storage mcap)
+//   a folder without metadata.yaml           one sequence in several files:
+//                                            its .bag, .mcap and .db3 files
+//                                            (each by its first bytes; not
+//                                            its sub-folders), merged in
+//                                            record time (bag/merged_message_reader.h)
+// A folder with neither is an error naming it and the shapes.
 
 #include <memory>
 #include <string>
@@ -33,6 +38,10 @@ SensorTypes SensorTypesOf(const bag::MessageReader& reader);
 // decompressed chunks the ROS 1 reader keeps.
 Status OpenBagInput(const std::string& path, size_t chunk_cache_size,
                     std::unique_ptr<bag::MessageReader>* reader);
+
+// Opens the one file `path` by its first bytes (MCAP, sqlite3, else ROS 1).
+Status OpenBagFile(const std::string& path, size_t chunk_cache_size,
+                   std::unique_ptr<bag::MessageReader>* reader);
 
 }  // namespace tiltcal::decode
 

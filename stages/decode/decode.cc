@@ -117,9 +117,14 @@ void PrintSummary(std::ostream* log, const DecodePaths& paths,
   const double shift_s = params.lidar_stamp_shift_s();
   if (log == nullptr) return;
   const double mb = static_cast<double>(s.bag_bytes) * 1e-6;
-  *log << fmt::format("tiltcal_decode: {}: {:.1f} MB, {}\n", paths.bag, mb,
+  *log << fmt::format("tiltcal_decode: {}: {}, {:.1f} MB, {}\n", paths.bag, s.bag_format, mb,
                       s.indexed ? "indexed" : "UNINDEXED (linear scan)");
-  if (!s.indexed) {
+  if (s.bag_files.size() > 1) {
+    *log << fmt::format("  merged in record time: {}; {} duplicate messages dropped (the same "
+                        "topic, record time and bytes in an earlier file)\n",
+                        Join(s.bag_files), s.duplicates_dropped);
+  }
+  if (s.salvaged_messages > 0 || !s.salvage_note.empty()) {
     *log << fmt::format("  salvaged {} messages from the unindexed bag{}{}\n",
                         s.salvaged_messages, s.salvage_note.empty() ? "" : "; ",
                         s.salvage_note);
@@ -205,6 +210,8 @@ Status OpenBag(const DecodePaths& paths, const proto::DecodeParams& params, cons
       paths.bag, std::max<uint32_t>(params.chunk_cache_size(), 1), input));
   const bag::MessageReader* reader = input->get();
   s->bag_bytes = reader->size_bytes();
+  s->bag_format = reader->format_name();
+  s->bag_files = reader->input_files();
   s->indexed = reader->indexed();
   s->salvaged_messages = reader->num_salvaged_messages();
   s->salvage_note = reader->salvage_note();
@@ -311,7 +318,11 @@ Status Decode(const DecodePaths& paths, const proto::DecodeParams& params, std::
   bag::MessageSelection options;
   TILTCAL_RETURN_IF_ERROR(MakeReadOptions(reader, params, s, &options));
 
+  // The bag as named, and every file read when they differ from it.
   std::vector<InputPath> input_paths = {{"bag", paths.bag}};
+  if (s.bag_files != std::vector<std::string>{paths.bag}) {
+    for (const std::string& file : s.bag_files) input_paths.push_back({"bag file", file});
+  }
   if (!paths.rig.empty()) input_paths.push_back({"rig", paths.rig});
   const proto::Provenance provenance =
       MakeProvenance("tiltcal_decode", params, input_paths, paths.command_line);
@@ -345,6 +356,7 @@ Status Decode(const DecodePaths& paths, const proto::DecodeParams& params, std::
   // Both outputs or neither, also when the process is killed meanwhile.
   TILTCAL_RETURN_IF_ERROR(CommitTogether({imu_writer.file(), scans_writer.file()}));
   s.chunks_decompressed = reader.chunks_decompressed();
+  s.duplicates_dropped = reader.duplicates_dropped();
   s.wall_s = std::chrono::duration<double>(Clock::now() - t0).count();
   PrintSummary(log, paths, params, s);
   if (summary != nullptr) *summary = s;

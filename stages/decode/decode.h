@@ -54,6 +54,9 @@ struct DecodeSummary {
   std::vector<std::string> imu_notes;     // units and sign: what was decided and why
   std::vector<std::string> imu_warnings;  // the notes that need the user's attention
   uint64_t bag_bytes = 0;
+  std::string bag_format;              // "ROS 1 bag", "2 files (ROS 1 bag, MCAP)", ...
+  std::vector<std::string> bag_files;  // every file read, in file-name order
+  int64_t duplicates_dropped = 0;      // the same message in two files, given once
   uint64_t chunks_decompressed = 0;
   double wall_s = 0.0;
 };

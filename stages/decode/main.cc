@@ -1,4 +1,5 @@
-// tiltcal_decode: the IMU and LiDAR topics of a ROS1 bag into record streams.
+// tiltcal_decode: the IMU and LiDAR topics of a bag (ROS 1, MCAP, rosbag2, or
+// one sequence in several bag files) into record streams.
 #include <iostream>
 
 #include "common/cli/command_line.h"
@@ -10,9 +11,13 @@
 int main(int argc, char** argv) {
   tiltcal::cli::CommandLine cli(
       "tiltcal_decode",
-      "decodes the IMU and LiDAR topics of a ROS1 bag (none / bz2 / lz4 chunks, indexed or "
-      "not) into imu.binpb and scans.binpb.lz4");
-  cli.AddFlag("bag", "input: the ROS1 bag (.bag)", tiltcal::cli::kRequired);
+      "decodes the IMU and LiDAR topics of a bag (ROS 1 with none / bz2 / lz4 chunks, indexed "
+      "or not; MCAP; rosbag2 sqlite3) or of one sequence in several bag files into imu.binpb "
+      "and scans.binpb.lz4");
+  cli.AddFlag("bag",
+              "input: a bag file (.bag, .mcap, .db3), a ROS 2 bag folder (metadata.yaml), or a "
+              "folder of bag files holding one sequence (merged in record time)",
+              tiltcal::cli::kRequired);
   cli.AddFlag("rig", "input: the dataset's rig.txtpb (imu_topic / lidar_topic)");
   cli.AddFlag("params",
               "decode params, text format (default: stages/decode/default_params.txtpb)");

@@ -7,11 +7,15 @@
 //                    metadata.yaml beside the .db3 files;
 //   CDR:             @foxglove/rosmsg2-serialization MessageWriter (little
 //                    endian), or @foxglove/cdr CdrWriter with the big-endian
-//                    encapsulation (the MessageWriter writes little endian only).
+//                    encapsulation (the MessageWriter writes little endian only);
+//   ROS 1 in MCAP:   --encoding=ros1: profile "ros1", schemas "ros1msg",
+//                    messages "ros1" by @foxglove/rosmsg-serialization
+//                    MessageWriter, ROS 1 type names (sensor_msgs/Imu), a
+//                    header seq of 0 (as a ROS 1 bag converted to MCAP).
 //
 // Usage:
 //   node write_ros2_bags.mjs OUT --format=mcap|sqlite3 [--compression=none|lz4|zstd]
-//        [--no-summary] [--big-endian] [--split=N] [--messages=IN.jsonl]
+//        [--no-summary] [--big-endian] [--encoding=cdr|ros1] [--split=N] [--messages=IN.jsonl]
 //        [--expected=EXPECTED.txt]
 // OUT is the .mcap file, or the rosbag2 folder (metadata.yaml + OUT_i.db3; a
 // new .db3 every N messages with --split=N).
@@ -45,6 +49,7 @@ import { McapWriter } from "@mcap/core";
 import { FileHandleWritable } from "@mcap/nodejs";
 import { parse } from "@foxglove/rosmsg";
 import { MessageWriter } from "@foxglove/rosmsg2-serialization";
+import { MessageWriter as Ros1MessageWriter } from "@foxglove/rosmsg-serialization";
 import * as zstd from "@foxglove/wasm-zstd";
 import lz4 from "lz4js";
 
@@ -79,23 +84,46 @@ const DEFINITIONS = {
 DEFINITIONS["livox_interfaces/msg/CustomMsg"] = DEFINITIONS["livox_ros_driver2/msg/CustomMsg"]
   .replaceAll("livox_ros_driver2/", "livox_interfaces/");
 const isLivox = (type) => type.endsWith("/msg/CustomMsg");
+// The same messages in ROS 1 (std_msgs/Header with seq, time as sec/nsec).
+const ROS1_HEADER = "MSG: std_msgs/Header\nuint32 seq\ntime stamp\nstring frame_id";
+const ROS1_DEFINITIONS = {
+  "sensor_msgs/Imu":
+    "Header header\n" +
+    "geometry_msgs/Quaternion orientation\nfloat64[9] orientation_covariance\n" +
+    "geometry_msgs/Vector3 angular_velocity\nfloat64[9] angular_velocity_covariance\n" +
+    "geometry_msgs/Vector3 linear_acceleration\nfloat64[9] linear_acceleration_covariance" +
+    SEP + ROS1_HEADER + SEP +
+    "MSG: geometry_msgs/Quaternion\nfloat64 x\nfloat64 y\nfloat64 z\nfloat64 w" + SEP +
+    "MSG: geometry_msgs/Vector3\nfloat64 x\nfloat64 y\nfloat64 z",
+  "sensor_msgs/PointCloud2":
+    "Header header\nuint32 height\nuint32 width\nPointField[] fields\n" +
+    "bool is_bigendian\nuint32 point_step\nuint32 row_step\nuint8[] data\nbool is_dense" +
+    SEP + ROS1_HEADER + SEP +
+    "MSG: sensor_msgs/PointField\nuint8 INT8=1\nuint8 UINT8=2\nuint8 INT16=3\nuint8 UINT16=4\n" +
+    "uint8 INT32=5\nuint8 UINT32=6\nuint8 FLOAT32=7\nuint8 FLOAT64=8\n" +
+    "string name\nuint32 offset\nuint8 datatype\nuint32 count",
+  "std_msgs/String": "string data",
+};
+const ros1TypeOf = (type) => type.replace("/msg/", "/");
 
 function parseArgs(argv) {
   const args = { out: null, format: "mcap", compression: "none", summary: true,
-                 bigEndian: false, split: 0, messages: null, expected: null };
+                 bigEndian: false, encoding: "cdr", split: 0, messages: null, expected: null };
   for (const a of argv) {
     if (!a.startsWith("--")) args.out = a;
     else if (a.startsWith("--format=")) args.format = a.slice(9);
     else if (a.startsWith("--compression=")) args.compression = a.slice(14);
     else if (a === "--no-summary") args.summary = false;
     else if (a === "--big-endian") args.bigEndian = true;
+    else if (a.startsWith("--encoding=")) args.encoding = a.slice(11);
     else if (a.startsWith("--split=")) args.split = Number(a.slice(8));
     else if (a.startsWith("--messages=")) args.messages = a.slice(11);
     else if (a.startsWith("--expected=")) args.expected = a.slice(11);
     else throw new Error("unknown argument " + a);
   }
   if (!args.out || !["mcap", "sqlite3"].includes(args.format) ||
-      !["none", "lz4", "zstd"].includes(args.compression)) {
+      !["none", "lz4", "zstd"].includes(args.compression) ||
+      !["cdr", "ros1"].includes(args.encoding) || (args.encoding === "ros1" && args.format !== "mcap")) {
     throw new Error("usage: write_ros2_bags.mjs OUT --format=mcap|sqlite3 [options]");
   }
   return args;
@@ -277,6 +305,20 @@ function writeBigEndian(type, m) {
   return w.data;
 }
 
+// ROS 1 serialization of a message given in the ROS 2 form of this script.
+function makeRos1Serializer() {
+  const writers = {};
+  for (const [type, text] of Object.entries(ROS1_DEFINITIONS)) {
+    writers[type] = new Ros1MessageWriter(parse(text));
+  }
+  return (type, msg) => {
+    const m = msg.header === undefined ? msg : { ...msg, header: { seq: 0,
+      stamp: { sec: msg.header.stamp.sec, nsec: msg.header.stamp.nanosec },
+      frame_id: msg.header.frame_id } };
+    return writers[ros1TypeOf(type)].writeMessage(m);
+  };
+}
+
 function makeSerializer(bigEndian) {
   const writers = {};
   for (const [type, text] of Object.entries(DEFINITIONS)) {
@@ -331,16 +373,20 @@ async function writeMcap(args, messages, serialize, onMessage) {
     useMessageIndex: args.summary, repeatSchemas: args.summary, repeatChannels: args.summary,
     useAttachmentIndex: args.summary, useMetadataIndex: args.summary,
   });
-  await writer.start({ profile: "ros2", library: "tiltcal tests/oracle/write_ros2_bags.mjs" });
+  const ros1 = args.encoding === "ros1";
+  await writer.start({ profile: ros1 ? "ros1" : "ros2",
+                       library: "tiltcal tests/oracle/write_ros2_bags.mjs" });
   const channels = new Map();
   const sequences = new Map();
   for await (const m of messages) {
     onMessage(m);
     if (!channels.has(m.topic)) {
+      const name = ros1 ? ros1TypeOf(m.type) : m.type;
       const schemaId = await writer.registerSchema({
-        name: m.type, encoding: "ros2msg", data: new TextEncoder().encode(DEFINITIONS[m.type]) });
+        name, encoding: ros1 ? "ros1msg" : "ros2msg",
+        data: new TextEncoder().encode((ros1 ? ROS1_DEFINITIONS : DEFINITIONS)[name]) });
       channels.set(m.topic, await writer.registerChannel({
-        topic: m.topic, schemaId, messageEncoding: "cdr", metadata: new Map() }));
+        topic: m.topic, schemaId, messageEncoding: ros1 ? "ros1" : "cdr", metadata: new Map() }));
       sequences.set(m.topic, 0);
     }
     const sequence = sequences.get(m.topic);
@@ -430,7 +476,7 @@ async function writeSqlite(args, messages, serialize, onMessage) {
 async function main() {
   const args = parseArgs(process.argv.slice(2));
   const messages = args.messages ? messagesFromJsonl(args.messages) : deterministicMessages();
-  const serialize = makeSerializer(args.bigEndian);
+  const serialize = args.encoding === "ros1" ? makeRos1Serializer() : makeSerializer(args.bigEndian);
   const expected = args.expected ? fs.openSync(args.expected, "w") : null;
   const onMessage = (m) => { if (expected !== null) fs.writeSync(expected, expectedLine(m) + "\n"); };
   if (args.format === "mcap") await writeMcap(args, messages, serialize, onMessage);

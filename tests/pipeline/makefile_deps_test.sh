@@ -178,4 +178,31 @@ expect "MCAP files and ROS 2 bag folders are sequences" "$(planned decode)" \
 "${MAKE[@]}" decode > /dev/null
 sleep_past; touch "$DATA/seq_d/seq_d_1.db3"
 expect "a changed .db3 reruns its folder's sequence only" "$(planned decode)" "tiltcal_decode seq_d;"
+"${MAKE[@]}" decode > /dev/null
+
+# Sequences of several bag files: a sub-folder of bags (split by time, or
+# imu + lidar in any format) is one sequence named after it; a single .db3 is
+# one too. Not sequences: a folder without bags (flat/), a dataset folder
+# (rig.txtpb) with its bags, params/, and out/ (even with a bag in it).
+mkdir -p "$DATA/seq_e" "$DATA/seq_f" "$DATA/other_dataset" "$DATA/out/stray"
+touch "$DATA/seq_e/seq_e_0.bag" "$DATA/seq_e/seq_e_1.bag" "$DATA/seq_e/notes.txt"
+touch "$DATA/seq_f/imu.bag" "$DATA/seq_f/lidar.mcap" "$DATA/seq_g.db3"
+touch "$DATA/other_dataset/rig.txtpb" "$DATA/other_dataset/run.bag" "$DATA/params/x.bag" "$DATA/out/x.bag"
+expect "folders of bag files and .db3 files are sequences" "$(planned decode)" \
+"tiltcal_decode seq_e;tiltcal_decode seq_f;tiltcal_decode seq_g;"
+"${MAKE[@]}" -n decode | grep -q -- "--bag=$DATA/seq_e " || fail "decode not given the folder seq_e"
+"${MAKE[@]}" -n decode | grep -q -- "--bag=$DATA/seq_g.db3 " || fail "decode not given seq_g.db3"
+"${MAKE[@]}" decode > /dev/null
+sleep_past; touch "$DATA/seq_f/lidar.mcap"
+expect "a changed file of a folder of bags reruns that sequence only" "$(planned decode)" "tiltcal_decode seq_f;"
+"${MAKE[@]}" decode > /dev/null
+sleep_past; touch "$DATA/seq_e/seq_e_2.bag"
+expect "a file added to a folder of bags reruns that sequence only" "$(planned decode)" "tiltcal_decode seq_e;"
+touch "$DATA/seq_e.bag"
+if "${MAKE[@]}" -n decode > /dev/null 2> "$WORK/same_name.log"; then
+  fail "seq_e.bag beside the folder seq_e/ was accepted"
+fi
+grep -q "several inputs for the sequence(s) seq_e" "$WORK/same_name.log" ||
+  fail "no error naming seq_e: $(cat "$WORK/same_name.log")"
+echo "ok: a bag file and a folder of one name are an error"
 echo "PASS"

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "bag/mcap/chunk_decompressor.h"
+#include "bag/ros1/messages.h"
 #include "bag/ros2/cdr_reader.h"
 #include "bag/ros2/messages.h"
 #include "tests/bag/ros2/ros2_oracle.h"
@@ -45,7 +46,8 @@ TEST_P(McapOracle, EveryValueReadEqualsWhatTheLibraryWrote) {
   ASSERT_TRUE(status.ok()) << status.message();
   EXPECT_EQ(reader.profile(), "ros2");
   EXPECT_EQ(reader.used_summary(), summary);
-  EXPECT_EQ(reader.salvage_note(), "");  // complete either way
+  EXPECT_EQ(reader.salvage_note(), "");  // complete either way: nothing salvaged
+  EXPECT_EQ(reader.num_salvaged_messages(), 0);
   EXPECT_EQ(reader.TopicNames(),
             (std::vector<std::string>{"/chatter", "/hesai/pandar", "/imu", "/ouster/points",
                                       "/velodyne_points"}));
@@ -63,6 +65,34 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(std::make_tuple("none", true, false), std::make_tuple("lz4", true, false),
                       std::make_tuple("zstd", true, false), std::make_tuple("zstd", false, false),
                       std::make_tuple("lz4", false, true), std::make_tuple("none", false, false)));
+
+// A ROS 1 bag converted to MCAP: profile "ros1", schemas "ros1msg", messages
+// "ros1", written by @mcap/core with @foxglove/rosmsg-serialization.
+TEST(McapReader, Ros1EncodedMessagesReadEqualToWhatTheLibraryWrote) {
+  SKIP_WITHOUT_ORACLE();
+  for (const char* summary : {"", " --no-summary"}) {
+    TempDir dir;
+    const std::string bag = dir.File("bag.mcap");
+    std::string error;
+    ASSERT_TRUE(testing::WriteRos2Bag(
+        bag, std::string("--format=mcap --encoding=ros1 --compression=zstd") + summary,
+        dir.File("expected.txt"), &error))
+        << error;
+    McapReader reader;
+    const Status status = reader.Open(bag);
+    ASSERT_TRUE(status.ok()) << status.message();
+    EXPECT_EQ(reader.profile(), "ros1");
+    EXPECT_EQ(reader.salvage_note(), "");
+    EXPECT_EQ(reader.num_salvaged_messages(), 0);
+    EXPECT_EQ(reader.TopicType("/imu"), ros1::kImuType);
+    EXPECT_EQ(reader.TopicType("/velodyne_points"), ros1::kPointCloud2Type);
+    EXPECT_EQ(reader.TopicType("/chatter"), "std_msgs/String");
+    int count = 0;
+    EXPECT_EQ(testing::CompareWithExpected(&reader, dir.File("expected.txt"), &count), "")
+        << summary;
+    EXPECT_EQ(count, 54);
+  }
+}
 
 TEST(McapReader, TruncatedRecordingIsSalvagedWithANote) {
   SKIP_WITHOUT_ORACLE();

@@ -1,10 +1,12 @@
 #include "tests/bag/ros2/ros2_oracle.h"
 
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 #include <vector>
 
+#include "bag/ros1/messages.h"
 #include "bag/ros2/cdr_reader.h"
 #include "bag/ros2/messages.h"
 #include "tests/testing/test_env.h"
@@ -33,9 +35,11 @@ std::string HeaderText(const std::string& topic, int64_t record_ns, const bag::H
 Status Describe(const bag::Message& m, const std::string& type, std::string* line,
                 std::vector<double>* values) {
   values->clear();
-  if (type == ros2::kImuType) {
+  const bool ros1 = m.encoding == bag::Encoding::kRos1;  // ROS 1 messages in an MCAP
+  if (type == ros2::kImuType || type == ros1::kImuType) {
     bag::ImuMessage imu;
-    TILTCAL_RETURN_IF_ERROR(ros2::DecodeImu(m.data, m.size, &imu));
+    TILTCAL_RETURN_IF_ERROR(ros1 ? ros1::DecodeImu(m.data, m.size, &imu)
+                                 : ros2::DecodeImu(m.data, m.size, &imu));
     *line = "imu " + HeaderText(*m.topic, m.time_ns, imu.header);
     values->insert(values->end(), imu.orientation, imu.orientation + 4);
     values->insert(values->end(), imu.orientation_covariance, imu.orientation_covariance + 9);
@@ -47,9 +51,10 @@ Status Describe(const bag::Message& m, const std::string& type, std::string* lin
                    imu.linear_acceleration_covariance + 9);
     return Status::Ok();
   }
-  if (type == ros2::kPointCloud2Type) {
+  if (type == ros2::kPointCloud2Type || type == ros1::kPointCloud2Type) {
     bag::PointCloud2View c;
-    TILTCAL_RETURN_IF_ERROR(ros2::DecodePointCloud2(m.data, m.size, &c));
+    TILTCAL_RETURN_IF_ERROR(ros1 ? ros1::DecodePointCloud2(m.data, m.size, &c)
+                                 : ros2::DecodePointCloud2(m.data, m.size, &c));
     std::ostringstream out;
     out << "cloud " << HeaderText(*m.topic, m.time_ns, c.header) << " " << c.height << " "
         << c.width << " " << c.is_bigendian << " " << c.point_step << " " << c.row_step << " "
@@ -61,9 +66,18 @@ Status Describe(const bag::Message& m, const std::string& type, std::string* lin
     *line = out.str();
     return Status::Ok();
   }
+  std::string data;
+  if (ros1) {  // std_msgs/String: uint32 length, the bytes
+    uint32_t length = 0;
+    if (m.size < 4) return Status::Error("std_msgs/String shorter than its length");
+    std::memcpy(&length, m.data, 4);
+    if (length != m.size - 4) return Status::Error("std_msgs/String length mismatch");
+    data.assign(reinterpret_cast<const char*>(m.data) + 4, length);
+    *line = "string " + *m.topic + " " + std::to_string(m.time_ns) + " " + data;
+    return Status::Ok();
+  }
   ros2::CdrReader r;
   TILTCAL_RETURN_IF_ERROR(r.Open(m.data, m.size));
-  std::string data;
   TILTCAL_RETURN_IF_ERROR(r.String("data", &data));
   TILTCAL_RETURN_IF_ERROR(r.ExpectEnd("std_msgs/msg/String"));
   *line = "string " + *m.topic + " " + std::to_string(m.time_ns) + " " + data;
@@ -91,7 +105,8 @@ void SplitImuLine(const std::string& line, std::string* text, std::vector<double
 std::string Ros2OracleMissing() {
   const std::string modules = SourceDir() + "/tests/node_modules";
   if (!FileExists(modules + "/@mcap/core/package.json") ||
-      !FileExists(modules + "/better-sqlite3/package.json")) {
+      !FileExists(modules + "/better-sqlite3/package.json") ||
+      !FileExists(modules + "/@foxglove/rosmsg-serialization/package.json")) {
     return "the npm oracles are not installed in " + modules + " (run scripts/setup.sh)";
   }
   if (RunCommand("node --version >/dev/null 2>&1") != 0) return "no node on PATH";

@@ -1,9 +1,11 @@
 // tiltcal_decode on ROS 2 bags as a user runs it: a simulated sequence
-// (tiltcal_simulate writes ROS 1) converted to MCAP and to a rosbag2 sqlite3
-// folder by the reference libraries (tests/oracle/ros1_bag_to_ros2_jsonl.py
-// with python3-rosbag, then write_ros2_bags.mjs) decodes to the very same
-// IMU samples and scans as the ROS 1 bag; bad ROS 2 input gives one error
-// line naming the file, exit 1 and no output.
+// (tiltcal_simulate writes ROS 1) converted to MCAP, to a rosbag2 sqlite3
+// folder and to MCAP with ROS 1 messages by the reference libraries
+// (tests/oracle/ros1_bag_to_ros2_jsonl.py with python3-rosbag, then
+// write_ros2_bags.mjs) decodes to a byte-identical imu.binpb (after the
+// header, whose provenance names the input) and the same scans as the ROS 1
+// bag; bad ROS 2 input gives one error line naming the file, exit 1 and no
+// output.
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
@@ -15,6 +17,7 @@
 #include "common/io/record_stream.h"
 #include "common/io/text_proto.h"
 #include "tests/bag/ros2/ros2_oracle.h"
+#include "tests/testing/stream_bytes.h"
 #include "tests/testing/test_env.h"
 #include "tiltcal/proto/imu.pb.h"
 #include "tiltcal/proto/scan.pb.h"
@@ -86,6 +89,13 @@ TEST(DecodeRos2Bags, SimulatedSequenceDecodesIdenticallyFromRos1McapAndSqlite) {
                                         dir.File("run.jsonl"),
                                     "", &error))
       << error;
+  // A ROS 1 bag as converted to MCAP: ROS 1 messages ("ros1" encoding).
+  ASSERT_TRUE(testing::WriteRos2Bag(dir.File("run_ros1.mcap"),
+                                    "--format=mcap --encoding=ros1 --compression=zstd "
+                                    "--messages=" +
+                                        dir.File("run.jsonl"),
+                                    "", &error))
+      << error;
   // Three .db3 files: the messages are merged across them in time order.
   ASSERT_TRUE(testing::WriteRos2Bag(dir.File("run_ros2"),
                                     "--format=sqlite3 --split=200 --messages=" +
@@ -93,18 +103,24 @@ TEST(DecodeRos2Bags, SimulatedSequenceDecodesIdenticallyFromRos1McapAndSqlite) {
                                     "", &error))
       << error;
 
-  for (const char* name : {"ros1", "mcap", "sqlite3"}) {
-    const std::string bag = std::string(name) == "ros1"   ? dir.File("run.bag")
-                            : std::string(name) == "mcap" ? dir.File("run.mcap")
-                                                          : dir.File("run_ros2");
+  const std::vector<std::pair<std::string, std::string>> inputs = {
+      {"ros1", dir.File("run.bag")},
+      {"mcap", dir.File("run.mcap")},
+      {"sqlite3", dir.File("run_ros2")},
+      {"mcap_ros1", dir.File("run_ros1.mcap")}};
+  for (const auto& [name, bag] : inputs) {
     ASSERT_EQ(Decode(dir, bag, name, &output), 0) << name << ": " << output;
   }
   const auto imu = Records<proto::ImuSample>(dir.File("out_ros1/imu.binpb"));
   const auto scans = Records<proto::Scan>(dir.File("out_ros1/scans.binpb.lz4"));
   ASSERT_GT(imu.size(), 300u);
   ASSERT_GT(scans.size(), 15u);
-  for (const char* name : {"mcap", "sqlite3"}) {
+  const std::string imu_bytes = testing::StreamBytesAfterHeader(dir.File("out_ros1/imu.binpb"));
+  ASSERT_GT(imu_bytes.size(), 10000u);
+  for (const char* name : {"mcap", "sqlite3", "mcap_ros1"}) {
     const std::string out = dir.File(std::string("out_") + name);
+    EXPECT_TRUE(testing::StreamBytesAfterHeader(out + "/imu.binpb") == imu_bytes)
+        << name << ": imu.binpb is not byte-identical to the ROS 1 bag's";
     EXPECT_TRUE(Records<proto::ImuSample>(out + "/imu.binpb") == imu) << name;
     EXPECT_TRUE(Records<proto::Scan>(out + "/scans.binpb.lz4") == scans) << name;
   }
