@@ -41,7 +41,7 @@ NormalEquations Linearise(const std::vector<Eigen::Vector3d>& source, const Voxe
     for (int i = 0; i < n; ++i) {
       const Eigen::Vector3d p_map = pose * source[static_cast<size_t>(i)];
       if (!map.FindNearestOnPlane(p_map, options.max_correspondence_m, &neighbour)) continue;
-      const double r = PointToPlaneResidual(p_map, neighbour.point, neighbour.normal, &j);
+      const double r = PointToPlaneResidual(p_map, neighbour.centroid, neighbour.normal, &j);
       const double r_sq = r * r;
       const double w = (s_sq / (s_sq + r_sq)) * (s_sq / (s_sq + r_sq));
       local.jtj.noalias() += w * j.transpose() * j;

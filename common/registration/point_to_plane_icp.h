@@ -4,9 +4,12 @@
 // Point-to-plane ICP of a point set against a VoxelHashMap.
 //
 // Pose T = (R, t) = map_from_source. A source point p moved to the map,
-// p' = R p + t, pairs with its nearest map point q (within the gate) whose
-// voxel has a plane of unit normal n; the residual is
-//   r = n . (p' - q)   (m).
+// p' = R p + t, pairs with its nearest map point (within the gate) whose
+// voxel has a plane of unit normal n through the centroid c of the voxel's
+// points; the residual is
+//   r = n . (p' - c)   (m),
+// the distance to that plane (the mean of up to max_points_per_voxel points
+// carries less range noise than the nearest point alone).
 // The update is a left (map-frame) perturbation delta = (dt, dphi):
 //   T <- (Exp(dphi), dt) * T,   i.e. p' <- Exp(dphi) p' + dt,
 // so dr/d(dt) = n^T and dr/d(dphi) = (p' x n)^T at delta = 0.

@@ -39,6 +39,7 @@ void VoxelHashMap::FitPlane(Voxel* voxel) const {
   if (thickness_m > options_.max_plane_thickness_m) return;
   if (plane.eigenvalues(1) < options_.min_plane_spread_ratio * plane.eigenvalues(2)) return;
   voxel->normal = plane.normal;
+  voxel->centroid = plane.centroid;
   voxel->has_plane = true;
 }
 
@@ -106,6 +107,7 @@ bool VoxelHashMap::FindNearestOnPlane(const Eigen::Vector3d& p, double max_dista
   if (best_voxel == nullptr) return false;
   neighbour->point = *best_point;
   neighbour->normal = best_voxel->normal;
+  neighbour->centroid = best_voxel->centroid;
   neighbour->distance_m = std::sqrt(best_sq);
   return true;
 }

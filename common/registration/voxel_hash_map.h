@@ -33,9 +33,10 @@ struct VoxelHashMapOptions {
 
 // The nearest map point to a query and the plane of its voxel.
 struct PlaneNeighbour {
-  Eigen::Vector3d point = Eigen::Vector3d::Zero();   // nearest map point q
-  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ(); // unit normal of q's voxel plane
-  double distance_m = 0.0;                           // |p - q|
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();     // nearest map point q
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();   // unit normal of q's voxel plane
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  // mean of that voxel's points
+  double distance_m = 0.0;                             // |p - q|
 };
 
 // Integer voxel coordinates of p: floor(p / voxel_m) per axis.
@@ -76,6 +77,7 @@ class VoxelHashMap {
     std::vector<Eigen::Vector3d> points;
     bool has_plane = false;
     Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   };
   void FitPlane(Voxel* voxel) const;
 

@@ -35,6 +35,8 @@ TEST(VoxelHashMapTest, CapsPointsPerVoxelAndFitsThinPlanes) {
   ASSERT_TRUE(map.FindNearestOnPlane({0.06, 0.06, 0.7}, 0.5, &n));
   EXPECT_NEAR(std::abs(n.normal.z()), 1.0, 1e-9);
   EXPECT_EQ(n.point, floor[0]);
+  // The plane passes through the mean of the four kept points.
+  EXPECT_TRUE(n.centroid.isApprox(Eigen::Vector3d(0.3, 0.3, 0.5), 1e-12));
   EXPECT_NEAR(n.distance_m, (floor[0] - Eigen::Vector3d(0.06, 0.06, 0.7)).norm(), 1e-12);
   // From the voxel above: beyond a 0.5 m gate, within a 1 m one; two voxels
   // up, found with a gate that reaches that far.
