@@ -11,6 +11,24 @@ namespace {
 
 // No chunk of a sane recording is this large; refuse before allocating.
 constexpr uint64_t kMaxChunkBytes = uint64_t{4} << 30;
+// The most output one input byte can give: an LZ4 sequence adds at most 255
+// bytes of match per length byte; a zstd block of at most 128 KiB takes at
+// least 4 bytes (3 of header, 1 of an RLE block). A chunk that declares more
+// cannot be valid, and is refused before its declared size is allocated.
+constexpr uint64_t kLz4MaxRatio = 256;
+constexpr uint64_t kZstdMaxRatio = 32768;
+
+// An error when `compressed` bytes of `codec` cannot hold `uncompressed`.
+Status CheckRatio(const char* codec, uint64_t compressed, uint64_t uncompressed,
+                  uint64_t max_ratio) {
+  if (uncompressed / max_ratio > compressed) {
+    return Status::Error(std::string(codec) + " chunk of " + std::to_string(compressed) +
+                         " bytes cannot decompress to the " + std::to_string(uncompressed) +
+                         " bytes it declares (at most " + std::to_string(max_ratio) +
+                         " bytes per compressed byte)");
+  }
+  return Status::Ok();
+}
 
 }  // namespace
 
@@ -30,17 +48,35 @@ Status ChunkDecompressor::Decompress(const ChunkRecord& chunk, std::vector<uint8
     return Status::Error("unknown chunk compression '" + chunk.compression +
                          "' (known: none, lz4, zstd)");
   }
-  out->resize(chunk.uncompressed_size);
+  // Declared sizes are checked against the compressed bytes before the
+  // output is allocated.
   if (chunk.compression.empty()) {
     if (chunk.records_size != chunk.uncompressed_size) {
       return Status::Error("uncompressed chunk of " + std::to_string(chunk.records_size) +
                            " bytes says uncompressed_size " +
                            std::to_string(chunk.uncompressed_size));
     }
+    out->resize(chunk.uncompressed_size);
     if (chunk.records_size > 0) std::memcpy(out->data(), chunk.records, chunk.records_size);
   } else if (chunk.compression == "lz4") {
+    TILTCAL_RETURN_IF_ERROR(
+        CheckRatio("lz4", chunk.records_size, chunk.uncompressed_size, kLz4MaxRatio));
+    out->resize(chunk.uncompressed_size);
     TILTCAL_RETURN_IF_ERROR(Lz4(chunk, out->data()));
   } else {
+    TILTCAL_RETURN_IF_ERROR(
+        CheckRatio("zstd", chunk.records_size, chunk.uncompressed_size, kZstdMaxRatio));
+    const unsigned long long declared =
+        ZSTD_getFrameContentSize(chunk.records, chunk.records_size);
+    if (declared != ZSTD_CONTENTSIZE_UNKNOWN && declared != chunk.uncompressed_size) {
+      return Status::Error(
+          "zstd chunk's frame " +
+          (declared == ZSTD_CONTENTSIZE_ERROR ? std::string("header does not parse")
+                                              : "declares " + std::to_string(declared) +
+                                                    " bytes") +
+          ", the chunk says " + std::to_string(chunk.uncompressed_size));
+    }
+    out->resize(chunk.uncompressed_size);
     TILTCAL_RETURN_IF_ERROR(Zstd(chunk, out->data()));
   }
   if (chunk.uncompressed_crc != 0) {

@@ -4,8 +4,11 @@
 // The records of an MCAP chunk, decompressed: compression "" (stored), "lz4"
 // (one LZ4 frame, liblz4; its own content checksum is skipped) or "zstd" (one
 // zstd frame, libzstd). The result must be exactly the chunk's
-// uncompressed_size, and match its uncompressed_crc when that is not 0. Errors say what differed (the caller
-// adds file and chunk offset).
+// uncompressed_size, and match its uncompressed_crc when that is not 0.
+// A declared size the compressed bytes cannot produce (beyond 256 bytes per
+// byte for lz4, 32768 for zstd, or not the zstd frame's own content size)
+// is refused before anything is allocated. Errors say what differed (the
+// caller adds file and chunk offset).
 
 #include <cstddef>
 #include <cstdint>
