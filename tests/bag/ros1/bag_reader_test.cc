@@ -4,6 +4,8 @@
 // indexes, eviction from a one-chunk cache, truncation and byte flips.
 #include "bag/ros1/bag_reader.h"
 
+#include <sys/resource.h>
+
 #include <cstdio>
 #include <fstream>
 #include <map>
@@ -39,6 +41,8 @@ struct BagOptions {
   // recorder leaves it; "none" keeps its records after the header, any other
   // compression keeps only a 7-byte frame start.
   std::string open_last_chunk_compression;
+  // Non-zero: the size the chunk records declare instead of their true one.
+  uint32_t declared_chunk_size = 0;
 };
 
 std::string Time(int64_t ns) {
@@ -94,8 +98,11 @@ std::string BuildBag(const std::vector<Conn>& conns, const std::vector<std::vect
       body += compression == "none" ? data : std::string("\x04\x22\x4d\x18\x64\x60\x85", 7);
       break;
     }
+    const uint32_t size = options.declared_chunk_size != 0
+                              ? options.declared_chunk_size
+                              : static_cast<uint32_t>(data.size());
     AppendRecord(&body, {{"op", OpValue(Op::kChunk)}, {"compression", options.compression},
-                         {"size", U32Value(static_cast<uint32_t>(data.size()))}},
+                         {"size", U32Value(size)}},
                  data);
     for (const auto& [conn, entries] : index) {
       uint32_t count = static_cast<uint32_t>(entries.size() / kIndexEntrySize);
@@ -324,6 +331,44 @@ TEST_F(BagReaderTest, IndexInconsistenciesAreErrors) {
     ASSERT_FALSE(status.ok());
     EXPECT_NE(status.message().find("unsupported chunk compression 'zstd'"), std::string::npos)
         << status.message();
+  }
+}
+
+// Peak resident memory of this process so far, MB.
+double PeakRssMb() {
+  struct rusage usage {};
+  getrusage(RUSAGE_SELF, &usage);
+  return usage.ru_maxrss / 1024.0;
+}
+
+// A chunk that declares 200 MB in a file of a few hundred bytes is refused,
+// indexed or scanned, before the 200 MB are allocated.
+TEST_F(BagReaderTest, ChunkSizeBeyondItsDataIsRefusedBeforeAllocating) {
+  for (const char* compression : {"none", "lz4"}) {
+    for (bool indexed : {true, false}) {
+      SCOPED_TRACE(std::string(compression) + (indexed ? " indexed" : " scanned"));
+      BagOptions options;
+      options.compression = compression;
+      options.indexed = indexed;
+      options.declared_chunk_size = 200000000;
+      const std::string path = Write(BuildBag(kTwoImuConns, {{{1, 1000, "a"}}}, options));
+      const double rss_before_mb = PeakRssMb();
+      BagReader reader;
+      Status status = reader.Open(path);
+      std::string message = status.message();
+      if (status.ok()) {  // the scan stops at the chunk and says why
+        EXPECT_FALSE(indexed);
+        message = reader.salvage_note();
+        std::vector<Seen> seen;
+        EXPECT_TRUE(ReadAll(&reader, &seen).ok());
+        EXPECT_TRUE(seen.empty());
+      }
+      EXPECT_NE(message.find("200000000"), std::string::npos) << message;
+      EXPECT_NE(message.find(std::string(compression) == "none" ? "data bytes" : "cannot decompress"),
+                std::string::npos)
+          << message;
+      EXPECT_LT(PeakRssMb() - rss_before_mb, 100.0);
+    }
   }
 }
 
