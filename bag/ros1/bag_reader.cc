@@ -609,12 +609,15 @@ Status BagReader::SalvageChunk(uint64_t pos, const RecordHeader& header, uint64_
     *stop = true;  // its records run to the end of the file
     return SalvageOpenChunk(chunk_index);
   }
-  std::vector<uint8_t> records(std::max<uint32_t>(chunk.size, 1));
+  // Not zero-filled: only the pages the decompressor writes are touched, so
+  // a bz2 chunk that declares more than it holds costs what it holds.
+  ByteBuffer records;
+  uint8_t* dst = records.Reserve(std::max<size_t>(chunk.size, 1));
   std::vector<uint8_t> compressed;
   size_t end = 0;
-  status = LoadChunk(chunk_index, &compressed, records.data());
+  status = LoadChunk(chunk_index, &compressed, dst);
   if (status.ok()) {
-    status = IndexChunkRecords(records.data(), chunk.size, chunk_index, /*open=*/false, &end);
+    status = IndexChunkRecords(dst, chunk.size, chunk_index, /*open=*/false, &end);
   }
   if (!status.ok()) {
     salvage_note_ = "stopped at the damaged chunk at byte " + std::to_string(pos) + ": " +
