@@ -1,5 +1,5 @@
 // libFuzzer harness: any bytes as a rosbag2 .db3 file (libsqlite3 opens it
-// read-only and immutable). Opens it (topics, counts, time range), reads
+// read-only and immutable; a named file in /dev/shm, fuzz_input_file.h). Opens it (topics, counts, time range), reads
 // every message in record-time order and decodes the IMU and PointCloud2
 // messages. Every outcome must be a Status, never a crash or a sanitizer
 // report in the reader.
@@ -11,7 +11,7 @@
 #include "fuzz/fuzz_input_file.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  tiltcal::fuzz::FuzzInputFile file(data, size);
+  tiltcal::fuzz::FuzzInputNamedFile file(data, size, ".db3");
   if (!file.ok()) return 0;
   tiltcal::ros2::SqliteBagReader reader;
   if (!reader.Open(file.path()).ok()) return 0;
