@@ -124,7 +124,7 @@ struct State {
 
 State RandomState(std::mt19937* rng, double dt) {
   std::normal_distribution<double> n(0.0, 1.0);
-  auto v = [&](double s) { return s * tiltcal::testing::RandomVector3(n, *rng); };
+  auto v = [&](double s) { return Eigen::Vector3d(s * tiltcal::testing::RandomVector3(n, *rng)); };
   State s;
   s.q[0] = ExpQuaternion(v(1.0));
   // Angular rates ~ 1-3 rad/s whatever dt.
