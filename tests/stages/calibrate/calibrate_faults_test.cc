@@ -17,6 +17,7 @@
 #include "common/io/eigen_proto.h"
 #include "common/io/record_stream.h"
 #include "common/io/text_proto.h"
+#include "tiltcal/proto/imu.pb.h"
 #include "tests/stages/calibrate/short_sequence_fixture.h"
 
 namespace tiltcal::calibrate {
