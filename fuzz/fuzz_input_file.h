@@ -3,10 +3,14 @@
 
 // The readers under test take a path: each input is written to an anonymous
 // in-memory file (memfd) and read back through /proc/self/fd/N, so fuzzing
-// touches no disk.
+// touches no disk. libsqlite3 resolves symbolic links before it opens a
+// file, which /proc/self/fd/N of a memfd defeats; FuzzInputNamedFile writes
+// the input to a named file in /dev/shm (memory as well) instead.
 
 #include <sys/mman.h>
 #include <unistd.h>
+
+#include <cstdio>
 
 #include <cstddef>
 #include <cstdint>
@@ -35,6 +39,27 @@ class FuzzInputFile {
 
  private:
   int fd_;
+};
+
+// The input as /dev/shm/tiltcal_fuzz_<pid><suffix>, removed by the destructor.
+class FuzzInputNamedFile {
+ public:
+  FuzzInputNamedFile(const uint8_t* data, size_t size, const std::string& suffix)
+      : path_("/dev/shm/tiltcal_fuzz_" + std::to_string(::getpid()) + suffix) {
+    std::FILE* f = std::fopen(path_.c_str(), "wb");
+    ok_ = f != nullptr && std::fwrite(data, 1, size, f) == size;
+    if (f != nullptr && std::fclose(f) != 0) ok_ = false;
+  }
+  ~FuzzInputNamedFile() { std::remove(path_.c_str()); }
+  FuzzInputNamedFile(const FuzzInputNamedFile&) = delete;
+  FuzzInputNamedFile& operator=(const FuzzInputNamedFile&) = delete;
+
+  bool ok() const { return ok_; }
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+  bool ok_ = false;
 };
 
 }  // namespace tiltcal::fuzz

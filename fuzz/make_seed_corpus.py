@@ -1,14 +1,19 @@
 #!/usr/bin/python3
 """Writes the fuzzers' seed corpus (fuzz/corpus/<harness>/): small valid
 inputs of each parser, from which libFuzzer mutates. Run with Debian's
-/usr/bin/python3 (python3-rosbag) and the lz4 command; the output is
-committed, so this runs only when a seed is added.
+/usr/bin/python3 (python3-rosbag), the lz4 command and node (the ROS 2
+bags come from the reference libraries, tests/oracle/write_ros2_bags.mjs);
+the output is committed, so this runs only when a seed is added.
     fuzz/make_seed_corpus.py"""
+import base64
 import io
+import json
 import os
 import shutil
+import sqlite3
 import struct
 import subprocess
+import tempfile
 
 import rosbag
 import rospy
@@ -17,6 +22,10 @@ from sensor_msgs.msg import Imu, PointCloud2, PointField
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 CORPUS = os.path.join(HERE, 'corpus')
+ROS2_WRITER = os.path.join(ROOT, 'tests', 'oracle', 'write_ros2_bags.mjs')
+ROS2_FIXTURES = os.path.join(ROOT, '..', 'shared', 'fixtures', 'bags', 'ros2')
+HARNESSES = ('ros1_bag_reader', 'record_stream', 'text_proto', 'point_cloud2', 'cdr_messages',
+             'mcap_reader', 'sqlite_bag_reader', 'rosbag2_metadata')
 
 
 def varint(n):
@@ -130,9 +139,88 @@ def serialized(msg):
     return buffer.getvalue()
 
 
+def ros2_messages():
+    """Four IMU messages and one small cloud (3 points, Velodyne layout) as
+    the JSON lines write_ros2_bags.mjs reads."""
+    lines = []
+    for i in range(4):
+        stamp = {'sec': 1700000000, 'nanosec': i * 5000000}
+        lines.append({'topic': '/imu', 'type': 'sensor_msgs/msg/Imu',
+                      'record_ns': str(1700000000 * 10**9 + i * 5000000),
+                      'msg': {'header': {'stamp': stamp, 'frame_id': 'imu_link'},
+                              'orientation': {'x': 0.0, 'y': 0.0, 'z': 0.0, 'w': 1.0},
+                              'orientation_covariance': [0.0] * 9,
+                              'angular_velocity': {'x': 0.01 * i, 'y': 0.0, 'z': -0.02},
+                              'angular_velocity_covariance': [0.0] * 9,
+                              'linear_acceleration': {'x': 0.1, 'y': -0.2, 'z': 9.81},
+                              'linear_acceleration_covariance': [0.0] * 9}})
+    fields = [('x', 0, 7), ('y', 4, 7), ('z', 8, 7), ('intensity', 12, 7), ('ring', 16, 4),
+              ('time', 18, 7)]
+    data = b''.join(struct.pack('<ffffHf', 1.0 + i, 2.0, -0.5, 3.0, i, 0.001 * i)
+                    for i in range(3))
+    lines.insert(2, {'topic': '/points', 'type': 'sensor_msgs/msg/PointCloud2',
+                     'record_ns': str(1700000000 * 10**9 + 7000000),
+                     'msg': {'header': {'stamp': {'sec': 1700000000, 'nanosec': 7000000},
+                                        'frame_id': 'lidar'},
+                             'height': 1, 'width': 3,
+                             'fields': [{'name': n, 'offset': o, 'datatype': d, 'count': 1}
+                                        for n, o, d in fields],
+                             'is_bigendian': False, 'point_step': 22, 'row_step': 66,
+                             'data_b64': base64.b64encode(data).decode(), 'is_dense': True}})
+    return ''.join(json.dumps(line) + '\n' for line in lines)
+
+
+def write_ros2_seeds():
+    """MCAP files (stored, lz4, zstd; with and without summary), a rosbag2
+    sqlite3 bag, its metadata.yaml and CDR messages (little and big endian),
+    written by the reference libraries; the ROS 2 fixtures when present."""
+    with tempfile.TemporaryDirectory() as tmp:
+        jsonl = os.path.join(tmp, 'messages.jsonl')
+        open(jsonl, 'w').write(ros2_messages())
+        mcaps = os.path.join(CORPUS, 'mcap_reader')
+        for name, options in (('stored', ['--compression=none']),
+                              ('lz4', ['--compression=lz4']),
+                              ('zstd', ['--compression=zstd']),
+                              ('lz4_no_summary', ['--compression=lz4', '--no-summary']),
+                              ('big_endian', ['--compression=none', '--big-endian'])):
+            subprocess.run(['node', ROS2_WRITER, os.path.join(mcaps, name + '.mcap'),
+                            '--format=mcap', '--messages=' + jsonl] + options, check=True)
+        for endian, options in (('le', []), ('be', ['--big-endian'])):
+            folder = os.path.join(tmp, 'sqlite_' + endian)
+            subprocess.run(['node', ROS2_WRITER, folder, '--format=sqlite3',
+                            '--messages=' + jsonl] + options, check=True)
+            db3 = os.path.join(folder, 'sqlite_%s_0.db3' % endian)
+            if endian == 'le':
+                shutil.copy(db3, os.path.join(CORPUS, 'sqlite_bag_reader', 'oracle.db3'))
+                shutil.copy(os.path.join(folder, 'metadata.yaml'),
+                            os.path.join(CORPUS, 'rosbag2_metadata', 'oracle.yaml'))
+            with sqlite3.connect(db3) as db:
+                rows = db.execute('SELECT m.id, t.type, m.data FROM messages m JOIN topics t '
+                                  'ON m.topic_id = t.id ORDER BY m.id').fetchall()
+            kept = set()
+            for row_id, msg_type, data in rows:
+                kind = msg_type.rsplit('/', 1)[-1]
+                if kind in kept:
+                    continue
+                kept.add(kind)
+                open(os.path.join(CORPUS, 'cdr_messages', '%s_%s.cdr' % (kind.lower(), endian)),
+                     'wb').write(data)
+    open(os.path.join(CORPUS, 'rosbag2_metadata', 'flow_list.yaml'), 'w').write(
+        'rosbag2_bagfile_information:\n  version: 5\n  storage_identifier: sqlite3\n'
+        '  relative_file_paths: [a_0.db3, "a_1.db3", \'a_2.db3\']\n'
+        '  compression_format: ""\n  compression_mode: ""\n')
+    fixtures = {'mcap_reader': ('mcap_talker', 'talker.mcap'),
+                'sqlite_bag_reader': ('sqlite3_talker', 'talker.db3'),
+                'rosbag2_metadata': ('sqlite3_talker', 'metadata.yaml')}
+    for harness, (folder, name) in fixtures.items():
+        path = os.path.join(ROS2_FIXTURES, folder, name)
+        if os.path.exists(path):
+            shutil.copyfile(path, os.path.join(CORPUS, harness, 'fixture_' + name))
+
+
 def main():
     shutil.rmtree(CORPUS, ignore_errors=True)
-    for harness in ('ros1_bag_reader', 'record_stream', 'text_proto', 'point_cloud2'):
+    for harness in HARNESSES:
         os.makedirs(os.path.join(CORPUS, harness))
     bags = os.path.join(CORPUS, 'ros1_bag_reader')
     for compression, layout in (('none', 'velodyne'), ('bz2', 'ouster'), ('lz4', 'hesai')):
@@ -160,6 +248,8 @@ def main():
     for layout in ('velodyne', 'ouster', 'hesai'):
         open(os.path.join(clouds, layout + '.msg'), 'wb').write(
             serialized(cloud(layout, rospy.Time(1700000000, 0))))
+
+    write_ros2_seeds()
 
 
 if __name__ == '__main__':

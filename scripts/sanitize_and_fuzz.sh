@@ -11,13 +11,11 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 BUILD_DIR=${SANITIZE_BUILD_DIR:-build-sanitize}
 FUZZ_SECONDS=${FUZZ_SECONDS:-10}
-FUZZERS=(ros1_bag_reader_fuzzer record_stream_fuzzer text_proto_fuzzer point_cloud2_fuzzer)
-# decode_bags_test is not among them: its expected numbers come from the
-# synthetic IMU noise of tests/common/imu/synthetic_imu.h, which draws three
-# normals in one expression, an argument order gcc and clang evaluate
-# differently (the values differ in the third decimal under clang).
+FUZZERS=(ros1_bag_reader_fuzzer record_stream_fuzzer text_proto_fuzzer point_cloud2_fuzzer
+         cdr_messages_fuzzer mcap_reader_fuzzer sqlite_bag_reader_fuzzer
+         rosbag2_metadata_fuzzer)
 TESTS=(io_test checked_conversion_test imu_test ros1_unit_test ros1_bags_test
-       decode_unit_test)
+       mcap_unit_test ros2_unit_test decode_unit_test decode_bags_test)
 
 if [ ! -f "$BUILD_DIR/build.ninja" ]; then
   # -O1 and line tables only: half the compile time of -O2 -g, still

@@ -1,6 +1,8 @@
 #include "bag/mcap/chunk_decompressor.h"
 
 #include <lz4frame.h>
+// ZSTD_decompressBound (libzstd >= 1.4.0; exported by the shared library).
+#define ZSTD_STATIC_LINKING_ONLY
 #include <zstd.h>
 
 #include <cstring>
@@ -11,6 +13,24 @@ namespace {
 
 // No chunk of a sane recording is this large; refuse before allocating.
 constexpr uint64_t kMaxChunkBytes = uint64_t{4} << 30;
+// The most output one input byte can give: an LZ4 sequence adds at most 255
+// bytes of match per length byte; a zstd block of at most 128 KiB takes at
+// least 4 bytes (3 of header, 1 of an RLE block). A chunk that declares more
+// cannot be valid, and is refused before its declared size is allocated.
+constexpr uint64_t kLz4MaxRatio = 256;
+constexpr uint64_t kZstdMaxRatio = 32768;
+
+// An error when `compressed` bytes of `codec` cannot hold `uncompressed`.
+Status CheckRatio(const char* codec, uint64_t compressed, uint64_t uncompressed,
+                  uint64_t max_ratio) {
+  if (uncompressed / max_ratio > compressed) {
+    return Status::Error(std::string(codec) + " chunk of " + std::to_string(compressed) +
+                         " bytes cannot decompress to the " + std::to_string(uncompressed) +
+                         " bytes it declares (at most " + std::to_string(max_ratio) +
+                         " bytes per compressed byte)");
+  }
+  return Status::Ok();
+}
 
 }  // namespace
 
@@ -30,17 +50,45 @@ Status ChunkDecompressor::Decompress(const ChunkRecord& chunk, std::vector<uint8
     return Status::Error("unknown chunk compression '" + chunk.compression +
                          "' (known: none, lz4, zstd)");
   }
-  out->resize(chunk.uncompressed_size);
+  // Declared sizes are checked against the compressed bytes before the
+  // output is allocated.
   if (chunk.compression.empty()) {
     if (chunk.records_size != chunk.uncompressed_size) {
       return Status::Error("uncompressed chunk of " + std::to_string(chunk.records_size) +
                            " bytes says uncompressed_size " +
                            std::to_string(chunk.uncompressed_size));
     }
+    out->resize(chunk.uncompressed_size);
     if (chunk.records_size > 0) std::memcpy(out->data(), chunk.records, chunk.records_size);
   } else if (chunk.compression == "lz4") {
+    TILTCAL_RETURN_IF_ERROR(
+        CheckRatio("lz4", chunk.records_size, chunk.uncompressed_size, kLz4MaxRatio));
+    TILTCAL_RETURN_IF_ERROR(CheckLz4ContentSize(chunk));
+    out->resize(chunk.uncompressed_size);
     TILTCAL_RETURN_IF_ERROR(Lz4(chunk, out->data()));
   } else {
+    TILTCAL_RETURN_IF_ERROR(
+        CheckRatio("zstd", chunk.records_size, chunk.uncompressed_size, kZstdMaxRatio));
+    // The frame's own content size when it has one, else its blocks times
+    // their maximum size (ZSTD_decompressBound), must allow the chunk's.
+    const unsigned long long declared =
+        ZSTD_getFrameContentSize(chunk.records, chunk.records_size);
+    if (declared == ZSTD_CONTENTSIZE_ERROR) {
+      return Status::Error("zstd chunk's frame header does not parse");
+    }
+    if (declared != ZSTD_CONTENTSIZE_UNKNOWN && declared != chunk.uncompressed_size) {
+      return Status::Error("zstd chunk's frame declares " + std::to_string(declared) +
+                           " bytes, the chunk says " + std::to_string(chunk.uncompressed_size));
+    }
+    const unsigned long long bound = ZSTD_decompressBound(chunk.records, chunk.records_size);
+    if (bound == ZSTD_CONTENTSIZE_ERROR || bound < chunk.uncompressed_size) {
+      return Status::Error("zstd chunk's frames " +
+                           (bound == ZSTD_CONTENTSIZE_ERROR
+                                ? std::string("do not parse")
+                                : "hold at most " + std::to_string(bound) + " bytes") +
+                           ", the chunk says " + std::to_string(chunk.uncompressed_size));
+    }
+    out->resize(chunk.uncompressed_size);
     TILTCAL_RETURN_IF_ERROR(Zstd(chunk, out->data()));
   }
   if (chunk.uncompressed_crc != 0) {
@@ -53,12 +101,33 @@ Status ChunkDecompressor::Decompress(const ChunkRecord& chunk, std::vector<uint8
   return Status::Ok();
 }
 
-Status ChunkDecompressor::Lz4(const ChunkRecord& chunk, uint8_t* dst) {
+Status ChunkDecompressor::Lz4Context() {
   if (lz4_ == nullptr) {
     const size_t rc = LZ4F_createDecompressionContext(&lz4_, LZ4F_VERSION);
     if (LZ4F_isError(rc)) return Status::Error("lz4: cannot create a decompression context");
   }
   LZ4F_resetDecompressionContext(lz4_);
+  return Status::Ok();
+}
+
+Status ChunkDecompressor::CheckLz4ContentSize(const ChunkRecord& chunk) {
+  TILTCAL_RETURN_IF_ERROR(Lz4Context());
+  LZ4F_frameInfo_t info = {};
+  size_t header_bytes = static_cast<size_t>(chunk.records_size);
+  const size_t rc = LZ4F_getFrameInfo(lz4_, &info, chunk.records, &header_bytes);
+  if (LZ4F_isError(rc)) {
+    return Status::Error(std::string("lz4 chunk's frame header does not parse: ") +
+                         LZ4F_getErrorName(rc));
+  }
+  if (info.contentSize != 0 && info.contentSize != chunk.uncompressed_size) {
+    return Status::Error("lz4 chunk's frame declares " + std::to_string(info.contentSize) +
+                         " bytes, the chunk says " + std::to_string(chunk.uncompressed_size));
+  }
+  return Status::Ok();
+}
+
+Status ChunkDecompressor::Lz4(const ChunkRecord& chunk, uint8_t* dst) {
+  TILTCAL_RETURN_IF_ERROR(Lz4Context());
   size_t src_used = static_cast<size_t>(chunk.records_size);
   size_t dst_used = static_cast<size_t>(chunk.uncompressed_size);
   // The frame's own content checksum is not verified: the chunk's CRC-32 of

@@ -4,8 +4,12 @@
 // The records of an MCAP chunk, decompressed: compression "" (stored), "lz4"
 // (one LZ4 frame, liblz4; its own content checksum is skipped) or "zstd" (one
 // zstd frame, libzstd). The result must be exactly the chunk's
-// uncompressed_size, and match its uncompressed_crc when that is not 0. Errors say what differed (the caller
-// adds file and chunk offset).
+// uncompressed_size, and match its uncompressed_crc when that is not 0.
+// A declared size the compressed bytes cannot produce is refused before
+// anything is allocated: beyond 256 bytes per byte for lz4 or 32768 for
+// zstd, not the frame's own content size when it has one, or beyond the
+// zstd frame's blocks times their maximum size. Errors say what differed (the
+// caller adds file and chunk offset).
 
 #include <cstddef>
 #include <cstdint>
@@ -31,6 +35,10 @@ class ChunkDecompressor {
   Status Decompress(const ChunkRecord& chunk, std::vector<uint8_t>* out);
 
  private:
+  // The reset lz4 context (created on first use).
+  Status Lz4Context();
+  // The frame's content size, when its header has one, must be the chunk's.
+  Status CheckLz4ContentSize(const ChunkRecord& chunk);
   Status Lz4(const ChunkRecord& chunk, uint8_t* dst);
   Status Zstd(const ChunkRecord& chunk, uint8_t* dst);
 

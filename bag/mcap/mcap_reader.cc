@@ -401,7 +401,10 @@ Status McapReader::ReadMessages(const bag::MessageSelection& selection,
       record.resize(kRecordPrefixBytes + kMessageFixedBytes);
       TILTCAL_RETURN_IF_ERROR(ReadAt(e->offset, kRecordPrefixBytes, record.data()));
       const uint64_t length = LoadU64(record.data() + 1);
-      if (length > kMaxRecordBytes) return Error(where, "message record too large");
+      if (length > kMaxRecordBytes || length > file_size_ - e->offset - kRecordPrefixBytes) {
+        return Error(where, "Message record of " + std::to_string(length) +
+                                " bytes runs past the end of the file");
+      }
       record.resize(kRecordPrefixBytes + length);
       TILTCAL_RETURN_IF_ERROR(ReadAt(e->offset, record.size(), record.data()));
       data = record.data();

@@ -39,6 +39,7 @@ namespace {
 // one message, so a few hundred MB for a huge message at most).
 constexpr uint32_t kMaxHeaderBytes = 1 << 20;
 constexpr uint32_t kMaxChunkBytes = 1u << 30;
+constexpr uint32_t kLz4MaxRatio = 256;
 
 // A growable byte buffer that does not zero-fill.
 class ByteBuffer {
@@ -73,7 +74,12 @@ Status RequireOp(const RecordHeader& header, Op expected, const std::string& wha
 
 }  // namespace
 
-// Reads the fields of a chunk record header: compression and uncompressed size.
+// Reads the fields of a chunk record header: compression and uncompressed
+// size. The size is checked against the chunk's data bytes (chunk->data_len,
+// which fit in the file) before anything is allocated for it: equal for an
+// uncompressed chunk, at most 256 times for lz4 (an LZ4 sequence adds at
+// most 255 bytes of match per length byte); bz2, whose runs compress far
+// more, is held to the 1 GiB maximum only.
 Status BagReader::ParseChunkHeader(const RecordHeader& header, Chunk* chunk) {
   std::string compression;
   TILTCAL_RETURN_IF_ERROR(header.GetString("compression", &compression));
@@ -85,6 +91,17 @@ Status BagReader::ParseChunkHeader(const RecordHeader& header, Chunk* chunk) {
   if (chunk->size > kMaxChunkBytes) {
     return Status::Error("implausible uncompressed size " + std::to_string(chunk->size) +
                          " (> 1 GiB; corrupt bag?)");
+  }
+  if (chunk->compression == ChunkCompression::kNone && chunk->size != chunk->data_len) {
+    return Status::Error("uncompressed chunk of size " + std::to_string(chunk->size) +
+                         " has " + std::to_string(chunk->data_len) + " data bytes");
+  }
+  if (chunk->compression == ChunkCompression::kLz4 &&
+      chunk->size / kLz4MaxRatio > chunk->data_len) {
+    return Status::Error("lz4 chunk of " + std::to_string(chunk->data_len) +
+                         " data bytes cannot decompress to the " + std::to_string(chunk->size) +
+                         " bytes it declares (at most " + std::to_string(kLz4MaxRatio) +
+                         " per byte; corrupt bag?)");
   }
   return Status::Ok();
 }
@@ -390,11 +407,6 @@ Status BagReader::ReadChunkHeaders() {
                              " (" + OpName(op) + "), not a chunk");
     }
     if (status.ok()) status = ParseChunkHeader(header, &chunk);
-    if (status.ok() && chunk.compression == ChunkCompression::kNone &&
-        chunk.size != chunk.data_len) {
-      status = Status::Error("uncompressed chunk of size " + std::to_string(chunk.size) +
-                             " has " + std::to_string(chunk.data_len) + " data bytes");
-    }
     if (!status.ok()) return Error(chunk.pos, "chunk: " + status.message());
     chunk.index_pos = chunk.data_pos + chunk.data_len;
   }
@@ -597,12 +609,15 @@ Status BagReader::SalvageChunk(uint64_t pos, const RecordHeader& header, uint64_
     *stop = true;  // its records run to the end of the file
     return SalvageOpenChunk(chunk_index);
   }
-  std::vector<uint8_t> records(std::max<uint32_t>(chunk.size, 1));
+  // Not zero-filled: only the pages the decompressor writes are touched, so
+  // a bz2 chunk that declares more than it holds costs what it holds.
+  ByteBuffer records;
+  uint8_t* dst = records.Reserve(std::max<size_t>(chunk.size, 1));
   std::vector<uint8_t> compressed;
   size_t end = 0;
-  status = LoadChunk(chunk_index, &compressed, records.data());
+  status = LoadChunk(chunk_index, &compressed, dst);
   if (status.ok()) {
-    status = IndexChunkRecords(records.data(), chunk.size, chunk_index, /*open=*/false, &end);
+    status = IndexChunkRecords(dst, chunk.size, chunk_index, /*open=*/false, &end);
   }
   if (!status.ok()) {
     salvage_note_ = "stopped at the damaged chunk at byte " + std::to_string(pos) + ": " +

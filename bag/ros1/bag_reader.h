@@ -138,7 +138,8 @@ class BagReader {
   std::vector<Item> MergedItems(const std::vector<size_t>& slots,
                                 const ReadOptions& options) const;
   Status ScanUnindexed(uint64_t first_record_pos);
-  // The compression and size fields of a chunk record header.
+  // The compression and size fields of a chunk record header; the size must
+  // be one its chunk->data_len bytes can hold (checked before allocating).
   static Status ParseChunkHeader(const RecordHeader& header, Chunk* chunk);
   // Scan of an unindexed bag: reads the chunk record at `pos` and indexes its
   // records; sets *stop (with salvage_note_ saying why) when nothing after

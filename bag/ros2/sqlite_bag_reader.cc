@@ -7,8 +7,10 @@
 #include <fstream>
 #include <map>
 #include <queue>
+#include <sstream>
 
 #include "bag/ros2/messages.h"
+#include "bag/ros2/rosbag2_metadata.h"
 
 namespace tiltcal::ros2 {
 
@@ -36,54 +38,14 @@ std::string ImmutableUri(const std::string& path) {
   return uri + "?immutable=1";
 }
 
-std::string Trim(const std::string& s) {
-  const size_t begin = s.find_first_not_of(" \t\r");
-  if (begin == std::string::npos) return "";
-  return s.substr(begin, s.find_last_not_of(" \t\r") + 1 - begin);
-}
-
-std::string Unquote(const std::string& s) {
-  if (s.size() >= 2 && (s.front() == '"' || s.front() == '\'') && s.back() == s.front()) {
-    return s.substr(1, s.size() - 2);
-  }
-  return s;
-}
-
-// The entries of relative_file_paths and the compression_format of a
-// rosbag2 metadata.yaml. Only these two keys are read: a block list
-// ("- a.db3" lines) or a flow list ("[a.db3, b.db3]").
-Status ParseMetadata(const std::string& file, std::vector<std::string>* relative_paths,
-                     std::string* compression_format) {
-  std::ifstream in(file);
+// The text of metadata.yaml.
+Status ReadMetadataFile(const std::string& file, std::string* text) {
+  std::ifstream in(file, std::ios::binary);
   if (!in) return Status::Error(file + ": cannot read");
-  std::string line;
-  bool in_list = false;
-  while (std::getline(in, line)) {
-    const std::string t = Trim(line);
-    if (in_list && t.rfind("- ", 0) == 0) {
-      relative_paths->push_back(Unquote(Trim(t.substr(2))));
-      continue;
-    }
-    in_list = false;
-    if (t.rfind("relative_file_paths:", 0) == 0) {
-      const std::string rest = Trim(t.substr(20));
-      if (rest.empty()) {
-        in_list = true;
-      } else if (rest.front() == '[' && rest.back() == ']') {
-        std::string item;
-        for (char c : rest.substr(1, rest.size() - 2) + ",") {
-          if (c != ',') {
-            item += c;
-          } else if (!Trim(item).empty()) {
-            relative_paths->push_back(Unquote(Trim(item)));
-            item.clear();
-          }
-        }
-      }
-    } else if (t.rfind("compression_format:", 0) == 0) {
-      *compression_format = Unquote(Trim(t.substr(19)));
-    }
-  }
+  std::ostringstream buffer;
+  buffer << in.rdbuf();  // an empty file leaves the text empty
+  if (in.bad()) return Status::Error(file + ": cannot read");
+  *text = buffer.str();
   return Status::Ok();
 }
 
@@ -185,9 +147,11 @@ Status SqliteBagReader::ListFiles(const std::string& path) {
   }
   const std::string metadata = (fs::path(path) / kMetadataFile).string();
   if (fs::exists(metadata, ec)) {
-    std::vector<std::string> relative;
-    std::string compression;
-    TILTCAL_RETURN_IF_ERROR(ParseMetadata(metadata, &relative, &compression));
+    std::string text;
+    TILTCAL_RETURN_IF_ERROR(ReadMetadataFile(metadata, &text));
+    const Rosbag2Metadata parsed = ParseRosbag2Metadata(text);
+    const std::vector<std::string>& relative = parsed.relative_file_paths;
+    const std::string& compression = parsed.compression_format;
     if (!compression.empty()) {
       return Status::Error(metadata + ": compression_format '" + compression +
                            "': compressed rosbag2 bags are not supported (decompress them with "

@@ -24,6 +24,7 @@
 #include "stages/calibrate/map_sharpness.h"
 #include "stages/calibrate/problem_builder.h"
 #include "stages/calibrate/residual_statistics.h"
+#include "stages/calibrate/solve_check.h"
 #include "stages/calibrate/verdict.h"
 
 namespace tiltcal::calibrate {
@@ -344,18 +345,6 @@ void FillEstimate(const CalibrationState& state, const std::vector<std::string>&
   result->set_ground_residuals_reason(ground_reason);
 }
 
-// A solve that failed outright (ceres FAILURE) or ended on a non-finite
-// cost leaves no usable estimate: an error, not a result.
-Status CheckSolveUsable(const OuterLoop& loop) {
-  if (loop.summary.termination_type == ceres::FAILURE ||
-      !std::isfinite(loop.summary.final_cost)) {
-    return Status::Error(fmt::format("the solve failed (termination {}, final cost {}): {}",
-                                     loop.termination, loop.summary.final_cost,
-                                     loop.summary.message));
-  }
-  return Status::Ok();
-}
-
 // What the verdict is decided from besides the estimate and the covariance:
 // residual statistics and tau bounds of the last problem, the map sharpness
 // with the estimate and with the rig's extrinsic (same trajectory and tau),
@@ -477,7 +466,7 @@ Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& pa
   while (loop.rounds < max_rounds && !settled) {
     TILTCAL_RETURN_IF_ERROR(RunOuterRound(setup, &state, &loop, &settled, log));
   }
-  TILTCAL_RETURN_IF_ERROR(CheckSolveUsable(loop));
+  TILTCAL_RETURN_IF_ERROR(CheckSolveUsable(loop.summary));
   FillSolverReport(loop, result);
   FillCovariance(inputs, params, loop.problem.get(), &state, result);
   FillVerdictFacts(inputs, params, init, loop.problem.get(), state, result);

@@ -1,6 +1,8 @@
 // tiltcal_calibrate: continuous-time LiDAR-IMU calibration.
 #include <iostream>
 
+#include <glog/logging.h>
+
 #include "common/cli/command_line.h"
 #include "stages/calibrate/calibrate.h"
 #include "stages/calibrate/calibrate_params_validation.h"
@@ -30,6 +32,9 @@ int main(int argc, char** argv) {
                   "result written but its verdict is SUSPECT (reasons in the file and on "
                   "stderr; params verdict.allow_suspect: true exits 0)");
   if (const auto exit_code = cli.Parse(argc, argv)) return *exit_code;
+  // Ceres also logs a failed solve through glog; its message is already in
+  // the stage's one error line (solve_check.h), so glog prints nothing.
+  FLAGS_minloglevel = google::GLOG_FATAL;
   tiltcal::calibrate::CalibratePaths paths;
   paths.imu = cli.Get("imu");
   paths.scans = cli.Get("scans");

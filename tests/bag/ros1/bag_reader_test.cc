@@ -4,6 +4,8 @@
 // indexes, eviction from a one-chunk cache, truncation and byte flips.
 #include "bag/ros1/bag_reader.h"
 
+#include <sys/resource.h>
+
 #include <cstdio>
 #include <fstream>
 #include <map>
@@ -39,6 +41,8 @@ struct BagOptions {
   // recorder leaves it; "none" keeps its records after the header, any other
   // compression keeps only a 7-byte frame start.
   std::string open_last_chunk_compression;
+  // Non-zero: the size the chunk records declare instead of their true one.
+  uint32_t declared_chunk_size = 0;
 };
 
 std::string Time(int64_t ns) {
@@ -94,8 +98,11 @@ std::string BuildBag(const std::vector<Conn>& conns, const std::vector<std::vect
       body += compression == "none" ? data : std::string("\x04\x22\x4d\x18\x64\x60\x85", 7);
       break;
     }
+    const uint32_t size = options.declared_chunk_size != 0
+                              ? options.declared_chunk_size
+                              : static_cast<uint32_t>(data.size());
     AppendRecord(&body, {{"op", OpValue(Op::kChunk)}, {"compression", options.compression},
-                         {"size", U32Value(static_cast<uint32_t>(data.size()))}},
+                         {"size", U32Value(size)}},
                  data);
     for (const auto& [conn, entries] : index) {
       uint32_t count = static_cast<uint32_t>(entries.size() / kIndexEntrySize);
@@ -324,6 +331,46 @@ TEST_F(BagReaderTest, IndexInconsistenciesAreErrors) {
     ASSERT_FALSE(status.ok());
     EXPECT_NE(status.message().find("unsupported chunk compression 'zstd'"), std::string::npos)
         << status.message();
+  }
+}
+
+// Peak resident memory of this process so far, MB.
+double PeakRssMb() {
+  struct rusage usage {};
+  getrusage(RUSAGE_SELF, &usage);
+  return usage.ru_maxrss / 1024.0;
+}
+
+// A chunk that declares 200 MB in a file of a few hundred bytes is an error,
+// indexed or scanned, without the 200 MB being allocated (none, lz4: refused
+// from the header; bz2, which can expand a million-fold, up to 1 GiB is
+// allocated but only what the decompressor writes is touched).
+TEST_F(BagReaderTest, ChunkSizeBeyondItsDataIsRefusedBeforeAllocating) {
+  const std::map<std::string, std::string> expected = {
+      {"none", "data bytes"}, {"lz4", "cannot decompress"}, {"bz2", "bz2 chunk"}};
+  for (const auto& [compression, expected_text] : expected) {
+    for (bool indexed : {true, false}) {
+      SCOPED_TRACE(compression + (indexed ? " indexed" : " scanned"));
+      BagOptions options;
+      options.compression = compression;
+      options.indexed = indexed;
+      options.declared_chunk_size = 200000000;
+      const std::string path = Write(BuildBag(kTwoImuConns, {{{1, 1000, "a"}}}, options));
+      const double rss_before_mb = PeakRssMb();
+      BagReader reader;
+      const Status status = reader.Open(path);
+      std::string message = status.message();
+      if (status.ok()) {  // bz2 indexed: an error when read; scanned: the scan stops there
+        EXPECT_TRUE(compression == "bz2" || !indexed);
+        std::vector<Seen> seen;
+        const Status read = ReadAll(&reader, &seen);
+        message = read.ok() ? reader.salvage_note() : read.message();
+        EXPECT_TRUE(seen.empty());
+      }
+      EXPECT_NE(message.find("200000000"), std::string::npos) << message;
+      EXPECT_NE(message.find(expected_text), std::string::npos) << message;
+      EXPECT_LT(PeakRssMb() - rss_before_mb, 100.0);
+    }
   }
 }
 

@@ -13,6 +13,7 @@
 #include "bag/ros1/message_encoding.h"
 #include "common/io/atomic_file.h"
 #include "tests/bag/ros1/rosbag_oracle.h"
+#include "tests/testing/random_vector.h"
 #include "tests/testing/test_env.h"
 
 namespace tiltcal::ros1 {
@@ -52,8 +53,9 @@ std::vector<Written> WriteTestBag(const std::string& path, ChunkCompression comp
     const int64_t stamp = t0 + i * 5000000LL;
     Written w{i % 3 == 2 ? "imu_raw" : "/imu/data", stamp + 1000000, stamp,
               static_cast<uint32_t>(i), "imu_link", ""};
-    const Eigen::Vector3d omega(gaussian(rng), gaussian(rng), gaussian(rng));
-    const Eigen::Vector3d accel(gaussian(rng), gaussian(rng), 9.81 + gaussian(rng));
+    const Eigen::Vector3d omega = tiltcal::testing::RandomVector3(gaussian, rng);
+    const Eigen::Vector3d accel =
+        tiltcal::testing::RandomVector3(gaussian, rng) + Eigen::Vector3d(0.0, 0.0, 9.81);
     EXPECT_TRUE(SerializeImu(w.seq, stamp, w.frame_id, omega, accel, 1e-6, 1e-4, &w.bytes));
     EXPECT_TRUE(writer.Write(i % 3 == 2 ? c_raw : c_imu, w.record_ns, w.bytes).ok());
     written.push_back(w);

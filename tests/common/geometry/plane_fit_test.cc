@@ -9,6 +9,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
+#include "tests/testing/random_vector.h"
 
 namespace tiltcal::geometry {
 namespace {
@@ -32,7 +33,11 @@ Cloud PlanePoints(const Eigen::Vector3d& n, double d, int count, double radius, 
   const Eigen::Vector3d e1 = n.unitOrthogonal(), e2 = n.cross(e1);
   Cloud cloud;
   for (int i = 0; i < count; ++i) {
-    cloud.Add(-d * n + u(*rng) * e1 + u(*rng) * e2 + noise(*rng) * n);
+    // Drawn normal offset, then e2, then e1 (tests/testing/random_vector.h).
+    const double offset = noise(*rng);
+    const double along_e2 = u(*rng);
+    const double along_e1 = u(*rng);
+    cloud.Add(-d * n + along_e1 * e1 + along_e2 * e2 + offset * n);
   }
   return cloud;
 }
@@ -127,7 +132,11 @@ TEST(PlaneFit, CovarianceMatchesMonteCarlo) {
   for (int t = 0; t < trials; ++t) {
     Cloud c;
     for (int i = 0; i < 300; ++i) {
-      c.Add(-d * n + (5.0 + u(rng)) * e1 + u(rng) * e2 + noise(rng) * n);
+      // Drawn normal offset, then e2, then e1 (tests/testing/random_vector.h).
+      const double offset = noise(rng);
+      const double along_e2 = u(rng);
+      const double along_e1 = u(rng);
+      c.Add(-d * n + (5.0 + along_e1) * e1 + along_e2 * e2 + offset * n);
     }
     PlaneFit fit = FitAll(c);
     ASSERT_TRUE(fit.ok);
@@ -159,7 +168,10 @@ TEST(PlaneFit, RobustFitIgnoresOutliers) {
   const Eigen::Vector3d n = Eigen::Vector3d(0.0, 0.1, 1.0).normalized();
   Cloud c = PlanePoints(n, 0.9, 2000, 8.0, 0.01, &rng);
   std::uniform_real_distribution<double> u(-8.0, 8.0);
-  for (int i = 0; i < 400; ++i) c.Add(Eigen::Vector3d(u(rng), u(rng), 0.5 + 0.1 * u(rng)));
+  for (int i = 0; i < 400; ++i) {
+    const Eigen::Vector3d v = tiltcal::testing::RandomVector3(u, rng);
+    c.Add(Eigen::Vector3d(v.x(), v.y(), 0.5 + 0.1 * v.z()));
+  }
   RobustPlaneOptions options;
   options.inlier_distance_m = 0.05;
   options.max_iterations = 10;
@@ -188,8 +200,17 @@ TEST(PlaneFit, RefinementFromAHypothesisStaysOnItsSurface) {
   std::uniform_real_distribution<double> ux(-8.0, 8.0), uy_road(-6.0, 2.5), uy_walk(2.5, 6.0);
   std::normal_distribution<double> noise(0.0, 0.01);
   Cloud c;
-  for (int i = 0; i < 3000; ++i) c.Add(Eigen::Vector3d(ux(rng), uy_road(rng), -0.9 + noise(rng)));
-  for (int i = 0; i < 1500; ++i) c.Add(Eigen::Vector3d(ux(rng), uy_walk(rng), -0.75 + noise(rng)));
+  // Each point drawn z, y, x (tests/testing/random_vector.h).
+  auto add = [&](std::uniform_real_distribution<double>& uy, double height, int count) {
+    for (int i = 0; i < count; ++i) {
+      const double z = height + noise(rng);
+      const double y = uy(rng);
+      const double x = ux(rng);
+      c.Add(Eigen::Vector3d(x, y, z));
+    }
+  };
+  add(uy_road, -0.9, 3000);
+  add(uy_walk, -0.75, 1500);
   RobustPlaneOptions options;
   options.inlier_distance_m = 0.08;
   options.max_iterations = 10;

@@ -89,7 +89,11 @@ TEST(EulerAngles, Euler123RoundTripAndHuskyPreset) {
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> angle(-3.0, 3.0), pitch(-1.5, 1.5);
   for (int i = 0; i < 100; ++i) {
-    const Eigen::Vector3d e(angle(rng), pitch(rng), angle(rng));
+    // Drawn z, y, x (tests/testing/random_vector.h).
+    const double yaw = angle(rng);
+    const double pitch_angle = pitch(rng);
+    const double roll = angle(rng);
+    const Eigen::Vector3d e(roll, pitch_angle, yaw);
     EXPECT_TRUE(Euler123FromRotation(RotationFromEuler123(e)).isApprox(e, 1e-9)) << e.transpose();
   }
   // Gimbal lock keeps the rotation.

@@ -6,6 +6,7 @@
 
 #include <ceres/jet.h>
 #include <gtest/gtest.h>
+#include "tests/testing/random_vector.h"
 
 namespace tiltcal::geometry {
 namespace {
@@ -21,7 +22,7 @@ std::vector<Eigen::Vector3d> TestVectors() {
   for (double norm : {1e-14, 1e-10, 1e-8, 1e-5, 9.9e-5, 1.01e-4, 9.9e-3, 1.01e-2, 0.1, 1.0, 2.0,
                       3.0, kPi - 1e-3, kPi - 1e-6, kPi - 1e-9}) {
     for (int k = 0; k < 3; ++k) {
-      Eigen::Vector3d v(n(rng), n(rng), n(rng));
+      Eigen::Vector3d v = tiltcal::testing::RandomVector3(n, rng);
       out.push_back(norm * v.normalized());
     }
   }
@@ -148,8 +149,8 @@ TEST(So3Test, BoxOperationsAndQuaternionJacobians) {
   std::mt19937 rng(3);
   std::normal_distribution<double> n(0.0, 1.0);
   for (int trial = 0; trial < 20; ++trial) {
-    const Eigen::Quaterniond q = ExpQuaternion(Eigen::Vector3d(n(rng), n(rng), n(rng)));
-    const Eigen::Vector3d delta = 0.5 * Eigen::Vector3d(n(rng), n(rng), n(rng));
+    const Eigen::Quaterniond q = ExpQuaternion(tiltcal::testing::RandomVector3(n, rng));
+    const Eigen::Vector3d delta = 0.5 * tiltcal::testing::RandomVector3(n, rng);
     // Right perturbation: q Exp(delta) as matrices is R Exp(delta).
     EXPECT_LT((BoxPlus(q, delta).toRotationMatrix() - q.toRotationMatrix() * ExpMatrix(delta)).norm(), 1e-14);
     EXPECT_LT((BoxMinus(BoxPlus(q, delta), q) - delta).norm(), 1e-13);

@@ -10,6 +10,7 @@
 
 #include "common/geometry/so3.h"
 #include "common/imu/imu_reading.h"
+#include "tests/testing/random_vector.h"
 
 namespace tiltcal::imu::testing {
 
@@ -42,9 +43,9 @@ inline std::vector<ImuReading> SyntheticImu(double rate_hz, double duration_s,
     ImuReading r;
     r.time_s = t;
     r.angular_velocity_radps = omega(t) + gyro_bias +
-                               gyro_noise * Eigen::Vector3d(n01(rng), n01(rng), n01(rng));
+                               gyro_noise * tiltcal::testing::RandomVector3(n01, rng);
     r.linear_acceleration_mps2 = -(c_wb.conjugate() * g_w) +
-                                 accel_noise * Eigen::Vector3d(n01(rng), n01(rng), n01(rng));
+                                 accel_noise * tiltcal::testing::RandomVector3(n01, rng);
     readings.push_back(r);
     if (attitudes != nullptr) attitudes->push_back(c_wb);
   }

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "common/geometry/so3.h"
+#include "tests/testing/random_vector.h"
 
 namespace tiltcal::spline {
 namespace {
@@ -24,7 +25,7 @@ using ceres::XPlusZeroIsXAt;
 
 Vector RandomUnitQuaternion(std::mt19937* rng, double angle_scale) {
   std::normal_distribution<double> n(0.0, angle_scale);
-  const Eigen::Quaterniond q = geometry::ExpQuaternion(Eigen::Vector3d(n(*rng), n(*rng), n(*rng)));
+  const Eigen::Quaterniond q = geometry::ExpQuaternion(tiltcal::testing::RandomVector3(n, *rng));
   return Eigen::Vector4d(q.coeffs());  // (x, y, z, w)
 }
 
@@ -34,11 +35,11 @@ TEST(RightQuaternionManifoldTest, InvariantsHold) {
   std::normal_distribution<double> n(0.0, 0.5);
   for (int trial = 0; trial < 20; ++trial) {
     const Vector x = RandomUnitQuaternion(&rng, 1.0);
-    const Vector delta = Eigen::Vector3d(n(rng), n(rng), n(rng));
+    const Vector delta = tiltcal::testing::RandomVector3(n, rng);
     // y near x so that x^{-1} y has w > 0 and Plus(x, Minus(y, x)) == y exactly
     // (not -y).
     const Eigen::Quaterniond qx(Eigen::Vector4d(x).data());
-    const Eigen::Quaterniond qy = qx * geometry::ExpQuaternion(Eigen::Vector3d(n(rng), n(rng), n(rng)));
+    const Eigen::Quaterniond qy = qx * geometry::ExpQuaternion(tiltcal::testing::RandomVector3(n, rng));
     const Vector y = Eigen::Vector4d(qy.coeffs());
     EXPECT_THAT_MANIFOLD_INVARIANTS_HOLD(manifold, x, delta, y, 1e-9);
   }

@@ -18,6 +18,7 @@
 #include "common/spline/so3_spline.h"
 #include "common/spline/spline_trajectory.h"
 #include "tests/common/spline/spline_reference.h"
+#include "tests/testing/random_vector.h"
 
 namespace tiltcal::spline {
 namespace {
@@ -49,11 +50,11 @@ struct Knots {
 Knots RandomKnots(std::mt19937* rng, double step) {
   std::normal_distribution<double> n(0.0, 1.0);
   Knots k;
-  k.q[0] = ExpQuaternion(Eigen::Vector3d(n(*rng), n(*rng), n(*rng)));
-  k.p[0] = Eigen::Vector3d(n(*rng), n(*rng), n(*rng));
+  k.q[0] = ExpQuaternion(tiltcal::testing::RandomVector3(n, *rng));
+  k.p[0] = tiltcal::testing::RandomVector3(n, *rng);
   for (int i = 1; i < 4; ++i) {
-    k.q[i] = k.q[i - 1] * ExpQuaternion(Eigen::Vector3d(step * Eigen::Vector3d(n(*rng), n(*rng), n(*rng))));
-    k.p[i] = k.p[i - 1] + 0.3 * Eigen::Vector3d(n(*rng), n(*rng), n(*rng));
+    k.q[i] = k.q[i - 1] * ExpQuaternion(Eigen::Vector3d(step * tiltcal::testing::RandomVector3(n, *rng)));
+    k.p[i] = k.p[i - 1] + 0.3 * tiltcal::testing::RandomVector3(n, *rng);
   }
   k.Refresh();
   return k;
@@ -185,9 +186,9 @@ TEST(SplineTrajectoryTest, DerivativesMatchFiniteDifferencesAcrossSegments) {
     SplineTrajectory traj(grid);
     Eigen::Quaterniond q = Eigen::Quaterniond::Identity();
     for (int i = 0; i < grid.num_knots(); ++i) {
-      q = q * ExpQuaternion(Eigen::Vector3d(0.3 * Eigen::Vector3d(n(rng), n(rng), n(rng))));
+      q = q * ExpQuaternion(Eigen::Vector3d(0.3 * tiltcal::testing::RandomVector3(n, rng)));
       traj.SetRotationKnot(i, q);
-      traj.SetPositionKnot(i, Eigen::Vector3d(n(rng), n(rng), n(rng)));
+      traj.SetPositionKnot(i, tiltcal::testing::RandomVector3(n, rng));
     }
     const double h = 1e-5 * dt;
     auto rot = [&](double t) {

@@ -1,19 +1,23 @@
 // Faults of real recordings that the calibrator's initialisation refuses,
 // on the short simulated sequence (short_sequence_fixture.h) changed in
 // memory: a gyro in deg/s labelled rad/s, a rig rotation wrong in yaw by
-// 90 deg, an IMU upside down that the rig does not declare. Each ends with
-// an error saying what the data show, never a result.
+// 90 deg, an IMU upside down that the rig does not declare; and one
+// accelerometer sample of 1e300 m/s^2 in the IMU file. Each ends with an
+// error saying what the data show, never a result.
 
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
 
 #include "common/io/eigen_proto.h"
+#include "common/io/record_stream.h"
 #include "common/io/text_proto.h"
+#include "tiltcal/proto/imu.pb.h"
 #include "tests/stages/calibrate/short_sequence_fixture.h"
 
 namespace tiltcal::calibrate {
@@ -87,6 +91,39 @@ TEST_F(CalibrateFaultsTest, WrongRigRotationExitsWithOneAndLeavesNoOutput) {
       &output);
   EXPECT_EQ(exit_code, 1) << output;
   EXPECT_NE(output.find("fix it in the rig"), std::string::npos) << output;
+  EXPECT_FALSE(testing::FileExists(out));
+}
+
+// One accelerometer sample of 1e300 m/s^2: finite, so the IMU reader keeps
+// it; its squared residual overflows a double, so no solve can use it. The
+// executable must exit 1 with one error line and write no result, whichever
+// step meets the value first (initialisation, or the solve's check in
+// solve_check.h, tested on its own in solve_check_test.cc).
+TEST_F(CalibrateFaultsTest, AccelerometerSampleOf1e300ExitsWithOneLineAndNoResult) {
+  std::vector<proto::ImuSample> samples;
+  proto::StreamHeader header;
+  ASSERT_TRUE(ReadAllRecords<proto::ImuSample>(dir_->File("imu.binpb"), &samples, &header).ok());
+  ASSERT_GT(samples.size(), 100u);
+  samples[samples.size() / 2].mutable_linear_acceleration_mps2()->set_z(1e300);
+  const std::string imu = dir_->File("imu_1e300.binpb");
+  RecordWriter writer;
+  ASSERT_TRUE(writer.Open(imu, header.payload_type(), header.provenance(), false).ok());
+  for (const proto::ImuSample& sample : samples) ASSERT_TRUE(writer.Write(sample).ok());
+  ASSERT_TRUE(writer.Close().ok());
+  const std::string params = dir_->File("lidar_imu_1e300.txtpb");
+  ASSERT_TRUE(WriteTextProto(params, LidarImuParams()).ok());
+  const std::string out = dir_->File("calibration_1e300.txtpb");
+  std::string output;
+  const int exit_code = testing::RunCommand(
+      testing::ToolPath("tiltcal_calibrate") + " --quiet --imu=" + imu + " --scans=" +
+          dir_->File("scans.binpb.lz4") + " --rig=" + dir_->File("rig.txtpb") +
+          " --params=" + params + " --out=" + out,
+      &output);
+  std::printf("%s", output.c_str());
+  EXPECT_EQ(exit_code, 1) << output;
+  EXPECT_EQ(output.rfind("tiltcal_calibrate: ", 0), 0u) << output;
+  ASSERT_FALSE(output.empty());
+  EXPECT_EQ(output.find('\n'), output.size() - 1) << "more than one line:\n" << output;
   EXPECT_FALSE(testing::FileExists(out));
 }
 

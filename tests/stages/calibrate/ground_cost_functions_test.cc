@@ -18,6 +18,7 @@
 #include "stages/calibrate/ground_cost_functions.h"
 #include "tests/common/spline/spline_reference.h"
 #include "tests/stages/calibrate/jacobian_checks.h"
+#include "tests/testing/random_vector.h"
 
 namespace tiltcal::calibrate {
 namespace {
@@ -123,7 +124,7 @@ struct State {
 
 State RandomState(std::mt19937* rng, double dt) {
   std::normal_distribution<double> n(0.0, 1.0);
-  auto v = [&](double s) { return Eigen::Vector3d(s * n(*rng), s * n(*rng), s * n(*rng)); };
+  auto v = [&](double s) { return Eigen::Vector3d(s * tiltcal::testing::RandomVector3(n, *rng)); };
   State s;
   s.q[0] = ExpQuaternion(v(1.0));
   // Angular rates ~ 1-3 rad/s whatever dt.
@@ -137,7 +138,7 @@ State RandomState(std::mt19937* rng, double dt) {
 
 Eigen::Vector3d RandomUnit(std::mt19937* rng) {
   std::normal_distribution<double> n(0.0, 1.0);
-  return Eigen::Vector3d(n(*rng), n(*rng), n(*rng)).normalized();
+  return tiltcal::testing::RandomVector3(n, *rng).normalized();
 }
 
 // A non-symmetric, well-conditioned weight.

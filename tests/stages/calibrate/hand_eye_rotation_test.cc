@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "tests/stages/calibrate/calibrate_params_text.h"
+#include "tests/testing/random_vector.h"
 
 namespace tiltcal::calibrate {
 namespace {
@@ -46,13 +47,13 @@ std::vector<RotationPair> MakePairs(const Eigen::Quaterniond& c_bl, const Eigen:
   std::normal_distribution<double> n(0.0, 1.0);
   std::vector<RotationPair> pairs;
   for (int i = 0; i < count; ++i) {
-    const Eigen::Vector3d phi(axis_rms_rad.x() * n(rng), axis_rms_rad.y() * n(rng), axis_rms_rad.z() * n(rng));
+    const Eigen::Vector3d phi = axis_rms_rad.cwiseProduct(tiltcal::testing::RandomVector3(n, rng));
     const Eigen::Quaterniond c_b = Exp(phi);
     const Eigen::Quaterniond c_l = c_bl.conjugate() * c_b * c_bl;
     const double s = noise_deg * kDegToRad;
     RotationPair p;
-    p.imu_delta = c_b * Exp(s * Eigen::Vector3d(n(rng), n(rng), n(rng)));
-    p.lidar_delta = c_l * Exp(s * Eigen::Vector3d(n(rng), n(rng), n(rng)));
+    p.imu_delta = c_b * Exp(s * tiltcal::testing::RandomVector3(n, rng));
+    p.lidar_delta = c_l * Exp(s * tiltcal::testing::RandomVector3(n, rng));
     pairs.push_back(p);
   }
   return pairs;

@@ -10,6 +10,7 @@
 #include <random>
 
 #include <gtest/gtest.h>
+#include "tests/testing/random_vector.h"
 
 namespace tiltcal::calibrate {
 namespace {
@@ -85,8 +86,8 @@ std::vector<ImuReading> SimulateImu(const EulerMotion& motion, double duration_s
     s.time_s = 100.0 + i / rate_hz;  // arbitrary sequence origin
     Eigen::Vector3d w;
     const Eigen::Matrix3d c_wb = motion.Rotation(s.time_s - 100.0, &w);
-    s.angular_velocity_radps = w + gyro_bias + gyro_sigma * Eigen::Vector3d(n(rng), n(rng), n(rng));
-    s.linear_acceleration_mps2 = -c_wb.transpose() * g_w + accel_sigma * Eigen::Vector3d(n(rng), n(rng), n(rng));
+    s.angular_velocity_radps = w + gyro_bias + gyro_sigma * tiltcal::testing::RandomVector3(n, rng);
+    s.linear_acceleration_mps2 = -c_wb.transpose() * g_w + accel_sigma * tiltcal::testing::RandomVector3(n, rng);
     out.push_back(s);
   }
   return out;

@@ -33,6 +33,7 @@
 #include "stages/calibrate/gyro_cost_function.h"
 #include "stages/calibrate/point_to_plane_cost_function.h"
 #include "tests/common/spline/spline_reference.h"
+#include "tests/testing/random_vector.h"
 
 namespace tiltcal::calibrate {
 namespace {
@@ -199,8 +200,8 @@ TEST(LidarSplineFitTest, PointToPlaneRecoversExtrinsicAndTimeOffset) {
   for (int k = 0; k < 3000; ++k) {
     Point pt;
     pt.t_lidar = uni(rng);
-    pt.p_l = Eigen::Vector3d(8.0 * n(rng), 8.0 * n(rng), 1.5 * n(rng));
-    pt.normal = Eigen::Vector3d(n(rng), n(rng), n(rng)).normalized();
+    pt.p_l = tiltcal::testing::RandomVector3(n, rng).cwiseProduct(Eigen::Vector3d(8.0, 8.0, 1.5));
+    pt.normal = tiltcal::testing::RandomVector3(n, rng).normalized();
     spline::So3SplineSample r;
     spline::R3SplineSample p;
     ASSERT_TRUE(traj.Evaluate(pt.t_lidar + tau_true, spline::kSo3Rotation, &r, &p));

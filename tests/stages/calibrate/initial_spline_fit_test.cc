@@ -33,6 +33,7 @@
 #include "stages/calibrate/orientation_sample_cost_function.h"
 #include "stages/calibrate/problem_builder.h"
 #include "tests/stages/calibrate/calibrate_params_text.h"
+#include "tests/testing/random_vector.h"
 
 namespace tiltcal::calibrate {
 namespace {
@@ -68,10 +69,10 @@ std::vector<imu::ImuReading> Imu(const Eigen::Vector3d& gyro_bias,
     imu::ImuReading r;
     r.time_s = t;
     r.angular_velocity_radps = geometry::RightJacobian(Phi(t)) * PhiDot(t) + gyro_bias +
-                               gyro_bias_drift * t + 0.002 * Eigen::Vector3d(n(*rng), n(*rng), n(*rng));
+                               gyro_bias_drift * t + 0.002 * tiltcal::testing::RandomVector3(n, *rng);
     r.linear_acceleration_mps2 = Rotation(t).transpose() * (Acceleration(t) - kGravity) +
                                  accel_bias + accel_bias_drift * t +
-                                 0.014 * Eigen::Vector3d(n(*rng), n(*rng), n(*rng));
+                                 0.014 * tiltcal::testing::RandomVector3(n, *rng);
     out.push_back(r);
   }
   return out;
@@ -95,7 +96,7 @@ void LidarPositions(const Eigen::Vector3d& r_bl, std::mt19937* rng, std::vector<
   for (double t = 0.1; t < kDuration - 0.1; t += 0.1) {
     times->push_back(t);
     positions->push_back(Position(t) + Rotation(t) * r_bl +
-                         0.01 * Eigen::Vector3d(n(*rng), n(*rng), n(*rng)));
+                         0.01 * tiltcal::testing::RandomVector3(n, *rng));
   }
 }
 
@@ -129,7 +130,7 @@ TEST(InitialSplineFitTest, OrientationSamplesRemoveTheHeadingDriftOfAWrongGyroBi
   std::vector<Eigen::Quaterniond> orientations;
   for (double t = 0.1; t < kDuration - 0.1; t += 0.1) {
     times.push_back(t);
-    const Eigen::Vector3d noise = 0.001 * Eigen::Vector3d(n(rng), n(rng), n(rng));
+    const Eigen::Vector3d noise = 0.001 * tiltcal::testing::RandomVector3(n, rng);
     orientations.emplace_back(Rotation(t) * geometry::ExpMatrix(noise));
   }
   RefineRotationSpline(times, orientations, imu, Options(), &state);
@@ -258,7 +259,7 @@ double WorstGyroBiasSegmentError(double segment_s, const Eigen::Vector3d& gyro_b
         for (double t = 0.1; t < kDuration - 0.1; t += 0.1) {
           spline::KnotWindow w;
           if (!grid.Locate(t, &w)) continue;
-          const Eigen::Vector3d noise = 0.001 * Eigen::Vector3d(n(rng), n(rng), n(rng));
+          const Eigen::Vector3d noise = 0.001 * tiltcal::testing::RandomVector3(n, rng);
           const int f = w.first_knot;
           p->AddResidualBlock(
               new OrientationSampleCostFunction(w, grid.inv_dt(),

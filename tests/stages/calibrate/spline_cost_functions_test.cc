@@ -20,6 +20,7 @@
 #include "stages/calibrate/point_to_plane_cost_function.h"
 #include "tests/stages/calibrate/cost_function_twins.h"
 #include "tests/stages/calibrate/jacobian_checks.h"
+#include "tests/testing/random_vector.h"
 
 namespace tiltcal::calibrate {
 namespace {
@@ -41,7 +42,7 @@ struct State {
 
 State RandomState(std::mt19937* rng, double dt) {
   std::normal_distribution<double> n(0.0, 1.0);
-  auto v = [&](double s) { return Eigen::Vector3d(s * n(*rng), s * n(*rng), s * n(*rng)); };
+  auto v = [&](double s) { return Eigen::Vector3d(s * tiltcal::testing::RandomVector3(n, *rng)); };
   State s;
   s.q[0] = ExpQuaternion(v(1.0));
   s.p[0] = v(2.0);
@@ -97,7 +98,7 @@ TEST(OrientationSampleCostFunctionTest, MatchesAutodiffTwinAndNumericDifferences
       // J_r^{-1} of the residual matters.
       const double size = 0.05 + 0.5 * std::abs(n(rng));
       const Eigen::Quaterniond measured =
-          s.q[1] * ExpQuaternion(Eigen::Vector3d(size * n(rng), size * n(rng), size * n(rng)));
+          s.q[1] * ExpQuaternion(Eigen::Vector3d(size * tiltcal::testing::RandomVector3(n, rng)));
       const double sigma = 0.002;
       OrientationSampleCostFunction analytic(spline::KnotWindow{0, u}, 1.0 / dt, measured, sigma);
       testing::OrientationTwin::AutoDiff twin(

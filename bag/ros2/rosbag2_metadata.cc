@@ -1,0 +1,58 @@
+#include "bag/ros2/rosbag2_metadata.h"
+
+#include <sstream>
+
+namespace tiltcal::ros2 {
+
+namespace {
+
+std::string Trim(const std::string& s) {
+  const size_t begin = s.find_first_not_of(" \t\r");
+  if (begin == std::string::npos) return "";
+  return s.substr(begin, s.find_last_not_of(" \t\r") + 1 - begin);
+}
+
+std::string Unquote(const std::string& s) {
+  if (s.size() >= 2 && (s.front() == '"' || s.front() == '\'') && s.back() == s.front()) {
+    return s.substr(1, s.size() - 2);
+  }
+  return s;
+}
+
+}  // namespace
+
+Rosbag2Metadata ParseRosbag2Metadata(const std::string& text) {
+  Rosbag2Metadata metadata;
+  std::istringstream in(text);
+  std::string line;
+  bool in_list = false;
+  while (std::getline(in, line)) {
+    const std::string t = Trim(line);
+    if (in_list && t.rfind("- ", 0) == 0) {
+      metadata.relative_file_paths.push_back(Unquote(Trim(t.substr(2))));
+      continue;
+    }
+    in_list = false;
+    if (t.rfind("relative_file_paths:", 0) == 0) {
+      const std::string rest = Trim(t.substr(20));
+      if (rest.empty()) {
+        in_list = true;
+      } else if (rest.front() == '[' && rest.back() == ']') {
+        std::string item;
+        for (char c : rest.substr(1, rest.size() - 2) + ",") {
+          if (c != ',') {
+            item += c;
+          } else if (!Trim(item).empty()) {
+            metadata.relative_file_paths.push_back(Unquote(Trim(item)));
+            item.clear();
+          }
+        }
+      }
+    } else if (t.rfind("compression_format:", 0) == 0) {
+      metadata.compression_format = Unquote(Trim(t.substr(19)));
+    }
+  }
+  return metadata;
+}
+
+}  // namespace tiltcal::ros2
