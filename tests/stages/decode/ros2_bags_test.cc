@@ -40,18 +40,6 @@ int Decode(const testing::TempDir& dir, const std::string& bag, const std::strin
                              output);
 }
 
-// Every record of the stream, serialized (the header, with its provenance
-// naming the input, is left out).
-template <typename Record>
-std::vector<std::string> Records(const std::string& path) {
-  std::vector<Record> records;
-  const Status status = ReadAllRecords<Record>(path, &records);
-  EXPECT_TRUE(status.ok()) << status.message();
-  std::vector<std::string> out;
-  for (const Record& r : records) out.push_back(r.SerializeAsString());
-  return out;
-}
-
 TEST(DecodeRos2Bags, SimulatedSequenceDecodesIdenticallyFromRos1McapAndSqlite) {
   if (const std::string missing = testing::Ros2OracleMissing(); !missing.empty()) {
     GTEST_SKIP() << missing;
@@ -111,8 +99,10 @@ TEST(DecodeRos2Bags, SimulatedSequenceDecodesIdenticallyFromRos1McapAndSqlite) {
   for (const auto& [name, bag] : inputs) {
     ASSERT_EQ(Decode(dir, bag, name, &output), 0) << name << ": " << output;
   }
-  const auto imu = Records<proto::ImuSample>(dir.File("out_ros1/imu.binpb"));
-  const auto scans = Records<proto::Scan>(dir.File("out_ros1/scans.binpb.lz4"));
+  const auto imu =
+      testing::SerializedRecords<proto::ImuSample>(dir.File("out_ros1/imu.binpb"));
+  const auto scans =
+      testing::SerializedRecords<proto::Scan>(dir.File("out_ros1/scans.binpb.lz4"));
   ASSERT_GT(imu.size(), 300u);
   ASSERT_GT(scans.size(), 15u);
   const std::string imu_bytes = testing::StreamBytesAfterHeader(dir.File("out_ros1/imu.binpb"));
@@ -121,8 +111,9 @@ TEST(DecodeRos2Bags, SimulatedSequenceDecodesIdenticallyFromRos1McapAndSqlite) {
     const std::string out = dir.File(std::string("out_") + name);
     EXPECT_TRUE(testing::StreamBytesAfterHeader(out + "/imu.binpb") == imu_bytes)
         << name << ": imu.binpb is not byte-identical to the ROS 1 bag's";
-    EXPECT_TRUE(Records<proto::ImuSample>(out + "/imu.binpb") == imu) << name;
-    EXPECT_TRUE(Records<proto::Scan>(out + "/scans.binpb.lz4") == scans) << name;
+    EXPECT_TRUE(testing::SerializedRecords<proto::ImuSample>(out + "/imu.binpb") == imu)
+        << name;
+    EXPECT_TRUE(testing::SerializedRecords<proto::Scan>(out + "/scans.binpb.lz4") == scans) << name;
   }
 }
 
