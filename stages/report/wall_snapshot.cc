@@ -61,7 +61,11 @@ std::optional<WallSlab> FindWall(const std::vector<Eigen::Vector3f>& points,
     if (!p.allFinite()) continue;
     const Eigen::Vector3i i = (p / params.cell_m()).array().floor().cast<int>();
     const auto [it, inserted] = index_of.emplace(Key(i), cells.size());
-    if (inserted) cells.push_back({i, {}, {}, {}, false, -1});
+    if (inserted) {
+      Cell cell;
+      cell.index = i;
+      cells.push_back(cell);
+    }
     cells[it->second].moments.Add(p);
   }
   for (Cell& cell : cells) {
