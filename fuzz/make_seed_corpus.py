@@ -23,7 +23,6 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 CORPUS = os.path.join(HERE, 'corpus')
 ROS2_WRITER = os.path.join(ROOT, 'tests', 'oracle', 'write_ros2_bags.mjs')
-ROS2_FIXTURES = os.path.join(ROOT, '..', 'shared', 'fixtures', 'bags', 'ros2')
 HARNESSES = ('ros1_bag_reader', 'record_stream', 'text_proto', 'point_cloud2', 'cdr_messages',
              'mcap_reader', 'sqlite_bag_reader', 'rosbag2_metadata')
 
@@ -173,7 +172,8 @@ def ros2_messages():
 def write_ros2_seeds():
     """MCAP files (stored, lz4, zstd; with and without summary), a rosbag2
     sqlite3 bag, its metadata.yaml and CDR messages (little and big endian),
-    written by the reference libraries; the ROS 2 fixtures when present."""
+    written by the reference libraries (scripts/sanitize_and_fuzz.sh adds the
+    ROS 2 fixtures of ../shared/fixtures as seeds when present)."""
     with tempfile.TemporaryDirectory() as tmp:
         jsonl = os.path.join(tmp, 'messages.jsonl')
         open(jsonl, 'w').write(ros2_messages())
@@ -209,13 +209,6 @@ def write_ros2_seeds():
         'rosbag2_bagfile_information:\n  version: 5\n  storage_identifier: sqlite3\n'
         '  relative_file_paths: [a_0.db3, "a_1.db3", \'a_2.db3\']\n'
         '  compression_format: ""\n  compression_mode: ""\n')
-    fixtures = {'mcap_reader': ('mcap_talker', 'talker.mcap'),
-                'sqlite_bag_reader': ('sqlite3_talker', 'talker.db3'),
-                'rosbag2_metadata': ('sqlite3_talker', 'metadata.yaml')}
-    for harness, (folder, name) in fixtures.items():
-        path = os.path.join(ROS2_FIXTURES, folder, name)
-        if os.path.exists(path):
-            shutil.copyfile(path, os.path.join(CORPUS, harness, 'fixture_' + name))
 
 
 def main():

@@ -43,8 +43,17 @@ mkdir -p "$artifacts"
 for fuzzer in "${FUZZERS[@]}"; do
   corpus=$(mktemp -d)
   log=$artifacts/${fuzzer}.log
+  # The ROS 2 talker fixtures seed the ROS 2 readers when ../shared is there
+  # (they are read in place, never copied into fuzz/corpus/).
+  seeds=("fuzz/corpus/${fuzzer%_fuzzer}")
+  case $fuzzer in
+    mcap_reader_fuzzer) fixture=../shared/fixtures/bags/ros2/mcap_talker ;;
+    sqlite_bag_reader_fuzzer | rosbag2_metadata_fuzzer) fixture=../shared/fixtures/bags/ros2/sqlite3_talker ;;
+    *) fixture= ;;
+  esac
+  if [ -n "$fixture" ] && [ -d "$fixture" ]; then seeds+=("$fixture"); fi
   if ! "$BUILD_DIR/bin/$fuzzer" -max_total_time="$FUZZ_SECONDS" -rss_limit_mb=2048 \
-      -timeout=10 -artifact_prefix="$artifacts/" "$corpus" "fuzz/corpus/${fuzzer%_fuzzer}" \
+      -timeout=10 -artifact_prefix="$artifacts/" "$corpus" "${seeds[@]}" \
       > "$log" 2>&1; then
     rm -rf "$corpus"
     tail -40 "$log" >&2
