@@ -56,9 +56,10 @@ def delimited(message):
 
 
 def stream(payload_type, records):
-    header = field(1, 2, payload_type.encode()) + field(2, 0, 1) + \
+    header = field(1, 2, payload_type.encode()) + field(2, 0, 2) + \
         field(3, 2, field(1, 2, b'make_seed_corpus'))
-    return b'TILTCAL1' + delimited(header) + b''.join(delimited(r) for r in records)
+    end_mark = varint(0) + delimited(field(1, 0, len(records)))
+    return b'TILTCAL1' + delimited(header) + b''.join(delimited(r) for r in records) + end_mark
 
 
 def imu_records():

@@ -1,6 +1,7 @@
 #include "common/io/record_stream.h"
 
 #include <cstring>
+#include <limits>
 
 #include <google/protobuf/io/coded_stream.h>
 #include <google/protobuf/io/zero_copy_stream_impl.h>
@@ -63,6 +64,10 @@ Status RecordWriter::Open(const std::string& path, const std::string& payload_ty
 }
 
 Status RecordWriter::Write(const google::protobuf::Message& record) {
+  if (record.ByteSizeLong() == 0) {
+    return Status::Error(impl_->file.path() + ": record " + std::to_string(num_records_) +
+                         " is empty (a zero length marks the end of a record stream)");
+  }
   if (!SerializeDelimitedToZeroCopyStream(record, impl_->stream())) {
     return Status::Error(impl_->file.path() + ": cannot write record " +
                          std::to_string(num_records_));
@@ -80,11 +85,19 @@ Status RecordWriter::Finish() {
   if (impl_->finished) return Status::Ok();
   impl_->finished = true;
   const std::string& path = impl_->file.path();
-  bool ok = true;
+  proto::StreamEnd end_mark;
+  end_mark.set_num_records(num_records_);
+  bool ok;
+  {
+    pbio::CodedOutputStream coded(impl_->stream());
+    coded.WriteVarint32(0);
+    ok = !coded.HadError();
+  }
+  ok = ok && SerializeDelimitedToZeroCopyStream(end_mark, impl_->stream());
   if (impl_->lz4_adaptor) {
-    ok = impl_->lz4_adaptor->Flush() && impl_->lz4->Close();
+    ok = ok && impl_->lz4_adaptor->Flush() && impl_->lz4->Close();
   } else {
-    ok = impl_->plain->Flush();
+    ok = ok && impl_->plain->Flush();
   }
   if (!ok) {
     const std::string message = path + ": cannot write output";
@@ -121,6 +134,7 @@ Status RecordReader::Open(const std::string& path, const std::string& expected_p
   impl_ = std::make_unique<Impl>();
   path_ = path;
   num_read_ = 0;
+  at_end_ = false;
   impl_->file = std::fopen(path.c_str(), "rb");
   if (impl_->file == nullptr) {
     return Status::Error(path + ": cannot open: " + std::strerror(errno));
@@ -169,19 +183,67 @@ Status RecordReader::Open(const std::string& path, const std::string& expected_p
 
 Status RecordReader::Read(google::protobuf::Message* record, bool* end) {
   *end = false;
-  bool clean_eof = false;
-  record->Clear();  // parsing merges into what the message holds
-  if (ParseDelimitedFromZeroCopyStream(record, impl_->stream(), &clean_eof)) {
-    ++num_read_;
-    return Status::Ok();
-  }
-  const std::string stream_error = impl_->StreamError();
-  if (clean_eof && stream_error.empty()) {
+  if (at_end_) {
     *end = true;
     return Status::Ok();
   }
-  return Status::Error(path_ + ": record " + std::to_string(num_read_) + ": " +
-                       (stream_error.empty() ? "truncated or corrupt record" : stream_error));
+  record->Clear();  // parsing merges into what the message holds
+  pbio::CodedInputStream coded(impl_->stream());
+  uint32_t size = 0;
+  if (!coded.ReadVarint32(&size)) {
+    const std::string stream_error = impl_->StreamError();
+    if (coded.CurrentPosition() == 0 && stream_error.empty()) {
+      return RecordError("the stream ends without its end mark (truncated)");
+    }
+    return RecordError(stream_error.empty() ? "truncated or corrupt record" : stream_error);
+  }
+  if (size == 0) {
+    TILTCAL_RETURN_IF_ERROR(ReadEndMark(&coded));
+    at_end_ = true;
+    *end = true;
+    return Status::Ok();
+  }
+  if (!ParseSized(size, record, &coded)) {
+    const std::string stream_error = impl_->StreamError();
+    return RecordError(stream_error.empty() ? "truncated or corrupt record" : stream_error);
+  }
+  ++num_read_;
+  return Status::Ok();
+}
+
+bool RecordReader::ParseSized(uint32_t size, google::protobuf::Message* message,
+                              pbio::CodedInputStream* coded) {
+  if (size > static_cast<uint32_t>(std::numeric_limits<int>::max())) return false;
+  const int start = coded->CurrentPosition();
+  const pbio::CodedInputStream::Limit limit = coded->PushLimit(static_cast<int>(size));
+  if (!message->MergePartialFromCodedStream(coded) || !coded->ConsumedEntireMessage() ||
+      coded->CurrentPosition() - start != static_cast<int>(size)) {
+    return false;
+  }
+  coded->PopLimit(limit);
+  return true;
+}
+
+Status RecordReader::ReadEndMark(pbio::CodedInputStream* coded) {
+  uint32_t size = 0;
+  proto::StreamEnd end_mark;
+  if (!coded->ReadVarint32(&size) || !ParseSized(size, &end_mark, coded)) {
+    const std::string stream_error = impl_->StreamError();
+    return RecordError(stream_error.empty() ? "truncated or corrupt end mark" : stream_error);
+  }
+  if (end_mark.num_records() != num_read_) {
+    return RecordError("the end mark counts " + std::to_string(end_mark.num_records()) +
+                       " records, the stream holds " + std::to_string(num_read_));
+  }
+  char extra = 0;
+  if (coded->ReadRaw(&extra, 1)) return RecordError("data after the end mark");
+  const std::string stream_error = impl_->StreamError();
+  if (!stream_error.empty()) return RecordError(stream_error);
+  return Status::Ok();
+}
+
+Status RecordReader::RecordError(const std::string& what) const {
+  return Status::Error(path_ + ": record " + std::to_string(num_read_) + ": " + what);
 }
 
 }  // namespace tiltcal

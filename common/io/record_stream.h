@@ -5,6 +5,7 @@
 #include <memory>
 #include <string>
 
+#include <google/protobuf/io/coded_stream.h>
 #include <google/protobuf/io/zero_copy_stream.h>
 #include <google/protobuf/message.h>
 
@@ -16,10 +17,12 @@ namespace tiltcal {
 
 // Record stream file layout (docs/design.md §4):
 //   kStreamMagic (8 bytes) · varint-delimited StreamHeader · varint-delimited records
+//   · end mark: varint 0 · varint-delimited StreamEnd
 // optionally wrapped as a whole in one LZ4 frame (`lz4 -dc` gives the plain
-// stream). Readers detect the LZ4 frame by its magic.
+// stream). Readers detect the LZ4 frame by its magic. Records are never
+// empty: a zero length is the end mark, and a stream without it is truncated.
 inline constexpr char kStreamMagic[8] = {'T', 'I', 'L', 'T', 'C', 'A', 'L', '1'};
-inline constexpr uint32_t kStreamFormatVersion = 1;
+inline constexpr uint32_t kStreamFormatVersion = 2;
 
 // Writes a record stream atomically: nothing appears at `path` until Close()
 // succeeds.
@@ -32,10 +35,12 @@ class RecordWriter {
   // stream in an LZ4 frame.
   Status Open(const std::string& path, const std::string& payload_type,
               const proto::Provenance& provenance, bool compress);
+  // An empty record (one that serialises to zero bytes) is an error: a zero
+  // length marks the end of the stream.
   Status Write(const google::protobuf::Message& record);
   // Finish() and AtomicFile::Commit(): the stream appears at its path.
   Status Close();
-  // Completes the stream under its temporary name (once; later calls do
+  // Writes the end mark and completes the stream under its temporary name (once; later calls do
   // nothing), for CommitTogether({file(), ...}).
   Status Finish();
   AtomicFile* file();
@@ -58,9 +63,10 @@ class RecordReader {
   // a file holding other records is an error naming both types.
   Status Open(const std::string& path, const std::string& expected_payload_type = "");
 
-  // Reads the next record into `record`. At a clean end of the stream returns
-  // Ok with *end = true; a truncated or corrupt record is an error naming the
-  // file and the record index.
+  // Reads the next record into `record`. At the end mark returns Ok with
+  // *end = true (and so on every later call); a truncated or corrupt record,
+  // a missing or wrong end mark, or data after it is an error naming the file
+  // and the record index.
   Status Read(google::protobuf::Message* record, bool* end);
 
   const proto::StreamHeader& header() const { return header_; }
@@ -68,11 +74,19 @@ class RecordReader {
   int64_t num_records_read() const { return num_read_; }
 
  private:
+  // Parses exactly `size` bytes of `coded` into `message`.
+  static bool ParseSized(uint32_t size, google::protobuf::Message* message,
+                         google::protobuf::io::CodedInputStream* coded);
+  // After the zero length: the StreamEnd, its count, and the end of the file.
+  Status ReadEndMark(google::protobuf::io::CodedInputStream* coded);
+  Status RecordError(const std::string& what) const;
+
   class Impl;
   std::unique_ptr<Impl> impl_;
   proto::StreamHeader header_;
   std::string path_;
   int64_t num_read_ = 0;
+  bool at_end_ = false;
 };
 
 // Reads every record of a stream of `Record` into `records`.

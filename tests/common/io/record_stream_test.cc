@@ -82,16 +82,22 @@ TEST_P(RecordStreamTest, TruncatedFileIsAnErrorNamingFileAndRecord) {
   EXPECT_LT(scans.size(), 10u);
 }
 
-TEST_P(RecordStreamTest, CutExactlyAtARecordBoundaryIsDetectedWhenCompressed) {
-  // In a plain stream a cut at a boundary cannot be told from the end; in an
-  // LZ4 frame the missing end mark gives it away.
-  if (!GetParam()) GTEST_SKIP() << "plain streams have no end mark";
+TEST_P(RecordStreamTest, EveryCutIsAnErrorAlsoBetweenTwoRecords) {
+  // Cut after every byte, record boundaries included: the end mark (and in
+  // an LZ4 frame also the frame's own end mark) is then missing.
   TempDir dir;
-  const std::string path = dir.File("scans.binpb.lz4");
-  WriteScans(path, true, 3, 10);
-  std::filesystem::resize_file(path, std::filesystem::file_size(path) - 4);  // drop checksum
+  const std::string path = dir.File("scans.binpb");
+  WriteScans(path, GetParam(), 3, 10);
+  std::string bytes;
+  ASSERT_TRUE(ReadFileToString(path, &bytes).ok());
   std::vector<proto::Scan> scans;
-  EXPECT_FALSE(ReadAllRecords<proto::Scan>(path, &scans).ok());
+  ASSERT_TRUE(ReadAllRecords<proto::Scan>(path, &scans).ok());
+  ASSERT_EQ(scans.size(), 3u);
+  for (size_t length = 0; length < bytes.size(); ++length) {
+    const std::string cut = dir.File("cut.binpb");
+    ASSERT_TRUE(WriteFileAtomically(cut, bytes.substr(0, length)).ok());
+    EXPECT_FALSE(ReadAllRecords<proto::Scan>(cut, &scans).ok()) << "cut after " << length;
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(PlainAndLz4, RecordStreamTest, ::testing::Bool(),
@@ -145,6 +151,47 @@ TEST(RecordStream, CorruptCompressedByteIsAnError) {
   ASSERT_TRUE(WriteFileAtomically(path, bytes).ok());
   std::vector<proto::Scan> scans;
   EXPECT_FALSE(ReadAllRecords<proto::Scan>(path, &scans).ok());
+}
+
+// A plain stream of 3 scans ends with its end mark: 0x00 (zero length), then
+// the StreamEnd (2 bytes: field 1 varint 3).
+TEST(RecordStream, EndMarkCountingOtherRecordsIsAnError) {
+  TempDir dir;
+  const std::string path = dir.File("scans.binpb");
+  WriteScans(path, false, 3, 10);
+  std::string bytes;
+  ASSERT_TRUE(ReadFileToString(path, &bytes).ok());
+  ASSERT_EQ(bytes.substr(bytes.size() - 4), std::string("\x00\x02\x08\x03", 4));
+  bytes.back() = '\x05';
+  ASSERT_TRUE(WriteFileAtomically(path, bytes).ok());
+  std::vector<proto::Scan> scans;
+  const Status status = ReadAllRecords<proto::Scan>(path, &scans);
+  ASSERT_FALSE(status.ok());
+  EXPECT_NE(status.message().find("counts 5 records, the stream holds 3"), std::string::npos)
+      << status.message();
+}
+
+TEST(RecordStream, DataAfterTheEndMarkIsAnError) {
+  TempDir dir;
+  const std::string path = dir.File("scans.binpb");
+  WriteScans(path, false, 2, 10);
+  std::string bytes;
+  ASSERT_TRUE(ReadFileToString(path, &bytes).ok());
+  ASSERT_TRUE(WriteFileAtomically(path, bytes + "x").ok());
+  std::vector<proto::Scan> scans;
+  const Status status = ReadAllRecords<proto::Scan>(path, &scans);
+  ASSERT_FALSE(status.ok());
+  EXPECT_NE(status.message().find("data after the end mark"), std::string::npos)
+      << status.message();
+}
+
+TEST(RecordStream, EmptyRecordIsRefusedByTheWriter) {
+  TempDir dir;
+  RecordWriter writer;
+  ASSERT_TRUE(writer.Open(dir.File("imu.binpb"), "tiltcal.proto.ImuSample", {}, false).ok());
+  const Status status = writer.Write(proto::ImuSample());
+  ASSERT_FALSE(status.ok());
+  EXPECT_NE(status.message().find("record 0 is empty"), std::string::npos) << status.message();
 }
 
 TEST(RecordStream, UnclosedWriterLeavesNoFile) {
