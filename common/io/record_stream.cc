@@ -64,11 +64,26 @@ Status RecordWriter::Open(const std::string& path, const std::string& payload_ty
 }
 
 Status RecordWriter::Write(const google::protobuf::Message& record) {
-  if (record.ByteSizeLong() == 0) {
+  // SerializeDelimitedToCodedStream, with the size computed once (it walks
+  // every packed varint of a scan) and checked: a zero length is the end mark.
+  const size_t size = record.ByteSizeLong();
+  if (size == 0) {
     return Status::Error(impl_->file.path() + ": record " + std::to_string(num_records_) +
                          " is empty (a zero length marks the end of a record stream)");
   }
-  if (!SerializeDelimitedToZeroCopyStream(record, impl_->stream())) {
+  bool ok = size <= static_cast<size_t>(std::numeric_limits<int>::max());
+  if (ok) {
+    pbio::CodedOutputStream coded(impl_->stream());
+    coded.WriteVarint32(static_cast<uint32_t>(size));
+    uint8_t* direct = coded.GetDirectBufferForNBytesAndAdvance(static_cast<int>(size));
+    if (direct != nullptr) {
+      record.SerializeWithCachedSizesToArray(direct);
+    } else {
+      record.SerializeWithCachedSizes(&coded);
+    }
+    ok = !coded.HadError();
+  }
+  if (!ok) {
     return Status::Error(impl_->file.path() + ": cannot write record " +
                          std::to_string(num_records_));
   }
