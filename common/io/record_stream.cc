@@ -187,7 +187,8 @@ Status RecordReader::Open(const std::string& path, const std::string& expected_p
   if (header_.format_version() != kStreamFormatVersion) {
     return Status::Error(path + ": unsupported stream format version " +
                          std::to_string(header_.format_version()) + " (this build reads " +
-                         std::to_string(kStreamFormatVersion) + ")");
+                         std::to_string(kStreamFormatVersion) +
+                         "); rerun the stage that wrote it with this build");
   }
   if (!expected_payload_type.empty() && header_.payload_type() != expected_payload_type) {
     return Status::Error(path + ": holds " + header_.payload_type() + " records, expected " +

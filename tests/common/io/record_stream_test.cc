@@ -185,6 +185,27 @@ TEST(RecordStream, DataAfterTheEndMarkIsAnError) {
       << status.message();
 }
 
+TEST(RecordStream, StreamOfAnOlderFormatVersionIsRefusedWithWhatToDo) {
+  // Format version 1 had no end mark: such a file cannot be trusted to be whole.
+  TempDir dir;
+  proto::StreamHeader header;
+  header.set_payload_type("tiltcal.proto.Scan");
+  header.set_format_version(1);
+  const std::string body = header.SerializeAsString();
+  ASSERT_LT(body.size(), 128u);
+  const std::string path = dir.File("scans.binpb");
+  ASSERT_TRUE(WriteFileAtomically(path, std::string(kStreamMagic, sizeof(kStreamMagic)) +
+                                            static_cast<char>(body.size()) + body)
+                  .ok());
+  std::vector<proto::Scan> scans;
+  const Status status = ReadAllRecords<proto::Scan>(path, &scans);
+  ASSERT_FALSE(status.ok());
+  EXPECT_NE(status.message().find("unsupported stream format version 1"), std::string::npos)
+      << status.message();
+  EXPECT_NE(status.message().find("rerun the stage that wrote it"), std::string::npos)
+      << status.message();
+}
+
 TEST(RecordStream, EmptyRecordIsRefusedByTheWriter) {
   TempDir dir;
   RecordWriter writer;
