@@ -83,7 +83,7 @@ expect_failure() {
   elif [ "$lines" != 1 ]; then problem="$lines output lines (expected 1)"
   elif ! printf '%s' "$output" | grep -qF -- "$file"; then problem="the line does not name $file"
   elif [ -n "$(ls -A "$OUT")" ]; then problem="left in the output directory: $(ls -A "$OUT")"
-  elif ls "$GOOD" "$BAD" | grep -q '\.tmp'; then problem="a temporary file was left"
+  elif [[ "$(ls "$GOOD" "$BAD")" == *.tmp* ]]; then problem="a temporary file was left"
   fi
   if [ -n "$problem" ]; then
     failures=$((failures + 1))

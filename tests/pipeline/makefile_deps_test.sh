@@ -173,8 +173,8 @@ mkdir -p "$DATA/seq_d"
 touch "$DATA/seq_d/metadata.yaml" "$DATA/seq_d/seq_d_0.db3" "$DATA/seq_d/seq_d_1.db3"
 expect "MCAP files and ROS 2 bag folders are sequences" "$(planned decode)" \
 "tiltcal_decode seq_a;tiltcal_decode seq_b;tiltcal_decode seq_c;tiltcal_decode seq_d;"
-"${MAKE[@]}" -n decode | grep -q -- "--bag=$DATA/seq_c.mcap " || fail "decode not given seq_c.mcap"
-"${MAKE[@]}" -n decode | grep -q -- "--bag=$DATA/seq_d " || fail "decode not given the folder seq_d"
+grep -q -- "--bag=$DATA/seq_c.mcap " <<< "$("${MAKE[@]}" -n decode)" || fail "decode not given seq_c.mcap"
+grep -q -- "--bag=$DATA/seq_d " <<< "$("${MAKE[@]}" -n decode)" || fail "decode not given the folder seq_d"
 "${MAKE[@]}" decode > /dev/null
 sleep_past; touch "$DATA/seq_d/seq_d_1.db3"
 expect "a changed .db3 reruns its folder's sequence only" "$(planned decode)" "tiltcal_decode seq_d;"
@@ -190,8 +190,8 @@ touch "$DATA/seq_f/imu.bag" "$DATA/seq_f/lidar.mcap" "$DATA/seq_g.db3"
 touch "$DATA/other_dataset/rig.txtpb" "$DATA/other_dataset/run.bag" "$DATA/params/x.bag" "$DATA/out/x.bag"
 expect "folders of bag files and .db3 files are sequences" "$(planned decode)" \
 "tiltcal_decode seq_e;tiltcal_decode seq_f;tiltcal_decode seq_g;"
-"${MAKE[@]}" -n decode | grep -q -- "--bag=$DATA/seq_e " || fail "decode not given the folder seq_e"
-"${MAKE[@]}" -n decode | grep -q -- "--bag=$DATA/seq_g.db3 " || fail "decode not given seq_g.db3"
+grep -q -- "--bag=$DATA/seq_e " <<< "$("${MAKE[@]}" -n decode)" || fail "decode not given the folder seq_e"
+grep -q -- "--bag=$DATA/seq_g.db3 " <<< "$("${MAKE[@]}" -n decode)" || fail "decode not given seq_g.db3"
 "${MAKE[@]}" decode > /dev/null
 sleep_past; touch "$DATA/seq_f/lidar.mcap"
 expect "a changed file of a folder of bags reruns that sequence only" "$(planned decode)" "tiltcal_decode seq_f;"
