@@ -197,6 +197,25 @@ Status RecordReader::Open(const std::string& path, const std::string& expected_p
   return Status::Ok();
 }
 
+namespace {
+
+// ParseDelimitedFromCodedStream after its length: parses exactly `size`
+// bytes of `coded` into `message`.
+bool ParseSized(uint32_t size, google::protobuf::Message* message,
+                pbio::CodedInputStream* coded) {
+  if (size > static_cast<uint32_t>(std::numeric_limits<int>::max())) return false;
+  const int start = coded->CurrentPosition();
+  const pbio::CodedInputStream::Limit limit = coded->PushLimit(static_cast<int>(size));
+  if (!message->MergePartialFromCodedStream(coded) || !coded->ConsumedEntireMessage() ||
+      coded->CurrentPosition() - start != static_cast<int>(size)) {
+    return false;
+  }
+  coded->PopLimit(limit);
+  return true;
+}
+
+}  // namespace
+
 Status RecordReader::Read(google::protobuf::Message* record, bool* end) {
   *end = false;
   if (at_end_) {
@@ -225,19 +244,6 @@ Status RecordReader::Read(google::protobuf::Message* record, bool* end) {
   }
   ++num_read_;
   return Status::Ok();
-}
-
-bool RecordReader::ParseSized(uint32_t size, google::protobuf::Message* message,
-                              pbio::CodedInputStream* coded) {
-  if (size > static_cast<uint32_t>(std::numeric_limits<int>::max())) return false;
-  const int start = coded->CurrentPosition();
-  const pbio::CodedInputStream::Limit limit = coded->PushLimit(static_cast<int>(size));
-  if (!message->MergePartialFromCodedStream(coded) || !coded->ConsumedEntireMessage() ||
-      coded->CurrentPosition() - start != static_cast<int>(size)) {
-    return false;
-  }
-  coded->PopLimit(limit);
-  return true;
 }
 
 Status RecordReader::ReadEndMark(pbio::CodedInputStream* coded) {

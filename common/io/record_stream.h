@@ -5,13 +5,16 @@
 #include <memory>
 #include <string>
 
-#include <google/protobuf/io/coded_stream.h>
 #include <google/protobuf/io/zero_copy_stream.h>
 #include <google/protobuf/message.h>
 
 #include "common/io/atomic_file.h"
 #include "common/status.h"
 #include "tiltcal/proto/stream.pb.h"
+
+namespace google::protobuf::io {
+class CodedInputStream;
+}  // namespace google::protobuf::io
 
 namespace tiltcal {
 
@@ -40,8 +43,8 @@ class RecordWriter {
   Status Write(const google::protobuf::Message& record);
   // Finish() and AtomicFile::Commit(): the stream appears at its path.
   Status Close();
-  // Writes the end mark and completes the stream under its temporary name (once; later calls do
-  // nothing), for CommitTogether({file(), ...}).
+  // Writes the end mark and completes the stream under its temporary name
+  // (once; later calls do nothing), for CommitTogether({file(), ...}).
   Status Finish();
   AtomicFile* file();
 
@@ -74,9 +77,6 @@ class RecordReader {
   int64_t num_records_read() const { return num_read_; }
 
  private:
-  // Parses exactly `size` bytes of `coded` into `message`.
-  static bool ParseSized(uint32_t size, google::protobuf::Message* message,
-                         google::protobuf::io::CodedInputStream* coded);
   // After the zero length: the StreamEnd, its count, and the end of the file.
   Status ReadEndMark(google::protobuf::io::CodedInputStream* coded);
   Status RecordError(const std::string& what) const;
