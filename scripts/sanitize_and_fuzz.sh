@@ -9,6 +9,7 @@
 #   scripts/sanitize_and_fuzz.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
+source scripts/phase_time.sh
 BUILD_DIR=${SANITIZE_BUILD_DIR:-build-sanitize}
 FUZZ_SECONDS=${FUZZ_SECONDS:-10}
 FUZZERS=(ros1_bag_reader_fuzzer record_stream_fuzzer text_proto_fuzzer point_cloud2_fuzzer
@@ -29,6 +30,7 @@ if [ ! -f "$BUILD_DIR/build.ninja" ]; then
 fi
 cmake --build "$BUILD_DIR" -j "$(nproc)" --target "${FUZZERS[@]}" "${TESTS[@]}" tiltcal_decode \
   tiltcal_inspect
+phase_done "sanitizer configure + build"
 
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
@@ -37,6 +39,7 @@ for t in "${TESTS[@]}"; do
     { tail -60 "$BUILD_DIR/tests/$t.log" >&2; echo "$t failed under the sanitizers" >&2; exit 1; }
   echo "$t: passed under ASan + UBSan"
 done
+phase_done "sanitizer tests"
 
 artifacts=$BUILD_DIR/fuzz-artifacts
 mkdir -p "$artifacts"
@@ -63,3 +66,4 @@ for fuzzer in "${FUZZERS[@]}"; do
   rm -rf "$corpus"
   echo "$fuzzer: $(grep -o 'Done [0-9]* runs in [0-9]* second(s)' "$log")"
 done
+phase_done fuzz

@@ -5,7 +5,9 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/build.sh -DTILTCAL_WERROR=ON
+source scripts/phase_time.sh
 (cd "${BUILD_DIR:-build}" && ctest --output-on-failure -j "$(nproc)" "$@")
+phase_done ctest
 # The parsers under ASan + UBSan and a few seconds of fuzzing each
 # (scripts/sanitize_and_fuzz.sh); SKIP_SANITIZERS=1 leaves them out.
 if [ "${SKIP_SANITIZERS:-0}" != 1 ]; then
