@@ -3,8 +3,10 @@
 //   MCAP:            @mcap/core McapWriter (+ @mcap/nodejs file handle),
 //                    chunks uncompressed, lz4 (lz4js frames) or zstd
 //                    (@foxglove/wasm-zstd), with or without the summary;
-//   rosbag2 sqlite3: better-sqlite3, the rosbag2 schema (topics, messages),
-//                    metadata.yaml beside the .db3 files;
+//   rosbag2 sqlite3: sql.js (the SQLite library compiled to WebAssembly, no
+//                    native build), the rosbag2 schema (topics, messages),
+//                    each database built in memory and written whole to its
+//                    .db3 file, metadata.yaml beside the .db3 files;
 //   CDR:             @foxglove/rosmsg2-serialization MessageWriter (little
 //                    endian), or @foxglove/cdr CdrWriter with the big-endian
 //                    encapsulation (the MessageWriter writes little endian only);
@@ -43,7 +45,7 @@ import path from "node:path";
 import { open } from "node:fs/promises";
 import readline from "node:readline";
 
-import Database from "better-sqlite3";
+import initSqlJs from "sql.js";
 import { CdrWriter, EncapsulationKind } from "@foxglove/cdr";
 import { McapWriter } from "@mcap/core";
 import { FileHandleWritable } from "@mcap/nodejs";
@@ -404,10 +406,12 @@ const QOS = "- history: 3\n  depth: 0\n  reliability: 1\n  durability: 2\n  dead
 
 // One .db3 of a rosbag2 folder: the rosbag2 schema, topics added as their
 // first message comes, ids counted down from 100 so that they do not line up
-// with the order of the names.
+// with the order of the names. sql.js keeps the database in memory; close()
+// writes its image (db.export()) to the file.
 class Db3File {
-  constructor(file) {
-    this.db = new Database(file);
+  constructor(SQL, file) {
+    this.file = file;
+    this.db = new SQL.Database();
     this.db.exec("CREATE TABLE schema(schema_version INTEGER PRIMARY KEY, ros_distro TEXT NOT NULL);" +
       "INSERT INTO schema VALUES (3, 'humble');" +
       "CREATE TABLE metadata(id INTEGER PRIMARY KEY, metadata_version INTEGER NOT NULL, metadata TEXT NOT NULL);" +
@@ -424,12 +428,17 @@ class Db3File {
   add(m, data) {
     if (!this.ids.has(m.topic)) {
       this.ids.set(m.topic, 100 - this.ids.size);
-      this.insertTopic.run(this.ids.get(m.topic), m.topic, m.type, QOS);
+      this.insertTopic.run([this.ids.get(m.topic), m.topic, m.type, QOS]);
     }
-    this.insertMessage.run(this.ids.get(m.topic), m.recordNs, Buffer.from(data));
+    // The record time as a BigInt (a 64-bit integer; ns since the epoch pass
+    // 2^53), the data as a Uint8Array (a blob).
+    this.insertMessage.run([this.ids.get(m.topic), m.recordNs, data]);
   }
   close() {
     this.db.exec("COMMIT");
+    this.insertTopic.free();
+    this.insertMessage.free();
+    fs.writeFileSync(this.file, this.db.export());
     this.db.close();
   }
 }
@@ -437,6 +446,7 @@ class Db3File {
 async function writeSqlite(args, messages, serialize, onMessage) {
   fs.rmSync(args.out, { recursive: true, force: true });
   fs.mkdirSync(args.out, { recursive: true });
+  const SQL = await initSqlJs();
   const base = path.basename(args.out);
   const topics = new Map();  // name -> {type, count}, in order of first message
   const files = [];
@@ -450,7 +460,7 @@ async function writeSqlite(args, messages, serialize, onMessage) {
     if (db === null || (args.split > 0 && inFile === args.split)) {
       if (db !== null) db.close();
       files.push(`${base}_${files.length}.db3`);
-      db = new Db3File(path.join(args.out, files[files.length - 1]));
+      db = new Db3File(SQL, path.join(args.out, files[files.length - 1]));
       inFile = 0;
     }
     db.add(m, serialize(m.type, m.msg));

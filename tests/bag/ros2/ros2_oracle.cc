@@ -105,7 +105,7 @@ void SplitImuLine(const std::string& line, std::string* text, std::vector<double
 std::string Ros2OracleMissing() {
   const std::string modules = SourceDir() + "/tests/node_modules";
   if (!FileExists(modules + "/@mcap/core/package.json") ||
-      !FileExists(modules + "/better-sqlite3/package.json") ||
+      !FileExists(modules + "/sql.js/package.json") ||
       !FileExists(modules + "/@foxglove/rosmsg-serialization/package.json")) {
     return "the npm oracles are not installed in " + modules + " (run scripts/setup.sh)";
   }
