@@ -16,10 +16,13 @@ PACKAGES=(
   clang libclang-rt-14-dev
 )
 
+# One dpkg-query for all of them (one per package took seconds on a loaded
+# machine).
+installed=$(dpkg-query -W -f='${Package} ${Status}\n' "${PACKAGES[@]}" 2>/dev/null |
+  awk '$2 == "install" && $3 == "ok" && $4 == "installed" { print $1 }' || true)
 missing=()
 for package in "${PACKAGES[@]}"; do
-  dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed" ||
-    missing+=("$package")
+  grep -qxF "$package" <<< "$installed" || missing+=("$package")
 done
 if [ ${#missing[@]} -ne 0 ]; then
   SUDO=""
@@ -32,13 +35,22 @@ if [ ${#missing[@]} -ne 0 ]; then
 fi
 
 # The npm packages of the ROS 2 test oracles (tests/oracle/write_ros2_bags.mjs),
-# pinned by tests/package-lock.json. npm ci only when the lock file changed
-# since the last install (npm records it as node_modules/.package-lock.json).
+# pinned by tests/package-lock.json; all are JavaScript or WebAssembly (sql.js
+# for the rosbag2 sqlite3 files), nothing is compiled. npm ci only when the
+# lock file differs from the one of the last install (its sha256 is kept in
+# node_modules/.tiltcal-lock.sha256). A node_modules that is a symlink (a git
+# worktree sharing another checkout's) is replaced by the worktree's own
+# install instead of being emptied through the link.
 TESTS_DIR="$(cd "$(dirname "${BASH_SOURCE[0]}")/../tests" && pwd)"
 if ! command -v npm >/dev/null; then
   echo "setup: no npm (Node 20): the ROS 2 bag tests will be skipped" >&2
-elif [ ! -f "$TESTS_DIR/node_modules/.package-lock.json" ] ||
-   [ "$TESTS_DIR/package-lock.json" -nt "$TESTS_DIR/node_modules/.package-lock.json" ]; then
-  echo "setup: npm ci in $TESTS_DIR" >&2
-  (cd "$TESTS_DIR" && npm ci --no-audit --no-fund --loglevel=error)
+else
+  lock_sum=$(sha256sum < "$TESTS_DIR/package-lock.json")
+  stamp=$TESTS_DIR/node_modules/.tiltcal-lock.sha256
+  if [ "$(cat "$stamp" 2>/dev/null)" != "$lock_sum" ]; then
+    echo "setup: npm ci in $TESTS_DIR" >&2
+    if [ -L "$TESTS_DIR/node_modules" ]; then rm "$TESTS_DIR/node_modules"; fi
+    (cd "$TESTS_DIR" && npm ci --no-audit --no-fund --loglevel=error)
+    echo "$lock_sum" > "$stamp"
+  fi
 fi
