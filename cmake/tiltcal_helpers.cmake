@@ -61,11 +61,14 @@ function(tiltcal_add_stage)
   tiltcal_set_target_options(tiltcal_${ARG_NAME})
 endfunction()
 
-# tiltcal_add_test(NAME SRCS ... DEPS ... [LABELS ...])
+# tiltcal_add_test(NAME SRCS ... DEPS ... [LABELS ...] [COST SECONDS])
 # One GoogleTest executable; every test case is registered with CTest. Tests
 # find the shared fixtures and the project tree through compile definitions.
+# COST: about the seconds of its slowest test case. ctest -j starts the tests
+# of highest cost first; a fresh build has no timings of an earlier run, and
+# without it the long tests declared last would run alone at the end.
 function(tiltcal_add_test)
-  cmake_parse_arguments(ARG "" "NAME" "SRCS;DEPS;LABELS" ${ARGN})
+  cmake_parse_arguments(ARG "" "NAME;COST" "SRCS;DEPS;LABELS" ${ARGN})
   add_executable(${ARG_NAME} ${ARG_SRCS})
   target_link_libraries(${ARG_NAME} PRIVATE ${ARG_DEPS} tiltcal_testing GTest::gtest GTest::gtest_main)
   set_target_properties(${ARG_NAME} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR}/tests)
@@ -73,8 +76,11 @@ function(tiltcal_add_test)
   if(NOT ARG_LABELS)
     set(ARG_LABELS unit)
   endif()
+  if(NOT ARG_COST)
+    set(ARG_COST 0)
+  endif()
   gtest_discover_tests(${ARG_NAME}
     WORKING_DIRECTORY ${PROJECT_BINARY_DIR}
-    PROPERTIES LABELS "${ARG_LABELS}"
+    PROPERTIES LABELS "${ARG_LABELS}" COST ${ARG_COST}
     DISCOVERY_TIMEOUT 60)
 endfunction()
