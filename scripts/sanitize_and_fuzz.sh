@@ -4,14 +4,17 @@
 # finding) and libFuzzer coverage, only what the I/O, bag and decode tests
 # and the fuzz harnesses need; runs those tests; then runs each harness for
 # FUZZ_SECONDS (default 10) from its committed seed corpus (fuzz/corpus/).
-# New inputs go to a temporary directory; a crash leaves its input as
-# crash-* in $BUILD_DIR/fuzz-artifacts/ and fails the script.
+# Tests and harnesses run JOBS (default: the number of cores) at a time; each
+# harness still gets its FUZZ_SECONDS. New inputs go to a temporary
+# directory; a crash leaves its input as crash-* in $BUILD_DIR/fuzz-artifacts/
+# and fails the script.
 #   scripts/sanitize_and_fuzz.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source scripts/phase_time.sh
 BUILD_DIR=${SANITIZE_BUILD_DIR:-build-sanitize}
 FUZZ_SECONDS=${FUZZ_SECONDS:-10}
+JOBS=${JOBS:-$(nproc)}
 FUZZERS=(ros1_bag_reader_fuzzer record_stream_fuzzer text_proto_fuzzer point_cloud2_fuzzer
          cdr_messages_fuzzer mcap_reader_fuzzer sqlite_bag_reader_fuzzer
          rosbag2_metadata_fuzzer)
@@ -34,8 +37,28 @@ phase_done "sanitizer configure + build"
 
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+status_dir=$(mktemp -d)
+trap 'rm -rf "$status_dir"' EXIT
+
+# run_jobs FUNC ITEM...: FUNC ITEM for every ITEM in the background, JOBS at
+# a time; the exit status of each goes to $status_dir/ITEM.
+run_jobs() {
+  local func=$1 item
+  shift
+  for item in "$@"; do
+    while [ "$(jobs -rp | wc -l)" -ge "$JOBS" ]; do wait -n || true; done
+    ( status=0; "$func" "$item" || status=$?; echo "$status" > "$status_dir/$item" ) &
+  done
+  wait
+}
+passed() { [ "$(cat "$status_dir/$1")" = 0 ]; }
+
+sanitized_test() {
+  cd "$BUILD_DIR" && "tests/$1" --gtest_brief=1 > "tests/$1.log" 2>&1
+}
+run_jobs sanitized_test "${TESTS[@]}"
 for t in "${TESTS[@]}"; do
-  (cd "$BUILD_DIR" && "tests/$t" --gtest_brief=1 > "tests/$t.log" 2>&1) ||
+  passed "$t" ||
     { tail -60 "$BUILD_DIR/tests/$t.log" >&2; echo "$t failed under the sanitizers" >&2; exit 1; }
   echo "$t: passed under ASan + UBSan"
 done
@@ -43,27 +66,35 @@ phase_done "sanitizer tests"
 
 artifacts=$BUILD_DIR/fuzz-artifacts
 mkdir -p "$artifacts"
-for fuzzer in "${FUZZERS[@]}"; do
+fuzz() {
+  local fuzzer=$1 corpus fixture status=0
   corpus=$(mktemp -d)
-  log=$artifacts/${fuzzer}.log
   # The ROS 2 talker fixtures seed the ROS 2 readers when ../shared is there
   # (they are read in place, never copied into fuzz/corpus/).
-  seeds=("fuzz/corpus/${fuzzer%_fuzzer}")
+  local seeds=("fuzz/corpus/${fuzzer%_fuzzer}")
   case $fuzzer in
     mcap_reader_fuzzer) fixture=../shared/fixtures/bags/ros2/mcap_talker ;;
     sqlite_bag_reader_fuzzer | rosbag2_metadata_fuzzer) fixture=../shared/fixtures/bags/ros2/sqlite3_talker ;;
     *) fixture= ;;
   esac
   if [ -n "$fixture" ] && [ -d "$fixture" ]; then seeds+=("$fixture"); fi
-  if ! "$BUILD_DIR/bin/$fuzzer" -max_total_time="$FUZZ_SECONDS" -rss_limit_mb=2048 \
-      -timeout=10 -artifact_prefix="$artifacts/" "$corpus" "${seeds[@]}" \
-      > "$log" 2>&1; then
-    rm -rf "$corpus"
+  "$BUILD_DIR/bin/$fuzzer" -max_total_time="$FUZZ_SECONDS" -rss_limit_mb=2048 \
+    -timeout=10 -artifact_prefix="$artifacts/" "$corpus" "${seeds[@]}" \
+    > "$artifacts/$fuzzer.log" 2>&1 || status=$?
+  rm -rf "$corpus"
+  return "$status"
+}
+run_jobs fuzz "${FUZZERS[@]}"
+findings=0
+for fuzzer in "${FUZZERS[@]}"; do
+  log=$artifacts/${fuzzer}.log
+  if ! passed "$fuzzer"; then
     tail -40 "$log" >&2
     echo "$fuzzer: a finding (input in $artifacts/)" >&2
-    exit 1
+    findings=1
+    continue
   fi
-  rm -rf "$corpus"
   echo "$fuzzer: $(grep -o 'Done [0-9]* runs in [0-9]* second(s)' "$log")"
 done
+[ "$findings" = 0 ] || exit 1
 phase_done fuzz
