@@ -226,10 +226,12 @@ Status RunOuterRound(const OuterLoopSetup& setup, CalibrationState* state, Outer
   Log(log, fmt::format("outer {}: {} surfels, {} lidar residuals, cost {:.4g} -> {:.4g}", round,
                        assoc.map.num_surfels, assoc.residuals, summary.initial_cost,
                        summary.final_cost));
+  const Eigen::Quaterniond q = state->ImuFromLidarRotation();
   Log(log, fmt::format("outer {}: {} LM iterations in {:.2f} s; tau {:.3f} ms; r_bl ({:.4f}, "
-                       "{:.4f}, {:.4f}) m",
+                       "{:.4f}, {:.4f}) m; q_bl (w {:.7f}, x {:.7f}, y {:.7f}, z {:.7f})",
                        round, static_cast<int>(summary.iterations.size()) - 1, solve_seconds,
-                       state->time_offset_s[0] * 1e3, r.x(), r.y(), r.z()));
+                       state->time_offset_s[0] * 1e3, r.x(), r.y(), r.z(), q.w(), q.x(), q.y(),
+                       q.z()));
   loop->rounds = round;
   loop->moved_deg =
       Eigen::AngleAxisd(rotation_before.conjugate() * state->ImuFromLidarRotation()).angle() *
@@ -443,10 +445,13 @@ Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& pa
       &ground_adder, &ground_used, &ground_reason));
   Log(log, ground_reason);
 
+  SolverSettings solver_settings;
+  solver_settings.max_iterations = static_cast<int>(params.solver().max_iterations());
+  solver_settings.num_threads = static_cast<int>(params.num_threads());
+  solver_settings.function_tolerance = params.solver().function_tolerance();
+  solver_settings.initial_trust_region_radius = params.solver().initial_trust_region_radius();
   OuterLoopSetup setup{inputs, params, ground_adder, ProblemOptions(),
-                       MakeSolverOptions(static_cast<int>(params.solver().max_iterations()),
-                                         static_cast<int>(params.num_threads()),
-                                         params.solver().function_tolerance()),
+                       MakeSolverOptions(solver_settings),
                        init.rotation_axis_b.normalized(),
                        std::find(ground_used.begin(), ground_used.end(), "dist") !=
                            ground_used.end()};

@@ -102,9 +102,12 @@ double RmsResidual(const ceres::Solver::Summary& summary) {
 
 // LM on one of the initial fits; returns the RMS weighted residual.
 double SolveFit(const proto::CalibrateParams& params, ceres::Problem* problem) {
-  const ceres::Solver::Options solver =
-      MakeSolverOptions(static_cast<int>(params.init().solver_iterations()),
-                        static_cast<int>(params.num_threads()), params.init().function_tolerance());
+  SolverSettings settings;
+  settings.max_iterations = static_cast<int>(params.init().solver_iterations());
+  settings.num_threads = static_cast<int>(params.num_threads());
+  settings.function_tolerance = params.init().function_tolerance();
+  settings.initial_trust_region_radius = params.init().solver_initial_trust_region_radius();
+  const ceres::Solver::Options solver = MakeSolverOptions(settings);
   ceres::Solver::Summary summary;
   ceres::Solve(solver, problem, &summary);
   return RmsResidual(summary);

@@ -235,15 +235,19 @@ const ProblemCounts& CalibrationProblem::counts() {
   return counts_;
 }
 
-ceres::Solver::Options MakeSolverOptions(int max_iterations, int num_threads,
-                                         double function_tolerance) {
+ceres::Solver::Options MakeSolverOptions(const SolverSettings& settings) {
   ceres::Solver::Options options;
   options.minimizer_type = ceres::TRUST_REGION;
   options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
   options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
-  options.max_num_iterations = std::max(1, max_iterations);
-  options.num_threads = std::max(1, num_threads);
-  if (function_tolerance > 0.0) options.function_tolerance = function_tolerance;
+  options.max_num_iterations = std::max(1, settings.max_iterations);
+  options.num_threads = std::max(1, settings.num_threads);
+  if (settings.function_tolerance > 0.0) options.function_tolerance = settings.function_tolerance;
+  if (settings.initial_trust_region_radius > 0.0) {
+    options.initial_trust_region_radius = settings.initial_trust_region_radius;
+    options.max_trust_region_radius =
+        std::max(options.max_trust_region_radius, settings.initial_trust_region_radius);
+  }
   options.logging_type = ceres::SILENT;
   options.minimizer_progress_to_stdout = false;
   return options;

@@ -166,10 +166,17 @@ class CalibrationProblem {
   std::vector<char> position_used_;
 };
 
+// What the params set of one LM solve.
+struct SolverSettings {
+  int max_iterations = 1;
+  int num_threads = 1;
+  double function_tolerance = 0.0;          // 0: Ceres' default
+  double initial_trust_region_radius = 0.0;  // 0: Ceres' default
+};
+
 // Solver settings of the calibrator: LM, SPARSE_NORMAL_CHOLESKY (no Schur
-// solvers), the given threads and iteration cap.
-ceres::Solver::Options MakeSolverOptions(int max_iterations, int num_threads,
-                                         double function_tolerance);
+// solvers) and the given settings.
+ceres::Solver::Options MakeSolverOptions(const SolverSettings& settings);
 
 // Re-expresses the state in the gauge C_ab(t0) = 1, r_a^{ba}(t0) = 0 with
 // t0 = grid start: with G = C_ab(t0)^T and p0 = r_a^{ba}(t0), every rotation

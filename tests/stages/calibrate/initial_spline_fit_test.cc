@@ -275,7 +275,7 @@ double WorstGyroBiasSegmentError(double segment_s, const Eigen::Vector3d& gyro_b
   EXPECT_TRUE(status.ok());
   problem.RemoveUnusedKnots();
   ceres::Solver::Summary summary;
-  ceres::Solve(MakeSolverOptions(30, 2, 1e-10), problem.problem(), &summary);
+  ceres::Solve(MakeSolverOptions(SolverSettings{30, 2, 1e-10}), problem.problem(), &summary);
   return WorstBiasError(state.gyro_bias, gyro_bias, drift);
 }
 
