@@ -115,6 +115,22 @@ TEST(ProblemBuilderTest, GaugeFixesTheFirstKnotsAndTauIsBounded) {
   EXPECT_DOUBLE_EQ(clamped.time_offset_lower_s(), 0.025);
 }
 
+// IMU-only problems: weights 1/0.01 rad/s and 1/0.05 m/s^2.
+proto::CalibrateParams ImuOnlyParams() {
+  return testing::DefaultCalibrateParamsWith(
+      "imu_noise { gyro_sigma_radps: 0.01 accel_sigma_mps2: 0.05 }");
+}
+
+// Gravity and biases held (IMU only, a free b_a trades with the motion).
+ProblemOptions ImuOnlyProblemOptions(const proto::CalibrateParams& params) {
+  ProblemOptions options;
+  options.time_offset_bound_s = params.time_offset_bound_s();
+  options.time_offset_step_bound_s = params.outer_loop().time_offset_step_bound_s();
+  options.estimate_gravity = false;
+  options.estimate_biases = false;
+  return options;
+}
+
 TEST(ProblemBuilderTest, ImuOnlyProblemKeepsTheTruthAndDropsUnusedBlocks) {
   CalibrationState truth = MakeState(1.0);
   const std::vector<imu::ImuReading> imu = ImuFromState(truth, 1.0);
@@ -124,14 +140,8 @@ TEST(ProblemBuilderTest, ImuOnlyProblemKeepsTheTruthAndDropsUnusedBlocks) {
     state.trajectory.SetPositionKnot(i, state.trajectory.PositionKnot(i) +
                                             Eigen::Vector3d(0.01, -0.02, 0.005));
   }
-  // IMU-only, weights 1/0.01 rad/s and 1/0.05 m/s^2.
-  const proto::CalibrateParams params = testing::DefaultCalibrateParamsWith(
-      "imu_noise { gyro_sigma_radps: 0.01 accel_sigma_mps2: 0.05 }");
-  ProblemOptions options;
-  options.time_offset_bound_s = params.time_offset_bound_s();
-  options.time_offset_step_bound_s = params.outer_loop().time_offset_step_bound_s();
-  options.estimate_gravity = false;
-  options.estimate_biases = false;  // IMU-only: a free b_a trades with the motion
+  const proto::CalibrateParams params = ImuOnlyParams();
+  const ProblemOptions options = ImuOnlyProblemOptions(params);
   CalibrationProblem problem(&state, params.imu_noise(), params.lidar(), options);
   problem.AddImuResiduals(imu, true, true);
   problem.RemoveUnusedKnots();
@@ -178,13 +188,8 @@ TEST(ProblemBuilderTest, LargeInitialTrustRegionReachesTheSameMinimumInFewerIter
             Eigen::Quaterniond(Eigen::AngleAxisd(0.02 * std::cos(i), Eigen::Vector3d::UnitZ())))
                .normalized());
   }
-  const proto::CalibrateParams params = testing::DefaultCalibrateParamsWith(
-      "imu_noise { gyro_sigma_radps: 0.01 accel_sigma_mps2: 0.05 }");
-  ProblemOptions options;
-  options.time_offset_bound_s = params.time_offset_bound_s();
-  options.time_offset_step_bound_s = params.outer_loop().time_offset_step_bound_s();
-  options.estimate_gravity = false;
-  options.estimate_biases = false;
+  const proto::CalibrateParams params = ImuOnlyParams();
+  const ProblemOptions options = ImuOnlyProblemOptions(params);
   // Returns the iterations; *cost the final cost.
   auto solve = [&](double radius, CalibrationState* state, double* cost) {
     CalibrationProblem problem(state, params.imu_noise(), params.lidar(), options);
