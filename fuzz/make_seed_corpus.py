@@ -59,7 +59,7 @@ def xxh32(data, seed=0):
 
 def stored_lz4_frame(data, checksum, block=256 * 1024):
     """One LZ4 frame of stored (uncompressed) independent blocks, as the
-    decode stage writes scans with scans_output.compress_blocks false."""
+    decode stage writes scans with scans_output.store_blocks true."""
     flg = 0x60 | (0x04 if checksum else 0)
     descriptor = bytes([flg, 0x50])
     out = b'\x04\x22\x4d\x18' + descriptor + bytes([(xxh32(descriptor) >> 8) & 0xff])

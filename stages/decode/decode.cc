@@ -333,8 +333,8 @@ Status Decode(const DecodePaths& paths, const proto::DecodeParams& params, std::
   // flight.
   AsyncRecordWriter scans_writer(proto::Scan::default_instance(), 4);
   Lz4FrameOptions scans_frame;
-  scans_frame.compress_blocks = params.scans_output().compress_blocks();
-  scans_frame.content_checksum = params.scans_output().content_checksum();
+  scans_frame.compress_blocks = !params.scans_output().store_blocks();
+  scans_frame.content_checksum = !params.scans_output().omit_content_checksum();
   TILTCAL_RETURN_IF_ERROR(scans_writer.Open(
       paths.out_scans, proto::Scan::descriptor()->full_name(), provenance, scans_frame));
   ImuSink imu(paths.bag, reader.MessageCount(s.imu_topic));
