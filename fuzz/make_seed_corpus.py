@@ -27,6 +27,51 @@ HARNESSES = ('ros1_bag_reader', 'record_stream', 'text_proto', 'point_cloud2', '
              'mcap_reader', 'sqlite_bag_reader', 'rosbag2_metadata')
 
 
+def xxh32(data, seed=0):
+    """XXH32 (xxHash specification), the checksum of LZ4 frames."""
+    p1, p2, p3, p4, p5 = 2654435761, 2246822519, 3266489917, 668265263, 374761393
+    mask = 0xffffffff
+    rotl = lambda x, r: ((x << r) | (x >> (32 - r))) & mask
+    n, i = len(data), 0
+    if n >= 16:
+        v = [(seed + p1 + p2) & mask, (seed + p2) & mask, seed, (seed - p1) & mask]
+        while i + 16 <= n:
+            for k in range(4):
+                lane = struct.unpack_from('<I', data, i + 4 * k)[0]
+                v[k] = (rotl((v[k] + lane * p2) & mask, 13) * p1) & mask
+            i += 16
+        acc = (rotl(v[0], 1) + rotl(v[1], 7) + rotl(v[2], 12) + rotl(v[3], 18)) & mask
+    else:
+        acc = (seed + p5) & mask
+    acc = (acc + n) & mask
+    while i + 4 <= n:
+        acc = (rotl((acc + struct.unpack_from('<I', data, i)[0] * p3) & mask, 17) * p4) & mask
+        i += 4
+    while i < n:
+        acc = (rotl((acc + data[i] * p5) & mask, 11) * p1) & mask
+        i += 1
+    acc ^= acc >> 15
+    acc = (acc * p2) & mask
+    acc ^= acc >> 13
+    acc = (acc * p3) & mask
+    return acc ^ (acc >> 16)
+
+
+def stored_lz4_frame(data, checksum, block=256 * 1024):
+    """One LZ4 frame of stored (uncompressed) independent blocks, as the
+    decode stage writes scans with scans_output.store_blocks true."""
+    flg = 0x60 | (0x04 if checksum else 0)
+    descriptor = bytes([flg, 0x50])
+    out = b'\x04\x22\x4d\x18' + descriptor + bytes([(xxh32(descriptor) >> 8) & 0xff])
+    for start in range(0, len(data), block):
+        piece = data[start:start + block]
+        out += struct.pack('<I', len(piece) | 0x80000000) + piece
+    out += struct.pack('<I', 0)
+    if checksum:
+        out += struct.pack('<I', xxh32(data))
+    return out
+
+
 def varint(n):
     out = b''
     while True:
@@ -212,6 +257,16 @@ def write_ros2_seeds():
         '  compression_format: ""\n  compression_mode: ""\n')
 
 
+def write_stored_frames(streams):
+    """The scans seed in LZ4 frames of stored blocks, with and without the
+    content checksum (decode params scans_output)."""
+    plain = open(os.path.join(streams, 'scans.binpb'), 'rb').read()
+    open(os.path.join(streams, 'scans.stored.binpb.lz4'), 'wb').write(
+        stored_lz4_frame(plain, True))
+    open(os.path.join(streams, 'scans.stored_no_checksum.binpb.lz4'), 'wb').write(
+        stored_lz4_frame(plain, False))
+
+
 def main():
     shutil.rmtree(CORPUS, ignore_errors=True)
     for harness in HARNESSES:
@@ -228,6 +283,7 @@ def main():
         path = os.path.join(streams, name)
         open(path, 'wb').write(stream(payload, records))
         subprocess.run(['lz4', '-q', '-f', '-B4', path, path + '.lz4'], check=True)
+    write_stored_frames(streams)
 
     texts = os.path.join(CORPUS, 'text_proto')
     for stage in ('calibrate', 'decode'):

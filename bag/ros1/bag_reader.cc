@@ -6,8 +6,12 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <condition_variable>
 #include <cstring>
+#include <deque>
+#include <mutex>
 #include <set>
+#include <thread>
 #include <tuple>
 #include <unordered_map>
 
@@ -52,6 +56,10 @@ class ByteBuffer {
     return data_.get();
   }
   uint8_t* data() { return data_.get(); }
+  void Swap(ByteBuffer* other) {
+    std::swap(data_, other->data_);
+    std::swap(capacity_, other->capacity_);
+  }
 
  private:
   std::unique_ptr<uint8_t[]> data_;
@@ -106,10 +114,95 @@ Status BagReader::ParseChunkHeader(const RecordHeader& header, Chunk* chunk) {
   return Status::Ok();
 }
 
+// Reads and decompresses chunks on its own thread, in a fixed order (the
+// order in which ReadMessages first needs them), at most `depth` ahead of the
+// one taken last. Each load is the same LoadChunk, with its own decompressor
+// and compressed-bytes buffer.
+class BagReader::ChunkReadAhead {
+ public:
+  ChunkReadAhead(const BagReader* reader, std::vector<uint32_t> order, size_t depth)
+      : reader_(reader), order_(std::move(order)), depth_(std::max<size_t>(depth, 1)) {
+    thread_ = std::thread([this] { Work(); });
+  }
+  ~ChunkReadAhead() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      stopping_ = true;
+    }
+    changed_.notify_all();
+    thread_.join();
+  }
+  ChunkReadAhead(const ChunkReadAhead&) = delete;
+  ChunkReadAhead& operator=(const ChunkReadAhead&) = delete;
+
+  // When `chunk` is the next chunk of the order, waits until it is loaded,
+  // swaps its bytes into *buffer (the old bytes of *buffer are reused for a
+  // later chunk), sets *status to the load's result and returns true. Any
+  // other chunk (one needed again after the cache evicted it): false.
+  bool Take(uint32_t chunk, ByteBuffer* buffer, Status* status) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    if (next_take_ >= order_.size() || order_[next_take_] != chunk) return false;
+    changed_.wait(lock, [this] { return !ready_.empty(); });
+    Loaded& loaded = ready_.front();
+    buffer->Swap(&loaded.buffer);
+    *status = std::move(loaded.status);
+    spare_.push_back(std::move(loaded.buffer));
+    ready_.pop_front();
+    ++next_take_;
+    changed_.notify_all();
+    return true;
+  }
+
+ private:
+  struct Loaded {
+    ByteBuffer buffer;
+    Status status;
+  };
+
+  void Work() {
+    ChunkDecompressor decompressor;
+    std::vector<uint8_t> compressed;
+    for (size_t next = 0; next < order_.size(); ++next) {
+      ByteBuffer buffer;
+      {
+        std::unique_lock<std::mutex> lock(mutex_);
+        changed_.wait(lock, [this] { return stopping_ || ready_.size() < depth_; });
+        if (stopping_) return;
+        if (!spare_.empty()) {
+          buffer.Swap(&spare_.back());
+          spare_.pop_back();
+        }
+      }
+      const uint32_t chunk = order_[next];
+      uint8_t* dst = buffer.Reserve(std::max<size_t>(reader_->chunks_[chunk].size, 1));
+      Status status = reader_->LoadChunkWith(chunk, &decompressor, &compressed, dst);
+      const bool failed = !status.ok();
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        ready_.push_back(Loaded{std::move(buffer), std::move(status)});
+      }
+      changed_.notify_all();
+      if (failed) return;  // the caller stops at this error
+    }
+  }
+
+  const BagReader* reader_;
+  const std::vector<uint32_t> order_;
+  const size_t depth_;
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  std::deque<Loaded> ready_;   // loaded chunks order_[next_take_], ... in order
+  std::vector<ByteBuffer> spare_;
+  size_t next_take_ = 0;
+  bool stopping_ = false;
+  std::thread thread_;
+};
+
 // LRU cache of decompressed chunks, keyed by chunk index.
 class BagReader::ChunkCache {
  public:
-  explicit ChunkCache(size_t capacity) : slots_(std::max<size_t>(capacity, 1)) {}
+  ChunkCache(size_t capacity, ChunkReadAhead* read_ahead)
+      : slots_(std::max<size_t>(capacity, 1)), read_ahead_(read_ahead) {}
 
   // The decompressed bytes of chunk `chunk`, loading it on a miss.
   Status Get(BagReader* reader, uint32_t chunk, const uint8_t** data) {
@@ -124,11 +217,17 @@ class BagReader::ChunkCache {
       if (slot.last_use < victim->last_use) victim = &slot;
     }
     victim->chunk = -1;
-    uint8_t* dst = victim->buffer.Reserve(std::max<size_t>(reader->chunks_[chunk].size, 1));
-    TILTCAL_RETURN_IF_ERROR(reader->LoadChunk(chunk, &compressed_, dst));
+    Status taken;
+    if (read_ahead_ != nullptr && read_ahead_->Take(chunk, &victim->buffer, &taken)) {
+      reader->CountChunkLoad(chunk);
+      TILTCAL_RETURN_IF_ERROR(taken);
+    } else {
+      uint8_t* dst = victim->buffer.Reserve(std::max<size_t>(reader->chunks_[chunk].size, 1));
+      TILTCAL_RETURN_IF_ERROR(reader->LoadChunk(chunk, &compressed_, dst));
+    }
     victim->chunk = chunk;
     victim->last_use = clock_;
-    *data = dst;
+    *data = victim->buffer.data();
     return Status::Ok();
   }
 
@@ -139,6 +238,7 @@ class BagReader::ChunkCache {
     ByteBuffer buffer;
   };
   std::vector<Slot> slots_;
+  ChunkReadAhead* read_ahead_;
   std::vector<uint8_t> compressed_;
   uint64_t clock_ = 0;
 };
@@ -478,11 +578,21 @@ Status BagReader::ReadChunkIndex(size_t chunk_index, const std::vector<size_t>& 
   return Status::Ok();
 }
 
-Status BagReader::LoadChunk(size_t chunk_index, std::vector<uint8_t>* compressed, uint8_t* dst) {
+void BagReader::CountChunkLoad(size_t chunk_index) {
   const Chunk& chunk = chunks_[chunk_index];
   stats_.chunks_decompressed += 1;
   stats_.compressed_bytes_read += chunk.data_len;
   stats_.uncompressed_bytes += chunk.size;
+}
+
+Status BagReader::LoadChunk(size_t chunk_index, std::vector<uint8_t>* compressed, uint8_t* dst) {
+  CountChunkLoad(chunk_index);
+  return LoadChunkWith(chunk_index, &decompressor_, compressed, dst);
+}
+
+Status BagReader::LoadChunkWith(size_t chunk_index, ChunkDecompressor* decompressor,
+                                std::vector<uint8_t>* compressed, uint8_t* dst) const {
+  const Chunk& chunk = chunks_[chunk_index];
   if (chunk.compression == ChunkCompression::kNone) {
     if (chunk.data_len != chunk.size) {
       return Error(chunk.pos, "uncompressed chunk of size " + std::to_string(chunk.size) +
@@ -492,7 +602,7 @@ Status BagReader::LoadChunk(size_t chunk_index, std::vector<uint8_t>* compressed
   }
   if (compressed->size() < chunk.data_len) compressed->resize(chunk.data_len);
   TILTCAL_RETURN_IF_ERROR(ReadAt(chunk.data_pos, chunk.data_len, compressed->data()));
-  Status status = decompressor_.Decompress(chunk.compression, compressed->data(),
+  Status status = decompressor->Decompress(chunk.compression, compressed->data(),
                                            chunk.data_len, dst, chunk.size);
   if (!status.ok()) {
     return Error(chunk.pos, std::string(ChunkCompressionName(chunk.compression)) +
@@ -786,7 +896,24 @@ Status BagReader::ReadMessages(const ReadOptions& options,
   TILTCAL_RETURN_IF_ERROR(LoadEntries(slots));
   const std::vector<Item> items = MergedItems(slots, options);
 
-  ChunkCache cache(options.chunk_cache_size);
+  std::unique_ptr<ChunkReadAhead> read_ahead;
+  if (options.read_ahead_chunks > 0) {
+    // The chunks in the order of their first use; later uses hit the cache
+    // (or, after an eviction, load on this thread).
+    std::vector<uint32_t> order;
+    std::vector<bool> seen(chunks_.size(), false);
+    for (const Item& item : items) {
+      if (!seen[item.chunk]) {
+        seen[item.chunk] = true;
+        order.push_back(item.chunk);
+      }
+    }
+    if (order.size() > 1) {
+      read_ahead =
+          std::make_unique<ChunkReadAhead>(this, std::move(order), options.read_ahead_chunks);
+    }
+  }
+  ChunkCache cache(options.chunk_cache_size, read_ahead.get());
   MessageView view;
   for (size_t i = 0; i < items.size(); ++i) {
     const Item& item = items[i];

@@ -12,6 +12,9 @@
 // (sorted by (time, chunk_pos, offset), so chunks may be out of time order),
 // decompressing chunks on demand into a small LRU cache: memory is bounded by
 // cache_size chunks plus 16 bytes per selected message, whatever the bag size.
+// With read_ahead_chunks > 0 a second thread reads and decompresses the next
+// chunks (in the order of their first use) while the messages of the current
+// one are handed out, at most that many ahead.
 // The file is read with pread(); nothing is memory-mapped.
 
 #include <cstdint>
@@ -56,6 +59,9 @@ struct ReadOptions {
   int64_t end_ns = INT64_MAX;
   // Decompressed chunks kept in memory.
   size_t chunk_cache_size = 8;
+  // Chunks read and decompressed ahead on a second thread (0: none, every
+  // chunk is loaded on the calling thread when first needed).
+  size_t read_ahead_chunks = 0;
 };
 
 // Counters of a reader, for summaries and tests.
@@ -159,8 +165,14 @@ class BagReader {
   void AddSalvagedEntry(uint32_t conn, RosTime time, uint32_t chunk, uint32_t offset);
   Status AddConnection(const RecordHeader& header, const uint8_t* data, size_t size,
                        uint64_t pos);
+  class ChunkReadAhead;
   // Loads chunk `chunk_index` decompressed into `dst` (sized to the chunk size).
   Status LoadChunk(size_t chunk_index, std::vector<uint8_t>* compressed, uint8_t* dst);
+  // LoadChunk with a decompressor of the caller, without counting it in the
+  // stats (safe on another thread: reads the file with pread only).
+  Status LoadChunkWith(size_t chunk_index, ChunkDecompressor* decompressor,
+                       std::vector<uint8_t>* compressed, uint8_t* dst) const;
+  void CountChunkLoad(size_t chunk_index);
   int ConnectionSlot(uint32_t id) const;
 
   std::string path_;

@@ -36,11 +36,24 @@ RecordWriter::~RecordWriter() = default;
 
 Status RecordWriter::Open(const std::string& path, const std::string& payload_type,
                           const proto::Provenance& provenance, bool compress) {
+  const Lz4FrameOptions lz4_options;
+  return OpenImpl(path, payload_type, provenance, compress ? &lz4_options : nullptr);
+}
+
+Status RecordWriter::Open(const std::string& path, const std::string& payload_type,
+                          const proto::Provenance& provenance,
+                          const Lz4FrameOptions& lz4_options) {
+  return OpenImpl(path, payload_type, provenance, &lz4_options);
+}
+
+Status RecordWriter::OpenImpl(const std::string& path, const std::string& payload_type,
+                              const proto::Provenance& provenance,
+                              const Lz4FrameOptions* lz4_options) {
   impl_ = std::make_unique<Impl>();
   num_records_ = 0;
   TILTCAL_RETURN_IF_ERROR(impl_->file.Open(path));
-  if (compress) {
-    impl_->lz4 = std::make_unique<Lz4FrameOutput>(impl_->file.file());
+  if (lz4_options != nullptr) {
+    impl_->lz4 = std::make_unique<Lz4FrameOutput>(impl_->file.file(), *lz4_options);
     // One LZ4 block (256 KiB) per Write(): liblz4 then compresses straight
     // from this buffer instead of first copying the input into its own.
     impl_->lz4_adaptor = std::make_unique<pbio::CopyingOutputStreamAdaptor>(

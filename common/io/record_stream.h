@@ -9,6 +9,7 @@
 #include <google/protobuf/message.h>
 
 #include "common/io/atomic_file.h"
+#include "common/io/lz4_stream.h"
 #include "common/status.h"
 #include "tiltcal/proto/stream.pb.h"
 
@@ -38,6 +39,9 @@ class RecordWriter {
   // stream in an LZ4 frame.
   Status Open(const std::string& path, const std::string& payload_type,
               const proto::Provenance& provenance, bool compress);
+  // The stream wrapped in one LZ4 frame built as `lz4_options` say.
+  Status Open(const std::string& path, const std::string& payload_type,
+              const proto::Provenance& provenance, const Lz4FrameOptions& lz4_options);
   // An empty record (one that serialises to zero bytes) is an error: a zero
   // length marks the end of the stream.
   Status Write(const google::protobuf::Message& record);
@@ -51,6 +55,8 @@ class RecordWriter {
   int64_t num_records() const { return num_records_; }
 
  private:
+  Status OpenImpl(const std::string& path, const std::string& payload_type,
+                  const proto::Provenance& provenance, const Lz4FrameOptions* lz4_options);
   class Impl;
   std::unique_ptr<Impl> impl_;
   int64_t num_records_ = 0;

@@ -75,11 +75,11 @@ Status OpenWith(std::unique_ptr<Reader> r, const std::string& path,
 // Opens every file of `files` (each by its first bytes) and merges them;
 // a single file is opened alone.
 Status OpenFiles(const std::string& path, const std::vector<std::string>& files,
-                 size_t chunk_cache_size, std::unique_ptr<bag::MessageReader>* reader) {
-  if (files.size() == 1) return OpenBagFile(files[0], chunk_cache_size, reader);
+                 const Ros1ChunkSettings& ros1_chunks, std::unique_ptr<bag::MessageReader>* reader) {
+  if (files.size() == 1) return OpenBagFile(files[0], ros1_chunks, reader);
   std::vector<std::unique_ptr<bag::MessageReader>> readers(files.size());
   for (size_t i = 0; i < files.size(); ++i) {
-    TILTCAL_RETURN_IF_ERROR(OpenBagFile(files[i], chunk_cache_size, &readers[i]));
+    TILTCAL_RETURN_IF_ERROR(OpenBagFile(files[i], ros1_chunks, &readers[i]));
   }
   auto merged = std::make_unique<bag::MergedMessageReader>();
   TILTCAL_RETURN_IF_ERROR(merged->Open(path, std::move(readers)));
@@ -112,11 +112,11 @@ SensorTypes SensorTypesOf(const bag::MessageReader& reader) {
   return ros2_types;
 }
 
-Status OpenBagInput(const std::string& path, size_t chunk_cache_size,
+Status OpenBagInput(const std::string& path, const Ros1ChunkSettings& ros1_chunks,
                     std::unique_ptr<bag::MessageReader>* reader) {
   std::error_code ec;
   const fs::path p(path);
-  if (!fs::is_directory(p, ec)) return OpenBagFile(path, chunk_cache_size, reader);
+  if (!fs::is_directory(p, ec)) return OpenBagFile(path, ros1_chunks, reader);
   const fs::path metadata = p / "metadata.yaml";
   if (!fs::exists(metadata, ec)) {
     const std::vector<std::string> files = BagFilesIn(p);
@@ -124,7 +124,7 @@ Status OpenBagInput(const std::string& path, size_t chunk_cache_size,
       return Status::Error(path + ": a folder with neither metadata.yaml nor bag files; expected " +
                            kShapes);
     }
-    return OpenFiles(path, files, chunk_cache_size, reader);
+    return OpenFiles(path, files, ros1_chunks, reader);
   }
   std::string storage;
   std::vector<std::string> relative_files;
@@ -137,7 +137,7 @@ Status OpenBagInput(const std::string& path, size_t chunk_cache_size,
     for (const std::string& f : relative_files) {
       files.push_back((p / fs::path(f).filename()).string());
     }
-    return OpenFiles(path, files, chunk_cache_size, reader);
+    return OpenFiles(path, files, ros1_chunks, reader);
   }
   if (!storage.empty() && storage != "sqlite3") {
     return Status::Error(metadata.string() + ": storage_identifier '" + storage +
@@ -146,7 +146,7 @@ Status OpenBagInput(const std::string& path, size_t chunk_cache_size,
   return OpenWith(std::make_unique<ros2::SqliteBagReader>(), path, reader);
 }
 
-Status OpenBagFile(const std::string& path, size_t chunk_cache_size,
+Status OpenBagFile(const std::string& path, const Ros1ChunkSettings& ros1_chunks,
                    std::unique_ptr<bag::MessageReader>* reader) {
   // A file is recognised by its first bytes, whatever its name; anything
   // that is neither MCAP nor sqlite3 goes to the ROS 1 reader, whose errors
@@ -159,7 +159,8 @@ Status OpenBagFile(const std::string& path, size_t chunk_cache_size,
   if (std::memcmp(head, kSqliteMagic, sizeof(kSqliteMagic)) == 0) {
     return OpenWith(std::make_unique<ros2::SqliteBagReader>(), path, reader);
   }
-  return OpenWith(std::make_unique<Ros1MessageReader>(chunk_cache_size), path, reader);
+  return OpenWith(std::make_unique<Ros1MessageReader>(ros1_chunks.cache_size,
+                                                     ros1_chunks.read_ahead), path, reader);
 }
 
 }  // namespace tiltcal::decode

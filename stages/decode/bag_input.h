@@ -34,13 +34,19 @@ struct SensorTypes {
 };
 SensorTypes SensorTypesOf(const bag::MessageReader& reader);
 
-// Opens `path` with the reader of its shape. `chunk_cache_size`: the
-// decompressed chunks the ROS 1 reader keeps.
-Status OpenBagInput(const std::string& path, size_t chunk_cache_size,
+// How the ROS 1 reader holds its chunks (decode params chunk_cache_size and
+// read_ahead_chunks).
+struct Ros1ChunkSettings {
+  size_t cache_size = 8;  // decompressed chunks kept
+  size_t read_ahead = 0;  // chunks decompressed ahead on a second thread
+};
+
+// Opens `path` with the reader of its shape.
+Status OpenBagInput(const std::string& path, const Ros1ChunkSettings& ros1_chunks,
                     std::unique_ptr<bag::MessageReader>* reader);
 
 // Opens the one file `path` by its first bytes (MCAP, sqlite3, else ROS 1).
-Status OpenBagFile(const std::string& path, size_t chunk_cache_size,
+Status OpenBagFile(const std::string& path, const Ros1ChunkSettings& ros1_chunks,
                    std::unique_ptr<bag::MessageReader>* reader);
 
 }  // namespace tiltcal::decode

@@ -206,8 +206,10 @@ Status CheckPaths(const DecodePaths& paths) {
 // the only topic of the type).
 Status OpenBag(const DecodePaths& paths, const proto::DecodeParams& params, const proto::Rig& rig,
                std::unique_ptr<bag::MessageReader>* input, DecodeSummary* s) {
-  TILTCAL_RETURN_IF_ERROR(decode::OpenBagInput(
-      paths.bag, std::max<uint32_t>(params.chunk_cache_size(), 1), input));
+  decode::Ros1ChunkSettings ros1_chunks;
+  ros1_chunks.cache_size = std::max<uint32_t>(params.chunk_cache_size(), 1);
+  ros1_chunks.read_ahead = params.read_ahead_chunks();
+  TILTCAL_RETURN_IF_ERROR(decode::OpenBagInput(paths.bag, ros1_chunks, input));
   const bag::MessageReader* reader = input->get();
   s->bag_bytes = reader->size_bytes();
   s->bag_format = reader->format_name();
@@ -327,11 +329,14 @@ Status Decode(const DecodePaths& paths, const proto::DecodeParams& params, std::
   const proto::Provenance provenance =
       MakeProvenance("tiltcal_decode", params, input_paths, paths.command_line);
 
-  // Scans are compressed and written on a second thread, 4 scans in flight.
+  // Scans are serialized, framed and written on a second thread, 4 scans in
+  // flight.
   AsyncRecordWriter scans_writer(proto::Scan::default_instance(), 4);
-  TILTCAL_RETURN_IF_ERROR(scans_writer.Open(paths.out_scans,
-                                            proto::Scan::descriptor()->full_name(), provenance,
-                                            /*compress=*/true));
+  Lz4FrameOptions scans_frame;
+  scans_frame.compress_blocks = !params.scans_output().store_blocks();
+  scans_frame.content_checksum = !params.scans_output().omit_content_checksum();
+  TILTCAL_RETURN_IF_ERROR(scans_writer.Open(
+      paths.out_scans, proto::Scan::descriptor()->full_name(), provenance, scans_frame));
   ImuSink imu(paths.bag, reader.MessageCount(s.imu_topic));
   ScanSink scans(paths.bag, params, s.lidar_type, &scans_writer);
   {

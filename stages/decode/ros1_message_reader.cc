@@ -22,6 +22,7 @@ Status Ros1MessageReader::ReadMessages(const bag::MessageSelection& selection,
   options.start_ns = selection.start_ns;
   options.end_ns = selection.end_ns;
   options.chunk_cache_size = chunk_cache_size_;
+  options.read_ahead_chunks = read_ahead_chunks_;
   bag::Message m;
   m.encoding = bag::Encoding::kRos1;
   m.file = nullptr;  // the one file: the path decode names first

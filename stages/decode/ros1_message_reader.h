@@ -15,8 +15,10 @@ namespace tiltcal::decode {
 
 class Ros1MessageReader : public bag::MessageReader {
  public:
-  // `chunk_cache_size`: decompressed chunks kept in memory.
-  explicit Ros1MessageReader(size_t chunk_cache_size) : chunk_cache_size_(chunk_cache_size) {}
+  // `chunk_cache_size`: decompressed chunks kept in memory;
+  // `read_ahead_chunks`: chunks decompressed ahead on a second thread.
+  Ros1MessageReader(size_t chunk_cache_size, size_t read_ahead_chunks)
+      : chunk_cache_size_(chunk_cache_size), read_ahead_chunks_(read_ahead_chunks) {}
 
   Status Open(const std::string& path);
 
@@ -36,6 +38,7 @@ class Ros1MessageReader : public bag::MessageReader {
 
  private:
   size_t chunk_cache_size_;
+  size_t read_ahead_chunks_;
   ros1::BagReader reader_;
   std::vector<bag::TopicInfo> topics_;
 };

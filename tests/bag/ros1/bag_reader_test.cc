@@ -15,6 +15,7 @@
 
 #include <gtest/gtest.h>
 
+#include "bag/ros1/bag_writer.h"
 #include "tests/testing/test_env.h"
 
 namespace tiltcal::ros1 {
@@ -241,6 +242,75 @@ TEST_F(BagReaderTest, OneChunkCacheReloadsChunksAndStaysCorrect) {
   EXPECT_EQ(reader.stats().chunks_decompressed, 20u);  // every chunk loaded twice
 }
 
+// The same messages and the same stats whether chunks are loaded on demand
+// or read ahead on the second thread, with and without evictions.
+TEST_F(BagReaderTest, ReadAheadGivesTheSameMessagesAsLoadingOnDemand) {
+  // Chunk k holds times 1000 + k and 2000 + k (reading in time order visits
+  // every chunk twice) and chunk-local times 5000 + 10 k (visited once).
+  std::vector<std::vector<Msg>> chunks(12);
+  for (int k = 0; k < 12; ++k) {
+    chunks[k] = {{1, 1000 + k, "a" + std::to_string(k)},
+                 {5, 5000 + 10 * k, "p" + std::to_string(k)},
+                 {2, 2000 + k, "b" + std::to_string(k)}};
+  }
+  const std::string path = Write(BuildBag(kTwoImuConns, chunks));
+  for (size_t cache : {1, 3, 8}) {
+    BagReader on_demand;
+    ASSERT_TRUE(on_demand.Open(path).ok());
+    std::vector<Seen> expected;
+    ReadOptions options;
+    options.chunk_cache_size = cache;
+    ASSERT_TRUE(ReadAll(&on_demand, &expected, options).ok());
+    ASSERT_EQ(expected.size(), 36u);
+    for (size_t ahead : {1, 2, 5, 16}) {
+      BagReader reader;
+      ASSERT_TRUE(reader.Open(path).ok());
+      std::vector<Seen> seen;
+      options.read_ahead_chunks = ahead;
+      ASSERT_TRUE(ReadAll(&reader, &seen, options).ok());
+      ASSERT_EQ(seen.size(), expected.size()) << "cache " << cache << " ahead " << ahead;
+      for (size_t i = 0; i < seen.size(); ++i) {
+        EXPECT_EQ(seen[i].data, expected[i].data) << i;
+        EXPECT_EQ(seen[i].time_ns, expected[i].time_ns) << i;
+      }
+      EXPECT_EQ(reader.stats().chunks_decompressed, on_demand.stats().chunks_decompressed);
+    }
+  }
+}
+
+// lz4 chunks as roslz4 writes them (BagWriter), several per bag: the read
+// ahead decompresses and verifies them on its thread; a callback that stops
+// early ends the read ahead cleanly.
+TEST_F(BagReaderTest, ReadAheadOfLz4ChunksAndAnEarlyStop) {
+  const std::string path = tmp_.File("lz4.bag");
+  {
+    BagWriter writer;
+    ASSERT_TRUE(writer.Open(path, ChunkCompression::kLz4, 4096).ok());
+    const uint32_t imu = writer.AddConnection("/imu", "sensor_msgs/Imu", "md5", "def");
+    for (int i = 0; i < 2000; ++i) {
+      ASSERT_TRUE(writer.Write(imu, 1000 + i, std::string(100, static_cast<char>('a' + i % 26)))
+                      .ok());
+    }
+    ASSERT_TRUE(writer.Close().ok());
+  }
+  std::vector<Seen> expected, seen;
+  BagReader on_demand, ahead;
+  ASSERT_TRUE(on_demand.Open(path).ok());
+  ASSERT_TRUE(ahead.Open(path).ok());
+  ASSERT_TRUE(ReadAll(&on_demand, &expected).ok());
+  ReadOptions options;
+  options.read_ahead_chunks = 2;
+  ASSERT_TRUE(ReadAll(&ahead, &seen, options).ok());
+  ASSERT_EQ(seen.size(), 2000u);
+  EXPECT_GT(ahead.stats().chunks_decompressed, 10u);
+  for (size_t i = 0; i < seen.size(); ++i) EXPECT_EQ(seen[i].data, expected[i].data) << i;
+  int calls = 0;
+  const Status stopped = ahead.ReadMessages(options, [&](const MessageView&) {
+    return ++calls == 50 ? Status::Error("stop") : Status::Ok();
+  });
+  EXPECT_EQ(stopped.message(), "stop");
+}
+
 TEST_F(BagReaderTest, UnindexedBagIsScanned) {
   BagOptions options;
   options.indexed = false;
@@ -392,8 +462,17 @@ TEST_F(BagReaderTest, TruncationsAndByteFlipsNeverCrash) {
       std::vector<Seen> seen;
       const bool opened = reader.Open(path).ok();
       if (opened) {
-        (void)ReadAll(&reader, &seen);
+        const Status on_demand = ReadAll(&reader, &seen);
         EXPECT_LE(seen.size(), 4u);
+        // Reading ahead gives the same messages and the same error.
+        BagReader ahead_reader;
+        EXPECT_TRUE(ahead_reader.Open(path).ok());
+        std::vector<Seen> ahead_seen;
+        ReadOptions ahead;
+        ahead.read_ahead_chunks = 2;
+        const Status read_ahead = ReadAll(&ahead_reader, &ahead_seen, ahead);
+        EXPECT_EQ(read_ahead.message(), on_demand.message());
+        EXPECT_EQ(ahead_seen.size(), seen.size());
       }
       std::remove(path.c_str());
       return opened;

@@ -31,16 +31,31 @@ proto::Scan MakeScan(int index, int num_points) {
   return scan;
 }
 
-void WriteScans(const std::string& path, bool compress, int count, int points) {
+// How a stream is written: plain, or one LZ4 frame built in one of the ways
+// Lz4FrameOptions allows.
+enum class Framing { kPlain, kLz4, kLz4Stored, kLz4NoChecksum, kLz4StoredNoChecksum };
+
+void WriteScans(const std::string& path, Framing framing, int count, int points) {
   RecordWriter writer;
   proto::Provenance provenance;
   provenance.set_producer("record_stream_test");
-  ASSERT_TRUE(writer.Open(path, "tiltcal.proto.Scan", provenance, compress).ok());
+  if (framing == Framing::kPlain) {
+    ASSERT_TRUE(writer.Open(path, "tiltcal.proto.Scan", provenance, false).ok());
+  } else {
+    Lz4FrameOptions options;
+    options.compress_blocks = framing == Framing::kLz4 || framing == Framing::kLz4NoChecksum;
+    options.content_checksum = framing == Framing::kLz4 || framing == Framing::kLz4Stored;
+    ASSERT_TRUE(writer.Open(path, "tiltcal.proto.Scan", provenance, options).ok());
+  }
   for (int i = 0; i < count; ++i) ASSERT_TRUE(writer.Write(MakeScan(i, points)).ok());
   ASSERT_TRUE(writer.Close().ok());
 }
 
-class RecordStreamTest : public ::testing::TestWithParam<bool> {};
+void WriteScans(const std::string& path, bool compress, int count, int points) {
+  WriteScans(path, compress ? Framing::kLz4 : Framing::kPlain, count, points);
+}
+
+class RecordStreamTest : public ::testing::TestWithParam<Framing> {};
 
 TEST_P(RecordStreamTest, RoundTripKeepsEveryRecordAndTheHeader) {
   TempDir dir;
@@ -100,14 +115,31 @@ TEST_P(RecordStreamTest, EveryCutIsAnErrorAlsoBetweenTwoRecords) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(PlainAndLz4, RecordStreamTest, ::testing::Bool(),
-                         [](const auto& info) { return info.param ? "Lz4" : "Plain"; });
+const char* FramingName(Framing framing) {
+  switch (framing) {
+    case Framing::kPlain: return "Plain";
+    case Framing::kLz4: return "Lz4";
+    case Framing::kLz4Stored: return "Lz4Stored";
+    case Framing::kLz4NoChecksum: return "Lz4NoChecksum";
+    case Framing::kLz4StoredNoChecksum: return "Lz4StoredNoChecksum";
+  }
+  return "?";
+}
 
-TEST(RecordStream, CompressedStreamIsOneStandardLz4Frame) {
+INSTANTIATE_TEST_SUITE_P(PlainAndLz4, RecordStreamTest,
+                         ::testing::Values(Framing::kPlain, Framing::kLz4, Framing::kLz4Stored,
+                                           Framing::kLz4NoChecksum,
+                                           Framing::kLz4StoredNoChecksum),
+                         [](const auto& info) { return FramingName(info.param); });
+
+class Lz4FramingTest : public ::testing::TestWithParam<Framing> {};
+
+TEST_P(Lz4FramingTest, StreamIsOneStandardLz4Frame) {
   if (testing::RunCommand("command -v lz4 >/dev/null") != 0) GTEST_SKIP() << "lz4 tool missing";
   TempDir dir;
-  WriteScans(dir.File("a.binpb.lz4"), true, 5, 100);
-  WriteScans(dir.File("b.binpb"), false, 5, 100);
+  // 300 scans of 1000 points: ~5 MB, many 256 KiB blocks and a short last one.
+  WriteScans(dir.File("a.binpb.lz4"), GetParam(), 300, 1000);
+  WriteScans(dir.File("b.binpb"), Framing::kPlain, 300, 1000);
   ASSERT_EQ(testing::RunCommand("lz4 -dc " + dir.File("a.binpb.lz4") + " > " + dir.File("a.binpb")),
             0);
   std::string a, b;
@@ -117,10 +149,43 @@ TEST(RecordStream, CompressedStreamIsOneStandardLz4Frame) {
   std::vector<proto::Scan> from_a, from_b;
   ASSERT_TRUE(ReadAllRecords<proto::Scan>(dir.File("a.binpb"), &from_a).ok());
   ASSERT_TRUE(ReadAllRecords<proto::Scan>(dir.File("b.binpb"), &from_b).ok());
-  ASSERT_EQ(from_a.size(), 5u);
+  ASSERT_EQ(from_a.size(), 300u);
   for (size_t i = 0; i < from_a.size(); ++i) {
     EXPECT_EQ(from_a[i].SerializeAsString(), from_b[i].SerializeAsString());
   }
+}
+
+INSTANTIATE_TEST_SUITE_P(Lz4, Lz4FramingTest,
+                         ::testing::Values(Framing::kLz4, Framing::kLz4Stored,
+                                           Framing::kLz4NoChecksum,
+                                           Framing::kLz4StoredNoChecksum),
+                         [](const auto& info) { return FramingName(info.param); });
+
+TEST(RecordStream, StoredBlocksAreLargerThanCompressedOnes) {
+  TempDir dir;
+  WriteScans(dir.File("compressed.binpb.lz4"), Framing::kLz4, 20, 2000);
+  WriteScans(dir.File("stored.binpb.lz4"), Framing::kLz4Stored, 20, 2000);
+  WriteScans(dir.File("plain.binpb"), Framing::kPlain, 20, 2000);
+  const auto compressed = std::filesystem::file_size(dir.File("compressed.binpb.lz4"));
+  const auto stored = std::filesystem::file_size(dir.File("stored.binpb.lz4"));
+  const auto plain = std::filesystem::file_size(dir.File("plain.binpb"));
+  EXPECT_LT(compressed, plain);
+  // Stored: 7 header bytes, 4 per block, the end mark and the checksum.
+  EXPECT_EQ(stored, plain + 7 + 4 * ((plain + 256 * 1024 - 1) / (256 * 1024)) + 4 + 4);
+}
+
+TEST(RecordStream, CorruptByteOfStoredBlocksFailsTheContentChecksum) {
+  TempDir dir;
+  const std::string path = dir.File("scans.binpb.lz4");
+  WriteScans(path, Framing::kLz4Stored, 5, 500);
+  std::string bytes;
+  ASSERT_TRUE(ReadFileToString(path, &bytes).ok());
+  bytes[bytes.size() / 2] ^= 0x01;  // a float of a column: still parses
+  ASSERT_TRUE(WriteFileAtomically(path, bytes).ok());
+  std::vector<proto::Scan> scans;
+  const Status status = ReadAllRecords<proto::Scan>(path, &scans);
+  ASSERT_FALSE(status.ok());
+  EXPECT_NE(status.message().find(path), std::string::npos) << status.message();
 }
 
 TEST(RecordStream, WrongMagicIsRejected) {

@@ -234,6 +234,43 @@ TEST_F(DecodeCli, MissingParamsMeanTheDefaults) {
   EXPECT_EQ(counts(with_defaults), counts(with_file));
 }
 
+// The scan stream is one LZ4 frame either way: stored blocks with the content
+// checksum by default (FLG 0x64, BD 0x50, the first block's size word with
+// bit 31 set); compressed blocks with store_blocks false, as a params file
+// written before scans_output gets. The records are the same.
+TEST_F(DecodeCli, ScansFrameStoredByDefaultCompressedOnRequest) {
+  REQUIRE_WRITTEN_BAG(bag, "velodyne_bz2.bag");
+  const std::string rig = WriteRigWithTopics();
+  std::string output;
+  ASSERT_EQ(Decode(bag, params_, &output, "--rig=" + rig), 0) << output;
+  const std::string stored = testing::ReadFileOrEmpty(tmp_.File("out/scans.binpb.lz4"));
+  ASSERT_GT(stored.size(), 11u);
+  EXPECT_EQ(stored.substr(0, 6), std::string("\x04\x22\x4d\x18\x64\x50", 6));
+  EXPECT_NE(static_cast<unsigned char>(stored[10]) & 0x80, 0);
+  const std::string params = tmp_.File("compressed.txtpb");
+  std::string text = testing::ReadFileOrEmpty(params_);
+  const size_t at = text.find("store_blocks: true");
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, 18, "store_blocks: false");
+  WriteFile(params, text);
+  ASSERT_EQ(Decode(bag, params, &output, "--rig=" + rig), 0) << output;
+  const std::string compressed = testing::ReadFileOrEmpty(tmp_.File("out/scans.binpb.lz4"));
+  ASSERT_GT(compressed.size(), 11u);
+  EXPECT_EQ(compressed.substr(0, 6), std::string("\x04\x22\x4d\x18\x64\x50", 6));
+  EXPECT_LT(compressed.size(), stored.size());
+  if (testing::RunCommand("command -v lz4 >/dev/null") != 0) return;
+  const std::string a = tmp_.File("stored.lz4"), b = tmp_.File("compressed.lz4");
+  WriteFile(a, stored);
+  WriteFile(b, compressed);
+  std::string plain_a, plain_b;
+  ASSERT_EQ(testing::RunCommand("lz4 -dc " + a, &plain_a), 0);
+  ASSERT_EQ(testing::RunCommand("lz4 -dc " + b, &plain_b), 0);
+  // The same records after the header (provenance: params and time).
+  ASSERT_GT(plain_a.size(), 1000u);
+  ASSERT_GT(plain_b.size(), 1000u);
+  EXPECT_EQ(plain_a.substr(plain_a.size() - 1000), plain_b.substr(plain_b.size() - 1000));
+}
+
 // A missing output flag is a usage error (exit 2) naming the flag.
 TEST_F(DecodeCli, RequiredFlagMissing) {
   std::string output;
