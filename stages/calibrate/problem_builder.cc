@@ -243,10 +243,9 @@ ceres::Solver::Options MakeSolverOptions(const SolverSettings& settings) {
   options.max_num_iterations = std::max(1, settings.max_iterations);
   options.num_threads = std::max(1, settings.num_threads);
   if (settings.function_tolerance > 0.0) options.function_tolerance = settings.function_tolerance;
+  // At most Ceres' max_trust_region_radius (1e16), the params' bound.
   if (settings.initial_trust_region_radius > 0.0) {
     options.initial_trust_region_radius = settings.initial_trust_region_radius;
-    options.max_trust_region_radius =
-        std::max(options.max_trust_region_radius, settings.initial_trust_region_radius);
   }
   options.logging_type = ceres::SILENT;
   options.minimizer_progress_to_stdout = false;
