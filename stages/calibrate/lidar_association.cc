@@ -4,6 +4,8 @@
 #include <chrono>
 #include <unordered_set>
 
+#include "stages/calibrate/point_priority.h"
+
 namespace tiltcal::calibrate {
 namespace {
 
@@ -20,6 +22,23 @@ void KeepEvenlySpaced(size_t keep, std::vector<T>* v) {
   const double step = static_cast<double>(v->size()) / keep;
   for (size_t i = 0; i < keep; ++i) out.push_back((*v)[static_cast<size_t>(i * step)]);
   v->swap(out);
+}
+
+// Keeps the `keep` associations of lowest priority (in point order).
+void KeepLowestPriority(size_t keep, const std::vector<uint64_t>& priorities,
+                        std::vector<SurfelAssociation>* v) {
+  if (v->size() <= keep) return;
+  auto priority = [&](const SurfelAssociation& a) {
+    return priorities[static_cast<size_t>(a.point_index)];
+  };
+  std::nth_element(v->begin(), v->begin() + static_cast<std::ptrdiff_t>(keep) - 1, v->end(),
+                   [&](const SurfelAssociation& a, const SurfelAssociation& b) {
+                     return priority(a) < priority(b);
+                   });
+  v->resize(keep);
+  std::sort(v->begin(), v->end(), [](const SurfelAssociation& a, const SurfelAssociation& b) {
+    return a.point_index < b.point_index;
+  });
 }
 
 }  // namespace
@@ -52,6 +71,9 @@ void BuildMapAndAssociate(const CalibrationState& state, const std::vector<Lidar
   start = std::chrono::steady_clock::now();
   const size_t stride = std::max<size_t>(params.point_stride(), 1);
   std::vector<size_t> index;
+  std::vector<uint64_t> priorities;
+  const bool fixed_priority = params.selection() == proto::AssociationParams::FIXED_PRIORITY;
+  const size_t max_per_scan = std::max<size_t>(params.max_residuals_per_scan(), 1);
   std::unordered_set<int> surfels_used;
   for (size_t k = 0; k < scans.size(); ++k) {
     if (!usable[k]) continue;
@@ -59,12 +81,18 @@ void BuildMapAndAssociate(const CalibrationState& state, const std::vector<Lidar
     table.Build(state, scan, params.deskew_node_spacing_s());
     world.clear();
     index.clear();
+    priorities.clear();
     for (size_t j = 0; j < scan.points.size(); j += stride) {
       world.push_back(table.ToWorld(scan, j));
       index.push_back(j);
+      if (fixed_priority) priorities.push_back(PointPriority(k, j));
     }
-    std::vector<SurfelAssociation> found = map.Associate(world, params);
-    KeepEvenlySpaced(std::max<size_t>(params.max_residuals_per_scan(), 1), &found);
+    std::vector<SurfelAssociation> found = map.Associate(world, params, priorities);
+    if (fixed_priority) {
+      KeepLowestPriority(max_per_scan, priorities, &found);
+    } else {
+      KeepEvenlySpaced(max_per_scan, &found);
+    }
     for (const SurfelAssociation& a : found) {
       const size_t j = index[a.point_index];
       const Surfel& s = map.surfels()[a.surfel_index];

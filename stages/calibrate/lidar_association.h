@@ -9,9 +9,12 @@
 // subsample of the points is associated with the surfel of its voxel
 // (AssociationParams):
 //   - only every point_stride-th kept point of a scan is tried;
-//   - at most max_points_per_surfel_per_scan points per surfel and scan
-//     (evenly spaced when more qualify);
-//   - at most max_residuals_per_scan per scan (evenly spaced).
+//   - at most max_points_per_surfel_per_scan points per surfel and scan;
+//   - at most max_residuals_per_scan per scan;
+//   both caps choose by AssociationParams.selection: evenly spaced in point
+//   order, or the candidates of lowest fixed priority (point_priority.h), so
+//   that the picks of one round stay picked in the next unless their own
+//   candidates changed.
 // The associations keep the raw LiDAR-frame point and its LiDAR time, so the
 // residual moves with the trajectory, the extrinsic and tau.
 

@@ -204,9 +204,13 @@ void CalibrationProblem::SetPositionKnotsConstant() {
 
 void CalibrationProblem::RemoveUnusedKnots() {
   spline::SplineTrajectory& traj = state_->trajectory;
+  // Held constant rather than removed: Ceres leaves constant blocks out of
+  // the solve, while RemoveParameterBlock scans every residual block for each
+  // knot (all position knots of the rotation-only fit: quadratic in the
+  // duration).
   for (int i = 0; i < traj.num_knots(); ++i) {
-    if (!rotation_used_[i]) problem_->RemoveParameterBlock(traj.rotation_knot(i));
-    if (!position_used_[i]) problem_->RemoveParameterBlock(traj.position_knot(i));
+    if (!rotation_used_[i]) problem_->SetParameterBlockConstant(traj.rotation_knot(i));
+    if (!position_used_[i]) problem_->SetParameterBlockConstant(traj.position_knot(i));
   }
   // The calibration blocks: asked of Ceres (a scan of the residual blocks
   // each; there are a handful), so extra residual sets are accounted for

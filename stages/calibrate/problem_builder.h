@@ -137,10 +137,12 @@ class CalibrationProblem {
   // position-only fit).
   void SetRotationKnotsConstant();
   void SetPositionKnotsConstant();
-  // Removes the blocks that no residual uses (so the solver does not see
-  // parameters without information), keeping the state's values. Call after
-  // the last Add*; extra residual sets must only use knots that the other
-  // residuals use (knot use is tracked by the Add* calls).
+  // Takes the blocks that no residual uses out of the solve (so the solver
+  // does not see parameters without information), keeping the state's
+  // values: unused knots are held constant, unused calibration blocks
+  // removed. Call after the last Add*; extra residual sets must only use
+  // knots that the other residuals use (knot use is tracked by the Add*
+  // calls).
   void RemoveUnusedKnots();
 
   ceres::Problem* problem() { return problem_.get(); }

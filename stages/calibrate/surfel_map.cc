@@ -1,6 +1,7 @@
 #include "stages/calibrate/surfel_map.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 
 namespace tiltcal::calibrate {
@@ -234,7 +235,9 @@ int SurfelMap::SurfelIndexAt(const Eigen::Vector3d& p_a) const {
 }
 
 std::vector<SurfelAssociation> SurfelMap::Associate(const std::vector<Eigen::Vector3d>& points_a,
-                                                    const proto::AssociationParams& params) const {
+                                                    const proto::AssociationParams& params,
+                                                    const std::vector<uint64_t>& priorities) const {
+  assert(priorities.empty() || priorities.size() == points_a.size());
   const double max_centroid_distance = params.max_centroid_distance_factor() * voxel_m_;
   // Candidates grouped per surfel, each group in increasing point order.
   std::unordered_map<int, std::vector<SurfelAssociation>> per_surfel;
@@ -259,6 +262,14 @@ std::vector<SurfelAssociation> SurfelMap::Associate(const std::vector<Eigen::Vec
         std::max<std::size_t>(params.max_points_per_surfel_per_scan(), 1);
     if (n <= cap) {
       out.insert(out.end(), group.begin(), group.end());
+    } else if (!priorities.empty()) {
+      std::vector<SurfelAssociation> lowest = group;
+      std::nth_element(lowest.begin(), lowest.begin() + static_cast<std::ptrdiff_t>(cap) - 1,
+                       lowest.end(), [&](const SurfelAssociation& a, const SurfelAssociation& b) {
+                         return priorities[static_cast<std::size_t>(a.point_index)] <
+                                priorities[static_cast<std::size_t>(b.point_index)];
+                       });
+      out.insert(out.end(), lowest.begin(), lowest.begin() + static_cast<std::ptrdiff_t>(cap));
     } else {
       // cap evenly spaced picks: index floor((k + 0.5) * n / cap), k = 0..cap-1.
       for (std::size_t k = 0; k < cap; ++k) {

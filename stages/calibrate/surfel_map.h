@@ -108,10 +108,12 @@ class SurfelMap {
   // params.max_distance_m and |p - centroid| <=
   // params.max_centroid_distance_factor x voxel_m (a point inside the patch
   // that the surfel describes); at most params.max_points_per_surfel_per_scan
-  // points per surfel (evenly spaced in query order when more qualify).
+  // points per surfel: when more qualify, evenly spaced in query order, or,
+  // with priorities (one per query point), those of lowest priority.
   // Output sorted by point_index.
   std::vector<SurfelAssociation> Associate(const std::vector<Eigen::Vector3d>& points_a,
-                                           const proto::AssociationParams& params) const;
+                                           const proto::AssociationParams& params,
+                                           const std::vector<uint64_t>& priorities = {}) const;
 
   // Integer voxel index of a point in frame a.
   Eigen::Vector3i VoxelOf(const Eigen::Vector3d& p_a) const;

@@ -131,6 +131,27 @@ ProblemOptions ImuOnlyProblemOptions(const proto::CalibrateParams& params) {
   return options;
 }
 
+TEST(ProblemBuilderTest, GyroOnlyProblemHoldsEveryPositionKnotConstant) {
+  CalibrationState state = MakeState(1.0);
+  const std::vector<imu::ImuReading> imu = ImuFromState(state, 1.0);
+  const proto::CalibrateParams params = ImuOnlyParams();
+  CalibrationProblem problem(&state, params.imu_noise(), params.lidar(), ImuOnlyProblemOptions(params));
+  problem.AddImuResiduals(imu, /*gyro=*/true, /*accel=*/false);
+  problem.RemoveUnusedKnots();
+  const spline::SplineTrajectory& traj = state.trajectory;
+  int free_rotation_knots = 0;
+  for (int i = 0; i < traj.num_knots(); ++i) {
+    EXPECT_TRUE(problem.problem()->IsParameterBlockConstant(traj.position_knot(i))) << i;
+    if (!problem.problem()->IsParameterBlockConstant(traj.rotation_knot(i))) ++free_rotation_knots;
+  }
+  EXPECT_GT(free_rotation_knots, traj.num_knots() / 2);
+  // Only the used rotation knots are free (3 tangent parameters each).
+  EXPECT_EQ(problem.counts().free_parameters, 3 * free_rotation_knots);
+  ceres::Solver::Summary summary;
+  ceres::Solve(MakeSolverOptions(SolverSettings{50, 1, 1e-14}), problem.problem(), &summary);
+  EXPECT_EQ(summary.num_parameter_blocks_reduced, free_rotation_knots) << summary.FullReport();
+}
+
 TEST(ProblemBuilderTest, ImuOnlyProblemKeepsTheTruthAndDropsUnusedBlocks) {
   CalibrationState truth = MakeState(1.0);
   const std::vector<imu::ImuReading> imu = ImuFromState(truth, 1.0);

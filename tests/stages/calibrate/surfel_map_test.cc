@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include "stages/calibrate/point_priority.h"
 #include "tests/stages/calibrate/calibrate_params_text.h"
 #include "tests/stages/calibrate/synthetic_room.h"
 
@@ -240,6 +241,81 @@ TEST_F(SurfelMapRoomTest, AssociationReturnsTheSurfelOfTheTrueSurface) {
   std::vector<Eigen::Vector3d> shifted = points_a;
   for (Eigen::Vector3d& p : shifted) p += a_from_w_.linear() * Eigen::Vector3d(0.3, 0.2, 0.15);
   EXPECT_LT(map_->Associate(shifted, options).size(), all.size() / 3);
+}
+
+TEST_F(SurfelMapRoomTest, FixedPrioritiesKeepThePicksOfSurfelsWhoseCandidatesDidNotChange) {
+  std::mt19937 rng(23);
+  LidarPattern pattern;
+  pattern.num_columns = 900;
+  Eigen::Isometry3d w_from_l = Eigen::Isometry3d::Identity();
+  w_from_l.linear() = Eigen::AngleAxisd(0.9, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  w_from_l.translation() = Eigen::Vector3d(-2.0, 0.3, 0.05);
+  const SimulatedScan scan = ScanScene(scene_, w_from_l, pattern, 0.01, &rng);
+  std::vector<Eigen::Vector3d> points_a;
+  std::vector<uint64_t> priorities;
+  for (std::size_t i = 0; i < scan.points.size(); i += 4) {
+    points_a.push_back(a_from_w_ * w_from_l * scan.points[i].cast<double>());
+    priorities.push_back(PointPriority(7, i));
+  }
+  const proto::AssociationParams cap2 = RoomAssociation(2);
+  const std::vector<SurfelAssociation> before = map_->Associate(points_a, cap2, priorities);
+  ASSERT_GT(before.size(), 50u);
+
+  // The picks of a surfel are its candidates of lowest priority.
+  const std::vector<SurfelAssociation> all = map_->Associate(points_a, RoomAssociation());
+  std::map<int, std::vector<uint64_t>> candidate_priorities;
+  for (const SurfelAssociation& a : all) {
+    candidate_priorities[a.surfel_index].push_back(priorities[static_cast<std::size_t>(a.point_index)]);
+  }
+  for (auto& [surfel, p] : candidate_priorities) std::sort(p.begin(), p.end());
+  std::map<int, std::vector<uint64_t>> picked;
+  for (const SurfelAssociation& a : before) {
+    picked[a.surfel_index].push_back(priorities[static_cast<std::size_t>(a.point_index)]);
+  }
+  for (auto& [surfel, p] : picked) {
+    std::sort(p.begin(), p.end());
+    const std::vector<uint64_t>& c = candidate_priorities.at(surfel);
+    EXPECT_EQ(p, std::vector<uint64_t>(c.begin(), c.begin() + static_cast<std::ptrdiff_t>(std::min<std::size_t>(2, c.size()))));
+  }
+
+  // The first tenth of the query points moves off the map (a changed map or
+  // pose): every surfel none of them was a candidate of keeps its picks.
+  std::vector<Eigen::Vector3d> moved = points_a;
+  std::set<int> touched;
+  for (const SurfelAssociation& a : all) {
+    if (a.point_index < static_cast<int>(points_a.size() / 10)) touched.insert(a.surfel_index);
+  }
+  for (std::size_t i = 0; i < points_a.size() / 10; ++i) moved[i] += Eigen::Vector3d(0.0, 0.0, 50.0);
+  const std::vector<SurfelAssociation> after = map_->Associate(moved, cap2, priorities);
+  std::set<std::pair<int, int>> before_kept, after_kept;
+  for (const SurfelAssociation& a : before) {
+    if (!touched.count(a.surfel_index)) before_kept.insert({a.point_index, a.surfel_index});
+  }
+  for (const SurfelAssociation& a : after) {
+    if (!touched.count(a.surfel_index)) after_kept.insert({a.point_index, a.surfel_index});
+  }
+  ASSERT_GT(before_kept.size(), 20u);
+  EXPECT_EQ(before_kept, after_kept);
+  EXPECT_TRUE(std::is_sorted(after.begin(), after.end(), [](const SurfelAssociation& a, const SurfelAssociation& b) {
+    return a.point_index < b.point_index;
+  }));
+}
+
+TEST(PointPriorityTest, IsFixedAndSpreadsTheLowestPicksOverTheScan) {
+  EXPECT_EQ(PointPriority(3, 17), PointPriority(3, 17));
+  EXPECT_NE(PointPriority(3, 17), PointPriority(17, 3));
+  EXPECT_NE(PointPriority(0, 1), PointPriority(1, 0));
+  // The 64 lowest of 4000 points of one scan: spread like a uniform sample
+  // (mean index 2000 +- 3 standard errors of 1155 / sqrt(64)), all distinct.
+  std::vector<std::pair<uint64_t, int>> ranked;
+  for (int j = 0; j < 4000; ++j) ranked.push_back({PointPriority(5, j), j});
+  std::sort(ranked.begin(), ranked.end());
+  std::set<uint64_t> distinct;
+  double mean_index = 0.0;
+  for (int i = 0; i < 64; ++i) mean_index += ranked[i].second / 64.0;
+  for (const auto& r : ranked) distinct.insert(r.first);
+  EXPECT_EQ(distinct.size(), ranked.size());
+  EXPECT_NEAR(mean_index, 2000.0, 3.0 * 1155.0 / 8.0);
 }
 
 // Controlled voxels: each of these point sets fills exactly one voxel.
