@@ -92,6 +92,20 @@ class SurfelMapRoomTest : public ::testing::Test {
     summary_ = map_->ExtractSurfels();
   }
 
+  // A new scan (900 columns, 1 cm noise) from a pose between the map poses.
+  static Eigen::Isometry3d QueryPose() {
+    Eigen::Isometry3d w_from_l = Eigen::Isometry3d::Identity();
+    w_from_l.linear() = Eigen::AngleAxisd(0.9, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    w_from_l.translation() = Eigen::Vector3d(-2.0, 0.3, 0.05);
+    return w_from_l;
+  }
+  SimulatedScan QueryScan(unsigned seed) const {
+    std::mt19937 rng(seed);
+    LidarPattern pattern;
+    pattern.num_columns = 900;
+    return ScanScene(scene_, QueryPose(), pattern, 0.01, &rng);
+  }
+
   Scene scene_;
   proto::SurfelMapParams options_ = RoomMapParams();
   Eigen::Isometry3d a_from_w_ = AFromW();
@@ -180,14 +194,8 @@ TEST_F(SurfelMapRoomTest, SurfelsLieOnTheTruePlanesWithMatchingNormals) {
 }
 
 TEST_F(SurfelMapRoomTest, AssociationReturnsTheSurfelOfTheTrueSurface) {
-  // A new scan from a pose between the map poses.
-  std::mt19937 rng(22);
-  LidarPattern pattern;
-  pattern.num_columns = 900;
-  Eigen::Isometry3d w_from_l = Eigen::Isometry3d::Identity();
-  w_from_l.linear() = Eigen::AngleAxisd(0.9, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  w_from_l.translation() = Eigen::Vector3d(-2.0, 0.3, 0.05);
-  const SimulatedScan scan = ScanScene(scene_, w_from_l, pattern, 0.01, &rng);
+  const Eigen::Isometry3d w_from_l = QueryPose();
+  const SimulatedScan scan = QueryScan(22);
   std::vector<Eigen::Vector3d> points_a;
   for (const Eigen::Vector3f& p : scan.points) points_a.push_back(a_from_w_ * w_from_l * p.cast<double>());
 
@@ -244,13 +252,8 @@ TEST_F(SurfelMapRoomTest, AssociationReturnsTheSurfelOfTheTrueSurface) {
 }
 
 TEST_F(SurfelMapRoomTest, FixedPrioritiesKeepThePicksOfSurfelsWhoseCandidatesDidNotChange) {
-  std::mt19937 rng(23);
-  LidarPattern pattern;
-  pattern.num_columns = 900;
-  Eigen::Isometry3d w_from_l = Eigen::Isometry3d::Identity();
-  w_from_l.linear() = Eigen::AngleAxisd(0.9, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  w_from_l.translation() = Eigen::Vector3d(-2.0, 0.3, 0.05);
-  const SimulatedScan scan = ScanScene(scene_, w_from_l, pattern, 0.01, &rng);
+  const Eigen::Isometry3d w_from_l = QueryPose();
+  const SimulatedScan scan = QueryScan(23);
   std::vector<Eigen::Vector3d> points_a;
   std::vector<uint64_t> priorities;
   for (std::size_t i = 0; i < scan.points.size(); i += 4) {
