@@ -24,23 +24,6 @@ void KeepEvenlySpaced(size_t keep, std::vector<T>* v) {
   v->swap(out);
 }
 
-// Keeps the `keep` associations of lowest priority (in point order).
-void KeepLowestPriority(size_t keep, const std::vector<uint64_t>& priorities,
-                        std::vector<SurfelAssociation>* v) {
-  if (v->size() <= keep) return;
-  auto priority = [&](const SurfelAssociation& a) {
-    return priorities[static_cast<size_t>(a.point_index)];
-  };
-  std::nth_element(v->begin(), v->begin() + static_cast<std::ptrdiff_t>(keep) - 1, v->end(),
-                   [&](const SurfelAssociation& a, const SurfelAssociation& b) {
-                     return priority(a) < priority(b);
-                   });
-  v->resize(keep);
-  std::sort(v->begin(), v->end(), [](const SurfelAssociation& a, const SurfelAssociation& b) {
-    return a.point_index < b.point_index;
-  });
-}
-
 }  // namespace
 
 void BuildMapAndAssociate(const CalibrationState& state, const std::vector<LidarScan>& scans,
@@ -89,7 +72,13 @@ void BuildMapAndAssociate(const CalibrationState& state, const std::vector<Lidar
     }
     std::vector<SurfelAssociation> found = map.Associate(world, params, priorities);
     if (fixed_priority) {
-      KeepLowestPriority(max_per_scan, priorities, &found);
+      KeepLowestPriority(
+          max_per_scan,
+          [&](const SurfelAssociation& a) { return priorities[static_cast<size_t>(a.point_index)]; },
+          &found);
+      std::sort(found.begin(), found.end(), [](const SurfelAssociation& a, const SurfelAssociation& b) {
+        return a.point_index < b.point_index;
+      });
     } else {
       KeepEvenlySpaced(max_per_scan, &found);
     }

@@ -4,6 +4,8 @@
 #include <cassert>
 #include <cmath>
 
+#include "stages/calibrate/point_priority.h"
+
 namespace tiltcal::calibrate {
 namespace {
 
@@ -264,12 +266,11 @@ std::vector<SurfelAssociation> SurfelMap::Associate(const std::vector<Eigen::Vec
       out.insert(out.end(), group.begin(), group.end());
     } else if (!priorities.empty()) {
       std::vector<SurfelAssociation> lowest = group;
-      std::nth_element(lowest.begin(), lowest.begin() + static_cast<std::ptrdiff_t>(cap) - 1,
-                       lowest.end(), [&](const SurfelAssociation& a, const SurfelAssociation& b) {
-                         return priorities[static_cast<std::size_t>(a.point_index)] <
-                                priorities[static_cast<std::size_t>(b.point_index)];
-                       });
-      out.insert(out.end(), lowest.begin(), lowest.begin() + static_cast<std::ptrdiff_t>(cap));
+      KeepLowestPriority(
+          cap,
+          [&](const SurfelAssociation& a) { return priorities[static_cast<std::size_t>(a.point_index)]; },
+          &lowest);
+      out.insert(out.end(), lowest.begin(), lowest.end());
     } else {
       // cap evenly spaced picks: index floor((k + 0.5) * n / cap), k = 0..cap-1.
       for (std::size_t k = 0; k < cap; ++k) {
