@@ -297,7 +297,7 @@ void FillCovariance(const CalibrateInputs& inputs, const proto::CalibrateParams&
   const auto start = Clock::now();
   if (params.observability().compute_covariance()) {
     Matrix7d cov;
-    const Status cs = ComputeExtrinsicCovariance(problem->problem(), state,
+    const Status cs = ComputeExtrinsicCovariance(problem->problem(), state, params.observability(),
                                                  static_cast<int>(params.num_threads()), &cov);
     if (cs.ok()) {
       const VarianceFactor factor = ComputeVarianceFactor(problem->problem());

@@ -3,11 +3,16 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <iterator>
 #include <utility>
+#include <vector>
 
-#include <ceres/covariance.h>
+#include <ceres/crs_matrix.h>
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/SparseCore>
+
+#include "stages/calibrate/marginal_covariance.h"
 
 namespace tiltcal::calibrate {
 
@@ -30,31 +35,64 @@ MotionAxis PrincipalRotationAxis(const std::vector<imu::ImuReading>& samples,
 }
 
 Status ComputeExtrinsicCovariance(ceres::Problem* problem, CalibrationState* state,
-                                  int num_threads, Matrix7d* covariance) {
+                                  const proto::ObservabilityParams& params, int num_threads,
+                                  Matrix7d* covariance) {
   covariance->setZero();
-  double* rot = state->imu_from_lidar_rotation;
-  double* trans = state->imu_from_lidar_translation;
-  double* tau = state->time_offset_s;
-  for (double* b : {rot, trans, tau}) {
-    if (!problem->HasParameterBlock(b)) {
+  // The 7 tangent parameters in covariance order; a constant block (e.g. tau
+  // with a zero bound) keeps zero rows and columns.
+  struct Group {
+    double* block;
+    int offset;
+    int size;
+  };
+  const Group groups[] = {{state->imu_from_lidar_rotation, 0, 3},
+                          {state->imu_from_lidar_translation, 3, 3},
+                          {state->time_offset_s, 6, 1}};
+  std::vector<double*> blocks;
+  problem->GetParameterBlocks(&blocks);
+  std::vector<double*> ordered;
+  for (double* b : blocks) {
+    const bool calibration = std::any_of(std::begin(groups), std::end(groups),
+                                         [b](const Group& g) { return g.block == b; });
+    if (!calibration && !problem->IsParameterBlockConstant(b)) ordered.push_back(b);
+  }
+  std::vector<const Group*> free_groups;
+  int k = 0;
+  for (const Group& g : groups) {
+    if (!problem->HasParameterBlock(g.block)) {
       return Status::Error("covariance: the extrinsic / time offset is not in the problem");
     }
+    if (problem->IsParameterBlockConstant(g.block)) continue;
+    ordered.push_back(g.block);
+    free_groups.push_back(&g);
+    k += g.size;
   }
-  ceres::Covariance::Options options;
-  options.algorithm_type = ceres::SPARSE_QR;
-  options.num_threads = std::max(1, num_threads);
+  if (k == 0) return Status::Error("covariance: the extrinsic and time offset are held constant");
+
+  ceres::Problem::EvaluateOptions options;
+  options.parameter_blocks = ordered;
   options.apply_loss_function = true;
-  ceres::Covariance cov(options);
-  std::vector<std::pair<const double*, const double*>> blocks = {
-      {rot, rot}, {rot, trans}, {rot, tau}, {trans, trans}, {trans, tau}, {tau, tau}};
-  if (!cov.Compute(blocks, problem)) {
-    return Status::Error("covariance: the Jacobian is rank deficient or the factorisation failed");
+  options.num_threads = std::max(1, num_threads);
+  ceres::CRSMatrix crs;
+  if (!problem->Evaluate(options, nullptr, nullptr, nullptr, &crs)) {
+    return Status::Error("covariance: the residuals could not be evaluated");
   }
-  Eigen::Matrix<double, 7, 7, Eigen::RowMajor> m;
-  if (!cov.GetCovarianceMatrixInTangentSpace({rot, trans, tau}, m.data())) {
-    return Status::Error("covariance: could not read the covariance blocks");
+  const Eigen::Map<const Eigen::SparseMatrix<double, Eigen::RowMajor>> jacobian(
+      crs.num_rows, crs.num_cols, static_cast<Eigen::Index>(crs.values.size()), crs.rows.data(),
+      crs.cols.data(), crs.values.data());
+  Eigen::MatrixXd marginal;
+  TILTCAL_RETURN_IF_ERROR(
+      MarginalCovarianceOfLastColumns(jacobian, k, params.min_relative_pivot(), &marginal));
+  int row = 0;
+  for (const Group* gi : free_groups) {
+    int col = 0;
+    for (const Group* gj : free_groups) {
+      covariance->block(gi->offset, gj->offset, gi->size, gj->size) =
+          marginal.block(row, col, gi->size, gj->size);
+      col += gj->size;
+    }
+    row += gi->size;
   }
-  *covariance = m;
   return Status::Ok();
 }
 

@@ -4,8 +4,9 @@
 // Covariance of the calibration (C_bl, r_b^{lb}, tau) from the final
 // Jacobian, and the observability report (docs/design.md §11).
 //
-// Covariance: ceres::Covariance (SPARSE_QR, robust loss applied) of the
-// blocks C_bl, r_b^{lb}, tau in the TANGENT space, 7x7 in the order
+// Covariance: the marginal covariance (marginal_covariance.h: the Schur
+// complement of J^T J, robust loss applied, linear in the sequence's length)
+// of the blocks C_bl, r_b^{lb}, tau in the TANGENT space, 7x7 in the order
 //   (delta_C [3, rad], delta_r [3, m], delta_tau [1, s])
 // with the right perturbation C_bl <- C_bl Exp(delta_C): delta_C is a
 // rotation vector in the LiDAR frame l. Residuals are weighted by 1/sigma, so
@@ -54,7 +55,8 @@ MotionAxis PrincipalRotationAxis(const std::vector<imu::ImuReading>& samples,
 // factorisation) are returned as Status for the report; they are data, not a
 // failure of the stage.
 Status ComputeExtrinsicCovariance(ceres::Problem* problem, CalibrationState* state,
-                                  int num_threads, Matrix7d* covariance);
+                                  const proto::ObservabilityParams& params, int num_threads,
+                                  Matrix7d* covariance);
 
 // A-posteriori variance factor of the weighted least-squares problem at its
 // current parameters: sigma0^2 = 2 F / (m - n), F the cost with the robust

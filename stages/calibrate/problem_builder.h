@@ -45,7 +45,7 @@
 // the windows re-chosen) at every outer iteration.
 //
 // The object owns the manifolds and the shared loss (Ceres does not), and the
-// Problem; it must outlive any ceres::Covariance computed on it.
+// Problem; it must outlive any evaluation of the Problem (the covariance).
 
 #include <functional>
 #include <memory>

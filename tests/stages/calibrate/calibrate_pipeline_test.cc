@@ -6,10 +6,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <random>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include <ceres/covariance.h>
 #include <ceres/problem.h>
 #include <ceres/sized_cost_function.h>
 #include <ceres/solver.h>
@@ -17,6 +19,7 @@
 
 #include <Eigen/Geometry>
 
+#include "common/geometry/so3.h"
 #include "common/io/atomic_file.h"
 #include "common/io/eigen_proto.h"
 #include "common/io/text_proto.h"
@@ -370,6 +373,91 @@ TEST(CovarianceReportTest, ScalingTheDataKeepsThePrior) {
   EXPECT_EQ(TranslationPriorInformation(0.0, Eigen::Vector3d::UnitZ()), Eigen::Matrix3d::Zero());
   EXPECT_EQ(TranslationPriorInformation(0.5, Eigen::Vector3d::Zero()),
             Eigen::Matrix3d::Identity() * 4.0);
+}
+
+// The covariance of (C_bl, r_b^{lb}, tau) from the Schur complement against
+// Ceres' own (ceres::Covariance, SPARSE_QR) on a calibration problem: IMU
+// residuals and LiDAR points on six planes at sigma-sized distances (Cauchy
+// loss), knots gauge-fixed; then with tau held constant (zero rows and
+// columns in both).
+TEST(CovarianceReportTest, ExtrinsicCovarianceEqualsCeresCovariance) {
+  for (const bool estimate_time_offset : {true, false}) {
+    // Rotation about all three axes and a varying acceleration, so that
+    // every direction of the extrinsic and tau is observed.
+    CalibrationState state(spline::UniformKnotGrid::ForDuration(0.0, 2.0, 0.05));
+    for (int i = 0; i < state.trajectory.num_knots(); ++i) {
+      const double t = (i - 1) * 0.05;
+      state.trajectory.SetRotationKnot(
+          i, Eigen::Quaterniond(geometry::ExpMatrix(
+                 Eigen::Vector3d(0.4 * std::sin(3.0 * t), 0.3 * std::cos(2.5 * t), 0.8 * t))));
+      state.trajectory.SetPositionKnot(
+          i, Eigen::Vector3d(std::sin(2.0 * t), 0.5 * std::cos(3.0 * t), 0.2 * std::sin(4.0 * t)));
+    }
+    state.SetGravityDirection(Eigen::Vector3d(0.1, 0.0, -1.0));
+    state.SetImuFromLidarRotation(
+        Eigen::Quaterniond(Eigen::AngleAxisd(0.2, Eigen::Vector3d(1, -1, 2).normalized())));
+    state.SetImuFromLidarTranslation(Eigen::Vector3d(0.1, -0.05, 0.2));
+    state.time_offset_s[0] = 0.004;
+    const std::vector<imu::ImuReading> imu = ImuFromState(state, 2.0);
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+    std::normal_distribution<double> noise(0.0, 0.02);
+    const Eigen::Vector3d normals[] = {{0, 0, 1},  {1, 0, 0},    {0, 1, 0},
+                                       {1, 1, 0},  {1, 0, 0.5},  {0, -1, 1}};
+    std::vector<LidarPointResidual> points;
+    for (int i = 0; i < 600; ++i) {
+      LidarPointResidual p;
+      p.time_s = 0.1 + 1.8 * (i + 0.5) / 600.0;
+      p.point_lidar_m = 8.0 * Eigen::Vector3d(uniform(rng), uniform(rng), uniform(rng));
+      spline::So3SplineSample rot;
+      spline::R3SplineSample pos;
+      state.trajectory.Evaluate(p.time_s + state.time_offset_s[0], spline::kSo3Rotation, &rot, &pos);
+      const Eigen::Vector3d p_a =
+          rot.rotation * (state.ImuFromLidarRotation() * p.point_lidar_m +
+                          state.ImuFromLidarTranslation()) +
+          pos.position;
+      p.plane_normal = normals[i % 6].normalized();
+      p.plane_offset_m = -p.plane_normal.dot(p_a) + noise(rng);
+      points.push_back(p);
+    }
+    const proto::CalibrateParams params = testing::DefaultCalibrateParamsWith();
+    ProblemOptions options;
+    options.time_offset_bound_s = estimate_time_offset ? 0.02 : 0.0;
+    options.time_offset_step_bound_s = 0.02;
+    CalibrationProblem problem(&state, params.imu_noise(), params.lidar(), options);
+    problem.AddImuResiduals(imu, true, true);
+    problem.AddLidarResiduals(points);
+    problem.RemoveUnusedKnots();
+    ASSERT_EQ(problem.counts().lidar_residuals, 600);
+
+    Matrix7d covariance;
+    const Status status =
+        ComputeExtrinsicCovariance(problem.problem(), &state, params.observability(), 1, &covariance);
+    ASSERT_TRUE(status.ok()) << status.message();
+
+    ceres::Covariance::Options oracle_options;
+    oracle_options.algorithm_type = ceres::SPARSE_QR;
+    oracle_options.apply_loss_function = true;
+    ceres::Covariance oracle(oracle_options);
+    double* blocks[] = {state.imu_from_lidar_rotation, state.imu_from_lidar_translation,
+                        state.time_offset_s};
+    std::vector<std::pair<const double*, const double*>> pairs;
+    for (int a = 0; a < 3; ++a) {
+      for (int b = a; b < 3; ++b) pairs.emplace_back(blocks[a], blocks[b]);
+    }
+    ASSERT_TRUE(oracle.Compute(pairs, problem.problem()));
+    Eigen::Matrix<double, 7, 7, Eigen::RowMajor> expected;
+    ASSERT_TRUE(oracle.GetCovarianceMatrixInTangentSpace({blocks[0], blocks[1], blocks[2]},
+                                                         expected.data()));
+    EXPECT_EQ(covariance(6, 6) == 0.0, !estimate_time_offset) << covariance(6, 6);
+    for (int r = 0; r < 7; ++r) {
+      for (int c = 0; c < 7; ++c) {
+        const double scale = std::sqrt(expected(r, r) * expected(c, c));
+        EXPECT_NEAR(covariance(r, c), expected(r, c), 1e-6 * scale + 1e-300)
+            << estimate_time_offset << " " << r << " " << c;
+      }
+    }
+  }
 }
 
 TEST(CovarianceReportTest, PrincipalAxisOfAYawingMotion) {
