@@ -3,11 +3,13 @@
 #include "common/registration/point_to_plane_icp.h"
 #include "common/registration/voxel_downsample.h"
 #include "common/registration/voxel_hash_map.h"
+#include "stages/calibrate/single_query_kd_tree.h"
 #include "stages/calibrate/surfel_map.h"
 
 #include <chrono>
 #include <cmath>
 #include <deque>
+#include <memory>
 
 #include <pcl/common/transforms.h>
 #include <pcl/filters/voxel_grid.h>
@@ -163,6 +165,9 @@ struct LidarOdometry::Impl {
     gicp.setMaxCorrespondenceDistance(p.max_correspondence_m());
     gicp.setCorrespondenceRandomness(static_cast<int>(p.gicp_neighbours()));
     gicp.setMaximumOptimizerIterations(static_cast<int>(p.gicp_optimizer_iterations()));
+    // Same neighbours as PCL's own trees, without an OpenMP region per query.
+    gicp.setSearchMethodTarget(std::make_shared<SingleQueryKdTree>());
+    gicp.setSearchMethodSource(std::make_shared<SingleQueryKdTree>());
     ndt.setResolution(static_cast<float>(p.ndt_resolution_m()));
     ndt.setStepSize(p.ndt_step_size_m());
     ndt.setTransformationEpsilon(p.transformation_epsilon());
