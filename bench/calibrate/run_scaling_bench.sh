@@ -9,7 +9,9 @@
 # (user + sys), peak resident memory, the odometry and solve phases (from
 # calibration.txtpb), wall / duration, and the errors against the truth;
 # then per binary the exponent b of a log-log fit wall = a duration^b
-# (1 = linear) and the anchor / this ratios. The machine load (uptime) is
+# (1 = linear) and the anchor / this ratios, and plots the time and the
+# peak memory per second of data against the duration into
+# <scratch>/scaling.png. The machine load (uptime) is
 # printed before and after: the machine is shared, so compare the ratios of
 # one run, not absolute times across runs.
 #
@@ -112,4 +114,8 @@ for d in $DURATIONS; do
   round=$((round + 1))
 done
 echo "load after:  $(uptime)"
-python3 "$REPO/bench/calibrate/scaling_report.py" "$RESULTS"
+# Debian's python3 has matplotlib for the plot (the first python3 on PATH
+# may not).
+PYTHON=/usr/bin/python3
+[ -x "$PYTHON" ] || PYTHON=python3
+"$PYTHON" "$REPO/bench/calibrate/scaling_report.py" "$RESULTS" --plot "$SCRATCH/scaling.png"

@@ -4,7 +4,13 @@
 errors against the truth), the exponent b of a least-squares fit
 log(wall) = log(a) + b log(duration) per binary, and anchor / this ratios.
 
-Usage: scaling_report.py results.tsv   (lines: duration_s, label, work dir)
+With --plot FILE.png it also draws, per binary, the CPU and wall seconds
+per second of data and the peak memory per second of data against the
+duration (log duration axis; a flat line is linear cost). The plot needs matplotlib (Debian's
+python3-matplotlib, in /usr/bin/python3).
+
+Usage: scaling_report.py results.tsv [--plot FILE.png]
+       (lines of results.tsv: duration_s, label, work dir)
 """
 import math
 import os
@@ -58,9 +64,51 @@ def fit_exponent(points):
     return sum((x - mx) * (y - my) for x, y in zip(xs, ys)) / sxx if sxx > 0 else float('nan')
 
 
+def plot(rows, path):
+    try:
+        import matplotlib
+        matplotlib.use('Agg')
+        import matplotlib.pyplot as plt
+    except ImportError:
+        print('no plot: matplotlib is missing (Debian python3-matplotlib, /usr/bin/python3)')
+        return
+    fig, (per_second, memory) = plt.subplots(1, 2, figsize=(11, 4.2))
+    for label, colour in (('this', 'tab:blue'), ('anchor', 'tab:gray')):
+        mine = sorted((r for r in rows if r['label'] == label), key=lambda r: r['d'])
+        if not mine:
+            continue
+        d = [r['d'] for r in mine]
+        per_second.plot(d, [r['cpu'] / r['d'] for r in mine], 'o-', color=colour,
+                        label='%s: CPU (exponent %.2f)' % (label, fit_exponent(
+                            [(r['d'], r['cpu']) for r in mine])))
+        per_second.plot(d, [r['wall'] / r['d'] for r in mine], 's--', color=colour,
+                        label='%s: wall (exponent %.2f)' % (label, fit_exponent(
+                            [(r['d'], r['wall']) for r in mine])))
+        memory.plot(d, [r['mem'] / r['d'] for r in mine], 'o-', color=colour, label=label)
+    for axis in (per_second, memory):
+        axis.set_xscale('log', base=2)
+        axis.set_xlabel('sequence duration, s')
+        axis.grid(True, which='both', alpha=0.3)
+        axis.legend(fontsize=8)
+    per_second.set_ylabel('s per second of data (flat = linear cost)')
+    per_second.set_ylim(bottom=0)
+    memory.set_ylabel('peak resident memory per second of data, MB')
+    memory.set_ylim(bottom=0)
+    fig.suptitle('tiltcal_calibrate scaling')
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    print('plot: %s' % path)
+
+
 def main():
+    args = sys.argv[1:]
+    plot_path = None
+    if '--plot' in args:
+        i = args.index('--plot')
+        plot_path = args[i + 1]
+        del args[i:i + 2]
     rows = []
-    for line in open(sys.argv[1]):
+    for line in open(args[0]):
         d, label, w = line.rstrip('\n').split('\t')
         wall, cpu, mem_mb = gnu_time(os.path.join(w, 'time_%s.txt' % label))
         cal = parse(open(os.path.join(w, 'calibration_%s.txtpb' % label)).read())
@@ -92,6 +140,8 @@ def main():
                   % (d, a['wall'] / t['wall'], a['cpu'] / t['cpu'],
                      a['odo'] / max(t['odo'], 1e-9), a['solve'] / max(t['solve'], 1e-9),
                      a['mem'] / t['mem']))
+    if plot_path:
+        plot(rows, plot_path)
 
 
 if __name__ == '__main__':
