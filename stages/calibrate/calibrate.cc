@@ -297,8 +297,8 @@ void FillCovariance(const CalibrateInputs& inputs, const proto::CalibrateParams&
   const auto start = Clock::now();
   if (params.observability().compute_covariance()) {
     Matrix7d cov;
-    const Status cs = ComputeExtrinsicCovariance(problem->problem(), state, params.observability(),
-                                                 static_cast<int>(params.num_threads()), &cov);
+    Status cs = ComputeExtrinsicCovariance(problem->problem(), state, params.observability(),
+                                           static_cast<int>(params.num_threads()), &cov);
     if (cs.ok()) {
       const VarianceFactor factor = ComputeVarianceFactor(problem->problem());
       result->set_variance_factor(factor.sigma0_squared);
@@ -310,6 +310,11 @@ void FillCovariance(const CalibrateInputs& inputs, const proto::CalibrateParams&
         cov = ScaleDataInformation(cov, prior_information, factor.sigma0_squared);
         result->set_covariance_scaled_by_variance_factor(true);
       }
+      // A covariance that is not finite is no covariance (SUSPECT), never
+      // NaN sigmas next to an OK verdict.
+      if (!cov.allFinite()) cs = Status::Error("covariance: not finite");
+    }
+    if (cs.ok()) {
       const MotionAxis motion = PrincipalRotationAxis(inputs.imu, state->GyroBias());
       *result->mutable_motion_rotation_axis_b() = ToProto(motion.axis_b);
       FillCovarianceReport(cov, state->ImuFromLidarRotation().toRotationMatrix(), motion,

@@ -127,10 +127,27 @@ Eigen::Matrix3d TranslationPriorInformation(double sigma_m, const Eigen::Vector3
 
 Matrix7d ScaleDataInformation(const Matrix7d& covariance, const Matrix7d& prior_information,
                               double sigma0_squared) {
-  const Matrix7d information = covariance.inverse();
-  const Matrix7d scaled = (information - prior_information) / sigma0_squared + prior_information;
-  const Matrix7d out = scaled.inverse();
-  return 0.5 * (out + out.transpose());
+  // Only the estimated parameters: a held one has zero rows and columns.
+  std::vector<int> free;
+  for (int i = 0; i < 7; ++i) {
+    if (covariance(i, i) > 0.0) free.push_back(i);
+  }
+  const int n = static_cast<int>(free.size());
+  Eigen::MatrixXd sub_covariance(n, n), sub_prior(n, n);
+  for (int r = 0; r < n; ++r) {
+    for (int c = 0; c < n; ++c) {
+      sub_covariance(r, c) = covariance(free[r], free[c]);
+      sub_prior(r, c) = prior_information(free[r], free[c]);
+    }
+  }
+  const Eigen::MatrixXd information = sub_covariance.inverse();
+  const Eigen::MatrixXd scaled = (information - sub_prior) / sigma0_squared + sub_prior;
+  const Eigen::MatrixXd sub_out = scaled.inverse();
+  Matrix7d out = Matrix7d::Zero();
+  for (int r = 0; r < n; ++r) {
+    for (int c = 0; c < n; ++c) out(free[r], free[c]) = 0.5 * (sub_out(r, c) + sub_out(c, r));
+  }
+  return out;
 }
 
 std::string DescribeDirection(const Eigen::Vector3d& v) {
@@ -202,8 +219,12 @@ void FillCovarianceReport(const Matrix7d& covariance, const Eigen::Matrix3d& c_b
   d->set_sigma(tau_sigma);
   d->set_weak(tau_sigma > params.weak_time_offset_sigma_s());
   char buf[128];
-  std::snprintf(buf, sizeof(buf), "time offset: sigma %.4g s%s", tau_sigma,
-                tau_sigma > params.weak_time_offset_sigma_s() ? " -- WEAK" : "");
+  if (covariance(6, 6) == 0.0) {
+    std::snprintf(buf, sizeof(buf), "time offset: held, not estimated (time_offset_bound_s 0)");
+  } else {
+    std::snprintf(buf, sizeof(buf), "time offset: sigma %.4g s%s", tau_sigma,
+                  tau_sigma > params.weak_time_offset_sigma_s() ? " -- WEAK" : "");
+  }
   d->set_description(buf);
 }
 

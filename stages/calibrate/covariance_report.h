@@ -51,7 +51,8 @@ struct MotionAxis {
 MotionAxis PrincipalRotationAxis(const std::vector<imu::ImuReading>& samples,
                                  const Eigen::Vector3d& gyro_bias_radps);
 
-// Fills *covariance (7x7 as above). Errors (rank deficiency, failure of the
+// Fills *covariance (7x7 as above; a block held constant in the problem has
+// zero rows and columns). Errors (rank deficiency, failure of the
 // factorisation) are returned as Status for the report; they are data, not a
 // failure of the stage.
 Status ComputeExtrinsicCovariance(ceres::Problem* problem, CalibrationState* state,
@@ -78,7 +79,9 @@ Eigen::Matrix3d TranslationPriorInformation(double sigma_m, const Eigen::Vector3
 // The covariance with the data's information scaled by 1/sigma0^2 and the
 // priors' kept: a prior acts on the extrinsic block only, so the marginal
 // information is P^{-1} = S_data + L_prior, and the result is
-// ((P^{-1} - L_prior) / sigma0^2 + L_prior)^{-1}.
+// ((P^{-1} - L_prior) / sigma0^2 + L_prior)^{-1}. Parameters held constant
+// (zero variance, e.g. tau with time_offset_bound_s 0) keep zero rows and
+// columns; the rest is computed without them.
 Matrix7d ScaleDataInformation(const Matrix7d& covariance, const Matrix7d& prior_information,
                               double sigma0_squared);
 

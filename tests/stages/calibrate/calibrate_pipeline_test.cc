@@ -460,6 +460,33 @@ TEST(CovarianceReportTest, ExtrinsicCovarianceEqualsCeresCovariance) {
   }
 }
 
+// tau held constant (time_offset_bound_s 0): its zero row and column stay
+// zero and the other six are scaled as a 6x6 problem (an inverse of the
+// singular 7x7 made every entry NaN).
+TEST(CovarianceReportTest, ScalingKeepsAHeldParameterAtZero) {
+  Eigen::Matrix<double, 6, 6> a = Eigen::Matrix<double, 6, 6>::Random();
+  const Eigen::Matrix<double, 6, 6> data = a * a.transpose() + Eigen::Matrix<double, 6, 6>::Identity();
+  Matrix7d prior = Matrix7d::Zero();
+  prior.block<3, 3>(3, 3) = TranslationPriorInformation(0.05, Eigen::Vector3d::UnitZ());
+  const Eigen::Matrix<double, 6, 6> prior6 = prior.topLeftCorner<6, 6>();
+  Matrix7d held = Matrix7d::Zero();
+  held.topLeftCorner<6, 6>() = (data + prior6).inverse();
+  const Matrix7d scaled = ScaleDataInformation(held, prior, 0.25);
+  ASSERT_TRUE(scaled.allFinite());
+  EXPECT_EQ(scaled.row(6).norm(), 0.0);
+  EXPECT_EQ(scaled.col(6).norm(), 0.0);
+  const Eigen::Matrix<double, 6, 6> expected = (data / 0.25 + prior6).inverse();
+  EXPECT_LT((scaled.topLeftCorner<6, 6>() - expected).norm(), 1e-12 * expected.norm());
+  // The report says tau was held, not that it is known to 0 s.
+  proto::CalibrationResult result;
+  FillCovarianceReport(scaled, Eigen::Matrix3d::Identity(), MotionAxis(),
+                       testing::DefaultCalibrateParamsWith().observability(), &result);
+  ASSERT_EQ(result.observability_size(), 7);
+  EXPECT_FALSE(result.observability(6).weak());
+  EXPECT_NE(result.observability(6).description().find("held, not estimated"), std::string::npos)
+      << result.observability(6).description();
+}
+
 TEST(CovarianceReportTest, PrincipalAxisOfAYawingMotion) {
   std::vector<imu::ImuReading> imu(100);
   for (size_t i = 0; i < imu.size(); ++i) {
