@@ -8,6 +8,8 @@
 #include <google/protobuf/util/delimited_message_util.h>
 
 #include "common/io/lz4_stream.h"
+#include "common/io/scan_encoder.h"
+#include "tiltcal/proto/scan.pb.h"
 
 namespace tiltcal {
 
@@ -79,7 +81,11 @@ Status RecordWriter::OpenImpl(const std::string& path, const std::string& payloa
 Status RecordWriter::Write(const google::protobuf::Message& record) {
   // SerializeDelimitedToCodedStream, with the size computed once (it walks
   // every packed varint of a scan) and checked: a zero length is the end mark.
-  const size_t size = record.ByteSizeLong();
+  // Scans, the bulk of the bytes, are written by ScanEncoder (same bytes).
+  const auto* scan = dynamic_cast<const proto::Scan*>(&record);
+  if (scan != nullptr && !ScanEncoder::Supported(*scan)) scan = nullptr;
+  ScanEncoder encoder;
+  const size_t size = scan != nullptr ? encoder.ByteSize(*scan) : record.ByteSizeLong();
   if (size == 0) {
     return Status::Error(impl_->file.path() + ": record " + std::to_string(num_records_) +
                          " is empty (a zero length marks the end of a record stream)");
@@ -88,13 +94,18 @@ Status RecordWriter::Write(const google::protobuf::Message& record) {
   if (ok) {
     pbio::CodedOutputStream coded(impl_->stream());
     coded.WriteVarint32(static_cast<uint32_t>(size));
-    uint8_t* direct = coded.GetDirectBufferForNBytesAndAdvance(static_cast<int>(size));
-    if (direct != nullptr) {
-      record.SerializeWithCachedSizesToArray(direct);
+    const int64_t start = coded.ByteCount();
+    if (scan != nullptr) {
+      encoder.Write(*scan, &coded);
     } else {
-      record.SerializeWithCachedSizes(&coded);
+      uint8_t* direct = coded.GetDirectBufferForNBytesAndAdvance(static_cast<int>(size));
+      if (direct != nullptr) {
+        record.SerializeWithCachedSizesToArray(direct);
+      } else {
+        record.SerializeWithCachedSizes(&coded);
+      }
     }
-    ok = !coded.HadError();
+    ok = !coded.HadError() && coded.ByteCount() - start == static_cast<int64_t>(size);
   }
   if (!ok) {
     return Status::Error(impl_->file.path() + ": cannot write record " +
