@@ -48,10 +48,15 @@ constexpr uint32_t kLz4MaxRatio = 256;
 // A growable byte buffer that does not zero-fill.
 class ByteBuffer {
  public:
+  // Grows to size + size / 8 rounded up to 64 KiB, so that chunks of
+  // varying size reuse the buffers instead of mapping and faulting in new
+  // ones each time a chunk is a little larger than the last.
   uint8_t* Reserve(size_t size) {
     if (size > capacity_) {
-      data_.reset(new uint8_t[size]);
-      capacity_ = size;
+      constexpr size_t kGranule = size_t{1} << 16;
+      const size_t grown = size + size / 8;
+      capacity_ = std::max(size, (grown + kGranule - 1) / kGranule * kGranule);
+      data_.reset(new uint8_t[capacity_]);
     }
     return data_.get();
   }
