@@ -97,10 +97,14 @@ apt_install librosbag-storage-dev libsensor-msgs-dev ||
   { HAVE_ROS_CPP=0; log "C++ rosbag library not installable: no C++ anchor"; }
 
 # ---- Build (Release). ----
-# Tests are not needed here (and a test directory being edited by someone
-# else must not stop the benchmark).
+# A new build directory is configured without tests (not needed here, and a
+# test directory being edited by someone else must not stop the benchmark);
+# an existing one (e.g. --build_dir build) keeps its own settings, so that
+# the benchmark does not turn the tests of a developer's build off.
+TESTS_OPTION=()
+[ -f "$BUILD_DIR/CMakeCache.txt" ] || TESTS_OPTION=(-DTILTCAL_BUILD_TESTS=OFF)
 if ! cmake -S "$REPO" -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=Release \
-    -DTILTCAL_BUILD_TESTS=OFF >"$LOGS/cmake.log" 2>&1; then
+    "${TESTS_OPTION[@]}" >"$LOGS/cmake.log" 2>&1; then
   log "cmake configure failed, see $LOGS/cmake.log"
   grep -A3 'CMake Error' "$LOGS/cmake.log" >&2 || true
   exit 1

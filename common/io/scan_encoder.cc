@@ -12,8 +12,8 @@ namespace wire = google::protobuf::io;
 // Wire tags: field number << 3 | wire type (0 varint, 2 length-delimited).
 constexpr uint32_t Tag(uint32_t field, uint32_t type) { return field << 3 | type; }
 
-// Bytes of one varint of `v` below 2^28 minus 1: (v >= 2^7) + (v >= 2^14) + (v >= 2^21);
-// plus (v >= 2^28) for a full uint32.
+// Bytes of the varint of `v` minus 1: (v >= 2^7) + (v >= 2^14) + (v >= 2^21)
+// + (v >= 2^28).
 inline uint32_t ExtraBytes(uint32_t v) {
   return static_cast<uint32_t>(v >= (1u << 7)) + static_cast<uint32_t>(v >= (1u << 14)) +
          static_cast<uint32_t>(v >= (1u << 21)) + static_cast<uint32_t>(v >= (1u << 28));
@@ -50,6 +50,46 @@ inline uint8_t* EncodeVarints(const uint32_t* values, size_t n, uint8_t* out) {
     }
   }
   return out;
+}
+
+// Bytes of the varints of to_uint(values[i]), i < n. The per-block sums of
+// at most 4 extra bytes per value stay in uint32 and vectorise.
+template <typename T, typename ToUInt>
+size_t VarintBytes(const T* values, size_t n, ToUInt to_uint) {
+  constexpr size_t kSumBlock = size_t{1} << 20;
+  size_t total = n;
+  for (size_t begin = 0; begin < n; begin += kSumBlock) {
+    const size_t end = std::min(n, begin + kSumBlock);
+    uint32_t extra = 0;
+    for (size_t i = begin; i < end; ++i) extra += ExtraBytes(to_uint(values[i]));
+    total += extra;
+  }
+  return total;
+}
+
+// Packed varint field `field` of to_uint(values[i]), i < n, whose payload is
+// `payload_bytes` (VarintBytes); nothing when empty. A payload of n bytes
+// means every value is below 2^7: one byte each.
+template <typename T, typename ToUInt>
+void WritePackedVarints(uint32_t field, size_t payload_bytes, const T* values, size_t n,
+                        ToUInt to_uint, wire::CodedOutputStream* out) {
+  if (payload_bytes == 0) return;
+  out->WriteTag(Tag(field, 2));
+  out->WriteVarint32(static_cast<uint32_t>(payload_bytes));
+  uint32_t block[kBlockValues];
+  uint8_t bytes[kBlockValues * 5 + 3];
+  for (size_t begin = 0; begin < n; begin += kBlockValues) {
+    const size_t count = std::min(kBlockValues, n - begin);
+    uint8_t* end;
+    if (payload_bytes == n) {
+      for (size_t i = 0; i < count; ++i) bytes[i] = static_cast<uint8_t>(to_uint(values[begin + i]));
+      end = bytes + count;
+    } else {
+      for (size_t i = 0; i < count; ++i) block[i] = to_uint(values[begin + i]);
+      end = EncodeVarints(block, count, bytes);
+    }
+    out->WriteRaw(bytes, static_cast<int>(end - bytes));
+  }
 }
 
 void WritePackedFloats(uint32_t field, const google::protobuf::RepeatedField<float>& values,
@@ -94,26 +134,11 @@ bool ScanEncoder::Supported(const proto::Scan& scan) {
 }
 
 size_t ScanEncoder::UInt32VarintBytes(const uint32_t* values, size_t n) {
-  size_t total = n;
-  // uint32 sums over blocks (at most 4 extra bytes per value) vectorise.
-  for (size_t begin = 0; begin < n; begin += (1u << 20)) {
-    const size_t end = std::min(n, begin + (size_t{1} << 20));
-    uint32_t extra = 0;
-    for (size_t i = begin; i < end; ++i) extra += ExtraBytes(values[i]);
-    total += extra;
-  }
-  return total;
+  return VarintBytes(values, n, [](uint32_t v) { return v; });
 }
 
 size_t ScanEncoder::SInt32VarintBytes(const int32_t* values, size_t n) {
-  size_t total = n;
-  for (size_t begin = 0; begin < n; begin += (1u << 20)) {
-    const size_t end = std::min(n, begin + (size_t{1} << 20));
-    uint32_t extra = 0;
-    for (size_t i = begin; i < end; ++i) extra += ExtraBytes(ZigZag(values[i]));
-    total += extra;
-  }
-  return total;
+  return VarintBytes(values, n, [](int32_t v) { return ZigZag(v); });
 }
 
 size_t ScanEncoder::ByteSize(const proto::Scan& scan) {
@@ -153,37 +178,11 @@ void ScanEncoder::Write(const proto::Scan& scan, wire::CodedOutputStream* out) c
   WritePackedFloats(6, scan.y(), out);
   WritePackedFloats(7, scan.z(), out);
   WritePackedFloats(8, scan.intensity(), out);
-  uint32_t values[kBlockValues];
-  uint8_t bytes[kBlockValues * 5 + 3];
-  if (ring_bytes_ > 0) {
-    out->WriteTag(Tag(9, 2));
-    out->WriteVarint32(static_cast<uint32_t>(ring_bytes_));
-    const uint32_t* ring = scan.ring().data();
-    const size_t n = static_cast<size_t>(scan.ring_size());
-    for (size_t begin = 0; begin < n; begin += kBlockValues) {
-      const size_t count = std::min(kBlockValues, n - begin);
-      uint8_t* end;
-      if (ring_bytes_ == n) {  // every value below 2^7: one byte each
-        for (size_t i = 0; i < count; ++i) bytes[i] = static_cast<uint8_t>(ring[begin + i]);
-        end = bytes + count;
-      } else {
-        end = EncodeVarints(ring + begin, count, bytes);
-      }
-      out->WriteRaw(bytes, static_cast<int>(end - bytes));
-    }
-  }
-  if (time_bytes_ > 0) {
-    out->WriteTag(Tag(10, 2));
-    out->WriteVarint32(static_cast<uint32_t>(time_bytes_));
-    const int32_t* time = scan.time_offset_ns().data();
-    const size_t n = static_cast<size_t>(scan.time_offset_ns_size());
-    for (size_t begin = 0; begin < n; begin += kBlockValues) {
-      const size_t count = std::min(kBlockValues, n - begin);
-      for (size_t i = 0; i < count; ++i) values[i] = ZigZag(time[begin + i]);
-      uint8_t* end = EncodeVarints(values, count, bytes);
-      out->WriteRaw(bytes, static_cast<int>(end - bytes));
-    }
-  }
+  WritePackedVarints(9, ring_bytes_, scan.ring().data(), static_cast<size_t>(scan.ring_size()),
+                     [](uint32_t v) { return v; }, out);
+  WritePackedVarints(10, time_bytes_, scan.time_offset_ns().data(),
+                     static_cast<size_t>(scan.time_offset_ns_size()),
+                     [](int32_t v) { return ZigZag(v); }, out);
   if (scan.time_source() != 0) {
     out->WriteTag(Tag(11, 0));
     out->WriteVarint32SignExtended(scan.time_source());

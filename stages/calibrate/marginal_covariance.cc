@@ -1,5 +1,6 @@
 #include "stages/calibrate/marginal_covariance.h"
 
+#include <cmath>
 #include <string>
 
 #include <Eigen/Eigenvalues>
