@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <ctime>
+#include <future>
 #include <memory>
 
 #include <ceres/solver.h>
@@ -356,9 +357,30 @@ void FillEstimate(const CalibrationState& state, const std::vector<std::string>&
 // residual statistics and tau bounds of the last problem, the map sharpness
 // with the estimate and with the rig's extrinsic (same trajectory and tau),
 // the move from the rig, hand-eye and static start.
+// The map sharpness with the estimate and with the rig's extrinsic.
+struct MapSharpnessPair {
+  proto::MapSharpness estimate;
+  proto::MapSharpness rig;
+};
+
+MapSharpnessPair MeasureBothMapSharpnesses(const CalibrateInputs& inputs,
+                                           const proto::CalibrateParams& params,
+                                           const CalibrationState& state) {
+  const Rigid3d rig = ToEigen(inputs.rig.imu_from_lidar());
+  const double spacing_s = params.association().deskew_node_spacing_s();
+  MapSharpnessPair out;
+  out.estimate = MeasureMapSharpness(state, inputs.scans, params.map(), spacing_s);
+  CalibrationState with_rig = state;
+  with_rig.SetImuFromLidarRotation(rig.rotation);
+  with_rig.SetImuFromLidarTranslation(rig.translation);
+  out.rig = MeasureMapSharpness(with_rig, inputs.scans, params.map(), spacing_s);
+  return out;
+}
+
 void FillVerdictFacts(const CalibrateInputs& inputs, const proto::CalibrateParams& params,
                       const InitialisationReport& init, CalibrationProblem* problem,
-                      const CalibrationState& state, proto::CalibrationResult* result) {
+                      const CalibrationState& state, MapSharpnessPair sharpness,
+                      proto::CalibrationResult* result) {
   const auto start = Clock::now();
   result->clear_residual_statistics();
   for (proto::ResidualStatistics& s :
@@ -368,15 +390,9 @@ void FillVerdictFacts(const CalibrateInputs& inputs, const proto::CalibrateParam
   result->set_time_offset_lower_bound_s(problem->time_offset_lower_s());
   result->set_time_offset_upper_bound_s(problem->time_offset_upper_s());
 
+  *result->mutable_map_sharpness_estimate() = std::move(sharpness.estimate);
+  *result->mutable_map_sharpness_rig() = std::move(sharpness.rig);
   const Rigid3d rig = ToEigen(inputs.rig.imu_from_lidar());
-  const double spacing_s = params.association().deskew_node_spacing_s();
-  *result->mutable_map_sharpness_estimate() =
-      MeasureMapSharpness(state, inputs.scans, params.map(), spacing_s);
-  CalibrationState with_rig = state;
-  with_rig.SetImuFromLidarRotation(rig.rotation);
-  with_rig.SetImuFromLidarTranslation(rig.translation);
-  *result->mutable_map_sharpness_rig() =
-      MeasureMapSharpness(with_rig, inputs.scans, params.map(), spacing_s);
 
   const Eigen::Quaterniond c_bl = state.ImuFromLidarRotation();
   *result->mutable_rig_imu_from_lidar() = ToProto(rig);
@@ -478,8 +494,13 @@ Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& pa
   }
   TILTCAL_RETURN_IF_ERROR(CheckSolveUsable(loop.summary));
   FillSolverReport(loop, result);
+  // The map sharpness reads the state and the scans only: measured on
+  // another thread (two or more) while the covariance is computed.
+  std::future<MapSharpnessPair> sharpness =
+      std::async(params.num_threads() > 1 ? std::launch::async : std::launch::deferred,
+                 MeasureBothMapSharpnesses, std::cref(inputs), std::cref(params), std::cref(state));
   FillCovariance(inputs, params, loop.problem.get(), &state, result);
-  FillVerdictFacts(inputs, params, init, loop.problem.get(), state, result);
+  FillVerdictFacts(inputs, params, init, loop.problem.get(), state, sharpness.get(), result);
   loop.problem.reset();
 
   ReexpressInFirstImuFrame(&state);

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <future>
+#include <memory>
 #include <optional>
 
 #include <ceres/sized_cost_function.h>
@@ -336,36 +338,60 @@ OdometryRun RunOdometry(const std::vector<LidarScan>& scans, const CalibrationSt
   report->odometry_registered = 0;
   report->odometry_mean_fitness_m = 0.0;
   const double tau = state.time_offset_s[0];
-  LidarOdometry odometry(params.odometry(), params.scans());
+  const int num_threads = std::max(static_cast<int>(params.num_threads()), 1);
+  LidarOdometry odometry(params.odometry(), params.scans(), num_threads);
   const spline::SplineTrajectory& traj = state.trajectory;
   const Eigen::Quaterniond c_bl = state.ImuFromLidarRotation();
   OdometryRun run;
-  ScanPoseTable table;
-  std::vector<Eigen::Vector3f> deskewed;
   bool have_first = false;
   Eigen::Quaterniond c_ab_first = Eigen::Quaterniond::Identity();
   const size_t scan_step = std::max<size_t>(params.odometry().scan_step(), 1);
-  for (size_t k = 0; k < scans.size(); k += scan_step) {
+  // Scan k deskewed and prepared for registration (reads only the state).
+  struct Prepared {
+    bool usable = false;
+    Eigen::Quaterniond c_ab = Eigen::Quaterniond::Identity();  // C_ab at the scan time
+    std::shared_ptr<LidarOdometry::PreparedScan> scan;
+  };
+  auto prepare = [&](size_t k, int threads) {
+    Prepared out;
     const LidarScan& scan = scans[k];
-    if (scan.points.empty()) continue;
+    if (scan.points.empty()) return out;
     spline::So3SplineSample rot;
-    if (!traj.Evaluate(scan.stamp_s + tau, spline::kSo3Rotation, &rot, nullptr)) continue;
+    if (!traj.Evaluate(scan.stamp_s + tau, spline::kSo3Rotation, &rot, nullptr)) return out;
+    std::vector<Eigen::Vector3f> deskewed;
+    ScanPoseTable table;
     if (!gyro_aided) {
       deskewed = scan.points;
     } else if (!DeskewScan(state, scan, params.init().deskew_node_spacing_s(), &table,
                            &deskewed)) {
-      continue;
+      return out;
     }
-    const Eigen::Quaterniond c_ab_k(rot.rotation);
+    out.usable = true;
+    out.c_ab = Eigen::Quaterniond(rot.rotation);
+    out.scan = odometry.Prepare(deskewed, threads);
+    return out;
+  };
+  // With two threads or more, scan k + scan_step is prepared (on one thread)
+  // while scan k is registered.
+  const bool ahead = num_threads > 1;
+  std::future<Prepared> next;
+  if (!scans.empty()) next = std::async(std::launch::deferred, prepare, size_t{0}, num_threads);
+  for (size_t k = 0; k < scans.size(); k += scan_step) {
+    const Prepared current = next.get();
+    if (k + scan_step < scans.size()) {
+      next = std::async(ahead ? std::launch::async : std::launch::deferred, prepare,
+                        k + scan_step, ahead ? 1 : num_threads);
+    }
+    if (!current.usable) continue;
     if (!have_first) {
-      c_ab_first = c_ab_k;
+      c_ab_first = current.c_ab;
       have_first = true;
     }
     std::optional<Eigen::Quaterniond> prior;
-    if (gyro_aided) prior = LidarRotationPriorFromImu(c_ab_first, c_ab_k, c_bl);
-    odometry.AddScan(scan.stamp_s, deskewed, prior);
+    if (gyro_aided) prior = LidarRotationPriorFromImu(c_ab_first, current.c_ab, c_bl);
+    odometry.AddPrepared(scans[k].stamp_s, *current.scan, prior);
     run.scan_of_pose.push_back(static_cast<int>(k));
-    run.imu_rotations.push_back(c_ab_k);
+    run.imu_rotations.push_back(current.c_ab);
   }
   run.poses = odometry.poses();
   report->odometry_scans = static_cast<int>(run.poses.size());

@@ -3,12 +3,14 @@
 #include "common/registration/point_to_plane_icp.h"
 #include "common/registration/voxel_downsample.h"
 #include "common/registration/voxel_hash_map.h"
+#include "stages/calibrate/gicp_covariances.h"
 #include "stages/calibrate/single_query_kd_tree.h"
 #include "stages/calibrate/surfel_map.h"
 
 #include <chrono>
 #include <cmath>
 #include <deque>
+#include <future>
 #include <memory>
 
 #include <pcl/common/transforms.h>
@@ -22,6 +24,10 @@ namespace tiltcal::calibrate {
 namespace {
 
 using Cloud = pcl::PointCloud<pcl::PointXYZ>;
+
+// The spread across a GICP plane (m^2): PCL's fixed value, which it offers
+// no setter for, so the covariances computed here are the ones it would use.
+constexpr double kGicpEpsilon = 0.001;
 
 Cloud::Ptr Downsample(const Cloud::ConstPtr& in, double leaf_m) {
   Cloud::Ptr out(new Cloud);
@@ -135,11 +141,21 @@ class VoxelIcpOdometry {
 
 }  // namespace
 
+struct LidarOdometry::PreparedScan {
+  std::vector<Eigen::Vector3f> points_lidar;  // VOXEL_ICP: the scan as given
+  std::vector<Eigen::Vector3f> cropped;       // GICP / NDT: cropped, full resolution
+  Cloud::Ptr source;                          // GICP / NDT: downsampled at scan_voxel_m
+  std::shared_ptr<SingleQueryKdTree> tree;    // GICP: of `source`
+  std::shared_ptr<GicpCovariances> covariances;  // GICP: of `source` (null: too few points)
+};
+
 struct LidarOdometry::Impl {
   struct Keyframe {
-    Cloud::Ptr map_cloud;                  // in l0, downsampled at map_voxel_m
-    std::vector<Eigen::Vector3f> points;   // cropped, full resolution, LiDAR frame
-    Eigen::Isometry3d pose;                // T_{l0 l}
+    Cloud::Ptr map_cloud;  // in l0, downsampled at map_voxel_m
+    // Cropped, full resolution, LiDAR frame; shared with the quality map's
+    // builder.
+    std::shared_ptr<const std::vector<Eigen::Vector3f>> points;
+    Eigen::Isometry3d pose;  // T_{l0 l}
   };
 
   proto::LidarOdometryParams params;
@@ -150,12 +166,20 @@ struct LidarOdometry::Impl {
   Eigen::Isometry3d last_keyframe_pose = Eigen::Isometry3d::Identity();
   Cloud::Ptr target;
   std::unique_ptr<SurfelMap> quality_map;  // surfels of the local map, frame l0
+  // The quality map of the latest keyframe, built while the next scan is
+  // registered (on the calling thread at its first use when num_threads is 1).
+  std::future<std::unique_ptr<SurfelMap>> next_quality_map;
   pcl::GeneralizedIterativeClosestPoint<pcl::PointXYZ, pcl::PointXYZ> gicp;
   pcl::NormalDistributionsTransform<pcl::PointXYZ, pcl::PointXYZ> ndt;
   std::unique_ptr<VoxelIcpOdometry> voxel_icp;  // set for method VOXEL_ICP
+  // GICP's target tree, built here so that the point covariances are
+  // computed on num_threads threads (gicp_covariances.h) and GICP only
+  // reuses it; each prepared scan brings its own source tree.
+  std::shared_ptr<SingleQueryKdTree> target_tree = std::make_shared<SingleQueryKdTree>();
+  int num_threads = 1;
 
-  Impl(const proto::LidarOdometryParams& p, const proto::LidarScanParams& s)
-      : params(p), scans(s) {
+  Impl(const proto::LidarOdometryParams& p, const proto::LidarScanParams& s, int threads)
+      : params(p), scans(s), num_threads(std::max(threads, 1)) {
     if (p.method() == proto::LidarOdometryParams::VOXEL_ICP) {
       voxel_icp = std::make_unique<VoxelIcpOdometry>(p, s);
     }
@@ -165,9 +189,9 @@ struct LidarOdometry::Impl {
     gicp.setMaxCorrespondenceDistance(p.max_correspondence_m());
     gicp.setCorrespondenceRandomness(static_cast<int>(p.gicp_neighbours()));
     gicp.setMaximumOptimizerIterations(static_cast<int>(p.gicp_optimizer_iterations()));
-    // Same neighbours as PCL's own trees, without an OpenMP region per query.
-    gicp.setSearchMethodTarget(std::make_shared<SingleQueryKdTree>());
-    gicp.setSearchMethodSource(std::make_shared<SingleQueryKdTree>());
+    // Same neighbours as PCL's own trees, without an OpenMP region per query;
+    // built by SetGicpTarget and Prepare, not by GICP.
+    gicp.setSearchMethodTarget(target_tree, /*force_no_recompute=*/true);
     ndt.setResolution(static_cast<float>(p.ndt_resolution_m()));
     ndt.setStepSize(p.ndt_step_size_m());
     ndt.setTransformationEpsilon(p.transformation_epsilon());
@@ -175,6 +199,24 @@ struct LidarOdometry::Impl {
   }
 
   bool UsesGicp() const { return params.method() == proto::LidarOdometryParams::GICP; }
+
+  // GICP's input clouds with their trees and point covariances (when the
+  // cloud has at least gicp_neighbours points; otherwise GICP computes and
+  // refuses them itself).
+  void SetGicpTarget(const Cloud::ConstPtr& cloud) {
+    target_tree->setInputCloud(cloud);
+    gicp.setInputTarget(cloud);
+    auto covariances = std::make_shared<GicpCovariances>();
+    if (ComputeGicpCovariances(*cloud, *target_tree, gicp.getCorrespondenceRandomness(),
+                               kGicpEpsilon, num_threads, covariances.get())) {
+      gicp.setTargetCovariances(covariances);
+    }
+  }
+  void SetGicpSource(const PreparedScan& scan) {
+    gicp.setSearchMethodSource(scan.tree, /*force_no_recompute=*/true);
+    gicp.setInputSource(scan.source);
+    if (scan.covariances) gicp.setSourceCovariances(scan.covariances);
+  }
 
   // Range crop (into *cropped) and voxel downsampling (returned).
   Cloud::Ptr Preprocess(const std::vector<Eigen::Vector3f>& points, std::vector<Eigen::Vector3f>* cropped) const {
@@ -197,7 +239,9 @@ struct LidarOdometry::Impl {
                    const Eigen::Isometry3d& pose) {
     Cloud::Ptr in_l0(new Cloud);
     pcl::transformPointCloud(*scan_lidar, *in_l0, pose.matrix().cast<float>());
-    keyframes.push_back(Keyframe{Downsample(in_l0, params.map_voxel_m()), std::move(points), pose});
+    keyframes.push_back(Keyframe{Downsample(in_l0, params.map_voxel_m()),
+                                 std::make_shared<const std::vector<Eigen::Vector3f>>(std::move(points)),
+                                 pose});
     while (static_cast<int>(keyframes.size()) > std::max(static_cast<int>(params.local_map_keyframes()), 1)) {
       keyframes.pop_front();
     }
@@ -205,14 +249,22 @@ struct LidarOdometry::Impl {
     for (const Keyframe& k : keyframes) *merged += *k.map_cloud;
     target = Downsample(merged, params.map_voxel_m());
     if (UsesGicp()) {
-      gicp.setInputTarget(target);
+      SetGicpTarget(target);
     } else {
       ndt.setInputTarget(target);
     }
     // Quality reference: surfels of the full-resolution local map.
-    quality_map = std::make_unique<SurfelMap>(params.quality_map());
-    for (const Keyframe& k : keyframes) quality_map->AddPoints(k.pose, k.points);
-    quality_map->ExtractSurfels();
+    std::vector<std::pair<Eigen::Isometry3d, std::shared_ptr<const std::vector<Eigen::Vector3f>>>>
+        map_scans;
+    for (const Keyframe& k : keyframes) map_scans.emplace_back(k.pose, k.points);
+    next_quality_map = std::async(
+        num_threads > 1 ? std::launch::async : std::launch::deferred,
+        [map_params = params.quality_map(), map_scans = std::move(map_scans)] {
+          auto map = std::make_unique<SurfelMap>(map_params);
+          for (const auto& [scan_pose, points] : map_scans) map->AddPoints(scan_pose, *points);
+          map->ExtractSurfels();
+          return map;
+        });
     last_keyframe_pose = pose;
   }
 
@@ -245,7 +297,8 @@ struct LidarOdometry::Impl {
 
   // Point-to-plane agreement of the aligned (downsampled) scan with the
   // local map's surfels.
-  void Quality(const Cloud& aligned, LidarOdometryPose* pose) const {
+  void Quality(const Cloud& aligned, LidarOdometryPose* pose) {
+    if (next_quality_map.valid()) quality_map = next_quality_map.get();
     if (aligned.empty() || !quality_map) return;
     const double gate = params.quality_inlier_distance_m();
     double sum_sq = 0.0;
@@ -269,8 +322,8 @@ struct LidarOdometry::Impl {
 };
 
 LidarOdometry::LidarOdometry(const proto::LidarOdometryParams& params,
-                             const proto::LidarScanParams& scans)
-    : impl_(std::make_unique<Impl>(params, scans)) {}
+                             const proto::LidarScanParams& scans, int num_threads)
+    : impl_(std::make_unique<Impl>(params, scans, num_threads)) {}
 
 LidarOdometry::~LidarOdometry() = default;
 
@@ -279,6 +332,33 @@ const std::vector<LidarOdometryPose>& LidarOdometry::poses() const { return impl
 const LidarOdometryPose& LidarOdometry::AddScan(double time_s,
                                                 const std::vector<Eigen::Vector3f>& points_lidar,
                                                 const std::optional<Eigen::Quaterniond>& rotation_prior) {
+  return AddPrepared(time_s, *Prepare(points_lidar, impl_->num_threads), rotation_prior);
+}
+
+std::shared_ptr<LidarOdometry::PreparedScan> LidarOdometry::Prepare(
+    const std::vector<Eigen::Vector3f>& points_lidar, int num_threads) const {
+  const Impl& m = *impl_;
+  auto scan = std::make_shared<PreparedScan>();
+  if (m.voxel_icp) {
+    scan->points_lidar = points_lidar;
+    return scan;
+  }
+  scan->source = m.Preprocess(points_lidar, &scan->cropped);
+  if (m.UsesGicp() && !scan->source->empty()) {
+    scan->tree = std::make_shared<SingleQueryKdTree>();
+    scan->tree->setInputCloud(scan->source);
+    auto covariances = std::make_shared<GicpCovariances>();
+    if (ComputeGicpCovariances(*scan->source, *scan->tree,
+                               static_cast<int>(m.params.gicp_neighbours()), kGicpEpsilon,
+                               num_threads, covariances.get())) {
+      scan->covariances = std::move(covariances);
+    }
+  }
+  return scan;
+}
+
+const LidarOdometryPose& LidarOdometry::AddPrepared(
+    double time_s, const PreparedScan& scan, const std::optional<Eigen::Quaterniond>& rotation_prior) {
   Impl& m = *impl_;
   const auto start = std::chrono::steady_clock::now();
   LidarOdometryPose pose;
@@ -286,21 +366,20 @@ const LidarOdometryPose& LidarOdometry::AddScan(double time_s,
   if (m.voxel_icp) {
     const Eigen::Isometry3d guess =
         m.poses.empty() ? Eigen::Isometry3d::Identity() : m.Predict(time_s, rotation_prior);
-    m.voxel_icp->Register(points_lidar, guess, &pose);
+    m.voxel_icp->Register(scan.points_lidar, guess, &pose);
     pose.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     m.poses.push_back(pose);
     m.priors.push_back(rotation_prior);
     return m.poses.back();
   }
-  std::vector<Eigen::Vector3f> cropped;
-  const Cloud::Ptr source = m.Preprocess(points_lidar, &cropped);
+  const Cloud::Ptr& source = scan.source;
   pose.num_source_points = static_cast<int>(source->size());
 
   if (m.poses.empty() || !m.target || m.target->empty()) {
     // First scan (or no map yet): it defines l0 / starts the map.
     pose.l0_from_lidar = m.poses.empty() ? Eigen::Isometry3d::Identity() : m.Predict(time_s, rotation_prior);
     if (!source->empty()) {
-      m.AddKeyframe(source, std::move(cropped), pose.l0_from_lidar);
+      m.AddKeyframe(source, scan.cropped, pose.l0_from_lidar);
       pose.keyframe = true;
     }
   } else {
@@ -311,7 +390,7 @@ const LidarOdometryPose& LidarOdometry::AddScan(double time_s,
       const Eigen::Matrix4f guess_f = guess.matrix().cast<float>();
       Eigen::Matrix4f result;
       if (m.UsesGicp()) {
-        m.gicp.setInputSource(source);
+        m.SetGicpSource(scan);
         m.gicp.align(aligned, guess_f);
         pose.converged = m.gicp.hasConverged();
         result = m.gicp.getFinalTransformation();
@@ -331,7 +410,7 @@ const LidarOdometryPose& LidarOdometry::AddScan(double time_s,
     if (pose.registered &&
         (since_keyframe.translation().norm() > m.params.keyframe_distance_m() ||
          RotationAngle(since_keyframe.linear()) * 180.0 / M_PI > m.params.keyframe_angle_deg())) {
-      m.AddKeyframe(source, std::move(cropped), pose.l0_from_lidar);
+      m.AddKeyframe(source, scan.cropped, pose.l0_from_lidar);
       pose.keyframe = true;
     }
   }

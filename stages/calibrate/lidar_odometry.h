@@ -66,7 +66,12 @@ struct LidarOdometryPose {
 
 class LidarOdometry {
  public:
-  LidarOdometry(const proto::LidarOdometryParams& params, const proto::LidarScanParams& scans);
+  // num_threads: threads of GICP's point covariances (gicp_covariances.h);
+  // with two or more, a new keyframe's quality map is built while the next
+  // scan is registered. The registration itself is sequential; the results
+  // do not depend on the thread count.
+  LidarOdometry(const proto::LidarOdometryParams& params, const proto::LidarScanParams& scans,
+                int num_threads = 1);
   ~LidarOdometry();
   LidarOdometry(const LidarOdometry&) = delete;
   LidarOdometry& operator=(const LidarOdometry&) = delete;
@@ -76,6 +81,17 @@ class LidarOdometry {
   // be finite; an empty scan keeps the predicted pose with registered=false.
   const LidarOdometryPose& AddScan(double time_s, const std::vector<Eigen::Vector3f>& points_lidar,
                                    const std::optional<Eigen::Quaterniond>& rotation_prior);
+
+  // AddScan in two steps. Prepare makes a scan ready for registration (range
+  // crop and downsampling; for GICP also its k-d tree and point covariances,
+  // on num_threads threads) and reads nothing of the odometry's state, so it
+  // may run on another thread while the previous scan is registered.
+  // AddPrepared registers it; its pose's `seconds` leave Prepare out.
+  struct PreparedScan;
+  std::shared_ptr<PreparedScan> Prepare(const std::vector<Eigen::Vector3f>& points_lidar,
+                                        int num_threads) const;
+  const LidarOdometryPose& AddPrepared(double time_s, const PreparedScan& scan,
+                                       const std::optional<Eigen::Quaterniond>& rotation_prior);
 
   const std::vector<LidarOdometryPose>& poses() const;
 

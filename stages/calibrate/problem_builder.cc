@@ -9,7 +9,9 @@
 #include "stages/calibrate/accel_cost_function.h"
 #include "stages/calibrate/bias_random_walk_cost_function.h"
 #include "stages/calibrate/gyro_cost_function.h"
+#include "stages/calibrate/interval_manifold.h"
 #include "stages/calibrate/point_to_plane_cost_function.h"
+#include "stages/calibrate/stacked_cost_function.h"
 
 namespace tiltcal::calibrate {
 namespace {
@@ -82,8 +84,8 @@ CalibrationProblem::CalibrationProblem(CalibrationState* state,
   tau_upper_ = std::min(highest, tau_bin + options_.time_offset_step_bound_s);
   state_->time_offset_s[0] = tau_bin;
   if (options_.estimate_time_offset && tau_upper_ > tau_lower_) {
-    p.SetParameterLowerBound(state_->time_offset_s, 0, tau_lower_);
-    p.SetParameterUpperBound(state_->time_offset_s, 0, tau_upper_);
+    time_offset_manifold_ = std::make_unique<IntervalManifold>(tau_lower_, tau_upper_);
+    p.SetManifold(state_->time_offset_s, time_offset_manifold_.get());
   } else {
     p.SetParameterBlockConstant(state_->time_offset_s);
   }
@@ -130,37 +132,43 @@ void CalibrationProblem::AddImuResiduals(const std::vector<imu::ImuReading>& sam
                                          bool accel) {
   spline::SplineTrajectory& traj = state_->trajectory;
   const spline::UniformKnotGrid& grid = traj.grid();
+  StackedResidualAdder gyro_rows(nullptr);
+  StackedResidualAdder accel_rows(nullptr);
   for (const imu::ImuReading& s : samples) {
     spline::KnotWindow w;
     if (!grid.Locate(s.time_s, &w)) continue;
     const int k = w.first_knot;
     if (gyro) {
-      problem_->AddResidualBlock(
-          new GyroCostFunction(w, grid.inv_dt(), s.angular_velocity_radps,
-                               imu_noise_.gyro_sigma_radps()),
-          nullptr, traj.rotation_knot(k), traj.rotation_knot(k + 1), traj.rotation_knot(k + 2),
-          traj.rotation_knot(k + 3), state_->gyro_bias.Block(s.time_s));
+      auto* row = new GyroCostFunction(w, grid.inv_dt(), s.angular_velocity_radps,
+                                       imu_noise_.gyro_sigma_radps());
+      std::vector<double*> blocks = {traj.rotation_knot(k), traj.rotation_knot(k + 1),
+                                     traj.rotation_knot(k + 2), traj.rotation_knot(k + 3),
+                                     state_->gyro_bias.Block(s.time_s)};
+      gyro_rows.Add(row, std::move(blocks));
       ++counts_.gyro_residuals;
       MarkKnots(k, false);
     }
     if (accel) {
-      problem_->AddResidualBlock(
-          new AccelCostFunction(w, grid.inv_dt(), s.linear_acceleration_mps2,
-                                imu_noise_.accel_sigma_mps2(), state_->gravity_norm_mps2),
-          nullptr,
-          {traj.rotation_knot(k), traj.rotation_knot(k + 1), traj.rotation_knot(k + 2),
-           traj.rotation_knot(k + 3), traj.position_knot(k), traj.position_knot(k + 1),
-           traj.position_knot(k + 2), traj.position_knot(k + 3), state_->gravity_direction,
-           state_->accel_bias.Block(s.time_s)});
+      auto* row = new AccelCostFunction(w, grid.inv_dt(), s.linear_acceleration_mps2,
+                                        imu_noise_.accel_sigma_mps2(), state_->gravity_norm_mps2);
+      std::vector<double*> blocks = {
+          traj.rotation_knot(k), traj.rotation_knot(k + 1), traj.rotation_knot(k + 2),
+          traj.rotation_knot(k + 3), traj.position_knot(k), traj.position_knot(k + 1),
+          traj.position_knot(k + 2), traj.position_knot(k + 3), state_->gravity_direction,
+          state_->accel_bias.Block(s.time_s)};
+      accel_rows.Add(row, std::move(blocks));
       ++counts_.accel_residuals;
       MarkKnots(k, true);
     }
   }
+  gyro_rows.Flush(problem_.get());
+  accel_rows.Flush(problem_.get());
 }
 
 void CalibrationProblem::AddLidarResiduals(const std::vector<LidarPointResidual>& points) {
   spline::SplineTrajectory& traj = state_->trajectory;
   const spline::UniformKnotGrid& grid = traj.grid();
+  StackedResidualAdder rows(lidar_loss_.get());
   for (const LidarPointResidual& r : points) {
     spline::KnotWindow w;
     if (!state_->TimeWindow(r.time_s, &w)) {
@@ -168,18 +176,19 @@ void CalibrationProblem::AddLidarResiduals(const std::vector<LidarPointResidual>
       continue;
     }
     const int k = w.first_knot;
-    problem_->AddResidualBlock(
-        new PointToPlaneCostFunction(grid.SegmentStart(k), grid.inv_dt(), r.time_s,
-                                     r.point_lidar_m, r.plane_normal, r.plane_offset_m,
-                                     lidar_.sigma_m()),
-        lidar_loss_.get(),
-        {traj.rotation_knot(k), traj.rotation_knot(k + 1), traj.rotation_knot(k + 2),
-         traj.rotation_knot(k + 3), traj.position_knot(k), traj.position_knot(k + 1),
-         traj.position_knot(k + 2), traj.position_knot(k + 3), state_->imu_from_lidar_rotation,
-         state_->imu_from_lidar_translation, state_->time_offset_s});
+    auto* row = new PointToPlaneCostFunction(grid.SegmentStart(k), grid.inv_dt(), r.time_s,
+                                             r.point_lidar_m, r.plane_normal, r.plane_offset_m,
+                                             lidar_.sigma_m());
+    std::vector<double*> blocks = {
+        traj.rotation_knot(k), traj.rotation_knot(k + 1), traj.rotation_knot(k + 2),
+        traj.rotation_knot(k + 3), traj.position_knot(k), traj.position_knot(k + 1),
+        traj.position_knot(k + 2), traj.position_knot(k + 3), state_->imu_from_lidar_rotation,
+        state_->imu_from_lidar_translation, state_->time_offset_s};
+    rows.Add(row, std::move(blocks));
     ++counts_.lidar_residuals;
     MarkKnots(k, true);
   }
+  rows.Flush(problem_.get());
 }
 
 Status CalibrationProblem::AddExtraResiduals(const ExtraResidualAdder& adder) {

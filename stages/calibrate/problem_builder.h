@@ -3,15 +3,18 @@
 
 // The ceres::Problem of the spline calibration (docs/design.md §6, §7, §13):
 // parameter blocks of a CalibrationState with their manifolds, gauge, the
-// bound on tau, and the residual blocks (all analytic, fixed-size):
-//   gyro  (gyro_cost_function.h):  one per IMU sample, weight
+// bound on tau, and the residuals (all analytic, fixed-size rows):
+//   gyro  (gyro_cost_function.h):  one row per IMU sample, weight
 //         1/ImuNoiseParams.gyro_sigma_radps;
-//   accel (accel_cost_function.h): one per IMU sample, weight
+//   accel (accel_cost_function.h): one row per IMU sample, weight
 //         1/ImuNoiseParams.accel_sigma_mps2;
-//   lidar (point_to_plane_cost_function.h): one per associated point, weight
-//         1/LidarResidualParams.sigma_m, Cauchy loss of scale
-//         LidarResidualParams.cauchy_scale (in units of the weighted
+//   lidar (point_to_plane_cost_function.h): one row per associated point,
+//         weight 1/LidarResidualParams.sigma_m, Cauchy loss of scale
+//         LidarResidualParams.cauchy_scale per row (in units of the weighted
 //         residual, i.e. of sigma_m; 0 = none);
+//   the rows of one kind with the same parameter blocks (the same knot
+//   window, bias segment) form one residual block (stacked_cost_function.h),
+//   the Cauchy loss folded into each LiDAR row;
 //   more residual sets (the ground residuals, ground_residuals.h) through
 //   AddExtraResiduals, which only adds residual blocks on the state's pointers.
 //
@@ -36,7 +39,7 @@
 // observe, while in-plane directions are left to the data). Counted in
 // ProblemCounts::prior_residuals.
 //
-// Time offset: tau is bounded to
+// Time offset: tau is held (interval_manifold.h) in
 //   [max(C - B, tau_bin - S), min(C + B, tau_bin + S)],
 // C = time_offset_center_s, B = time_offset_bound_s (|tau - C| <= B
 // overall), S = time_offset_step_bound_s
@@ -62,6 +65,7 @@
 #include "common/spline/quaternion_manifold.h"
 #include "common/status.h"
 #include "stages/calibrate/calibration_state.h"
+#include "stages/calibrate/interval_manifold.h"
 #include "tiltcal/proto/calibrate_params.pb.h"
 
 namespace tiltcal::calibrate {
@@ -159,6 +163,7 @@ class CalibrationProblem {
   ProblemOptions options_;
   spline::RightQuaternionManifold quaternion_manifold_;
   ceres::SphereManifold<3> sphere_manifold_;
+  std::unique_ptr<IntervalManifold> time_offset_manifold_;  // tau in its bounds
   std::unique_ptr<ceres::LossFunction> lidar_loss_;
   std::unique_ptr<ceres::Problem> problem_;
   ProblemCounts counts_;

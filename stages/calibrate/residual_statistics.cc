@@ -8,6 +8,7 @@
 #include "stages/calibrate/ground_cost_functions.h"
 #include "stages/calibrate/gyro_cost_function.h"
 #include "stages/calibrate/point_to_plane_cost_function.h"
+#include "stages/calibrate/stacked_cost_function.h"
 
 namespace tiltcal::calibrate {
 namespace {
@@ -15,7 +16,12 @@ namespace {
 enum ResidualType { kGyro = 0, kAccel, kLidar, kGround, kOther };
 constexpr const char* kTypeNames[] = {"gyro", "accel", "lidar", "ground"};
 
+// The type of a residual block's cost function; a stacked block has its
+// rows' type.
 ResidualType TypeOf(const ceres::CostFunction* f) {
+  if (const auto* stacked = dynamic_cast<const StackedCostFunction*>(f)) {
+    return TypeOf(&stacked->row(0));
+  }
   if (dynamic_cast<const GyroCostFunction*>(f) != nullptr) return kGyro;
   if (dynamic_cast<const AccelCostFunction*>(f) != nullptr) return kAccel;
   if (dynamic_cast<const PointToPlaneCostFunction*>(f) != nullptr) return kLidar;
@@ -140,24 +146,28 @@ std::vector<proto::ResidualStatistics> ComputeResidualStatistics(
     if (type != kOther) by_type[type].push_back(id);
   }
   std::vector<proto::ResidualStatistics> out;
+  std::vector<double*> parameters;
+  std::vector<double> block_residuals;
   for (int t = 0; t < kOther; ++t) {
     if (by_type[t].empty()) continue;
-    ceres::Problem::EvaluateOptions options;
-    options.residual_blocks = by_type[t];
-    options.apply_loss_function = false;
-    double cost = 0.0;
+    // The rows' own residuals, without a loss (a stacked block folds its
+    // loss into what Ceres sees).
     std::vector<double> residuals;
-    if (!problem->Evaluate(options, &cost, &residuals, nullptr, nullptr)) continue;
-    // Evaluate lists the residuals block by block in the order given.
     std::vector<TimedResidual> timed;
-    size_t offset = 0;
     for (ceres::ResidualBlockId id : by_type[t]) {
-      const int size = problem->GetCostFunctionForResidualBlock(id)->num_residuals();
+      const ceres::CostFunction* cost = problem->GetCostFunctionForResidualBlock(id);
+      problem->GetParameterBlocksForResidualBlock(id, &parameters);
+      block_residuals.resize(static_cast<size_t>(cost->num_residuals()));
+      const auto* stacked = dynamic_cast<const StackedCostFunction*>(cost);
+      const bool ok = stacked != nullptr
+                          ? stacked->EvaluateRows(parameters.data(), block_residuals.data())
+                          : cost->Evaluate(parameters.data(), block_residuals.data(), nullptr);
+      if (!ok) continue;
+      residuals.insert(residuals.end(), block_residuals.begin(), block_residuals.end());
       double time_s = 0.0;
       if (BlockTime(problem, id, state, &time_s)) {
-        for (int k = 0; k < size; ++k) timed.push_back({time_s, residuals[offset + k]});
+        for (const double r : block_residuals) timed.push_back({time_s, r});
       }
-      offset += static_cast<size_t>(size);
     }
     proto::ResidualStatistics s = SummariseResiduals(kTypeNames[t], std::move(residuals));
     FillTimeSeries(timed, start_s, end_s, static_cast<int>(params.bins()), &s);

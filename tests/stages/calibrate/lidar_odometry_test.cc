@@ -56,11 +56,13 @@ proto::CalibrateParams RoomOdometryParams(const std::string& method) {
       "local_map_keyframes: 6 }");
 }
 
-OdometryErrors RunOdometry(const proto::CalibrateParams& params, bool with_prior, int num_scans) {
+OdometryErrors RunOdometry(const proto::CalibrateParams& params, bool with_prior, int num_scans,
+                           int num_threads = 1,
+                           std::vector<LidarOdometryPose>* poses_out = nullptr) {
   const Scene scene = MakeDefaultScene();
   std::mt19937 rng(31);
   const LidarPattern pattern;  // full VLP-16 resolution: 16 x 1800
-  LidarOdometry odometry(params.odometry(), params.scans());
+  LidarOdometry odometry(params.odometry(), params.scans(), num_threads);
   const Eigen::Isometry3d w_from_l0 = TruePose(0.0);
   std::vector<Eigen::Isometry3d> truth;
   std::vector<std::vector<Eigen::Vector3f>> scans;
@@ -103,6 +105,7 @@ OdometryErrors RunOdometry(const proto::CalibrateParams& params, bool with_prior
     e.worst_inlier_fraction = std::min(e.worst_inlier_fraction, poses[k].inlier_fraction);
   }
   e.mean_seconds /= static_cast<double>(poses.size() - 1);
+  if (poses_out != nullptr) *poses_out = poses;
   e.mean_cpu_seconds = cpu_seconds / num_scans;
   std::printf(
       "odometry %s prior=%d: |dr| %.4f m, |dphi| %.4f deg (abs); step %.4f m, %.4f deg; "
@@ -123,6 +126,25 @@ TEST(LidarOdometryTest, GicpRecoversRelativePosesWithGyroPrior) {
   // Quality: point-to-plane RMS at the range noise (1 cm), nearly all inliers.
   EXPECT_LT(e.worst_rms_m, 0.02);
   EXPECT_GT(e.worst_inlier_fraction, 0.95);
+}
+
+// Two threads (GICP's covariances split, the quality map built alongside
+// the next registration) give the poses and quality figures of one.
+TEST(LidarOdometryTest, GicpOnTwoThreadsGivesTheResultsOfOne) {
+  std::vector<LidarOdometryPose> one, two;
+  RunOdometry(RoomOdometryParams("GICP"), /*with_prior=*/true, 25, 1, &one);
+  RunOdometry(RoomOdometryParams("GICP"), /*with_prior=*/true, 25, 2, &two);
+  ASSERT_EQ(one.size(), two.size());
+  int keyframes = 0;
+  for (std::size_t k = 0; k < one.size(); ++k) {
+    EXPECT_EQ(one[k].l0_from_lidar.matrix(), two[k].l0_from_lidar.matrix()) << k;
+    EXPECT_EQ(one[k].fitness_rms_m, two[k].fitness_rms_m) << k;
+    EXPECT_EQ(one[k].inlier_fraction, two[k].inlier_fraction) << k;
+    EXPECT_EQ(one[k].num_quality_points, two[k].num_quality_points) << k;
+    EXPECT_EQ(one[k].keyframe, two[k].keyframe) << k;
+    keyframes += one[k].keyframe;
+  }
+  EXPECT_GE(keyframes, 3) << "the local map should change during the run";
 }
 
 TEST(LidarOdometryTest, GicpWithoutPriorUsesConstantVelocity) {

@@ -1,6 +1,7 @@
 // SingleQueryKdTree against PCL's own pcl::search::KdTree: the same
 // neighbours in the same order with the same distances, and the same GICP
-// alignment to the last bit.
+// alignment to the last bit; ComputeGicpCovariances against GICP's own
+// covariances, bit for bit.
 
 #include <cmath>
 #include <limits>
@@ -10,12 +11,15 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
+
 #include <pcl/common/transforms.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 #include <pcl/registration/gicp.h>
 #include <pcl/search/kdtree.h>
 
+#include "stages/calibrate/gicp_covariances.h"
 #include "stages/calibrate/single_query_kd_tree.h"
 
 namespace tiltcal::calibrate {
@@ -102,6 +106,89 @@ TEST(SingleQueryKdTreeTest, GicpAlignsExactlyAsWithPclKdTrees) {
   }
   EXPECT_EQ(results[1], results[0]);
   // It undid the motion.
+  EXPECT_LT((results[0] * motion.matrix() - Eigen::Matrix4f::Identity()).norm(), 0.02f);
+}
+
+// GICP with its protected covariance computation made callable.
+class GicpExposingCovariances
+    : public pcl::GeneralizedIterativeClosestPoint<pcl::PointXYZ, pcl::PointXYZ> {
+ public:
+  using pcl::GeneralizedIterativeClosestPoint<pcl::PointXYZ, pcl::PointXYZ>::computeCovariances;
+};
+
+TEST(GicpCovariancesTest, SameAsPclBitForBitOnAnyNumberOfThreads) {
+  const Cloud::Ptr cloud = RoomCloud(5, 3001, false);
+  auto tree = std::make_shared<SingleQueryKdTree>();
+  tree->setInputCloud(cloud);
+  GicpExposingCovariances gicp;
+  gicp.setCorrespondenceRandomness(10);
+  GicpExposingCovariances::MatricesVector pcl_covariances;
+  gicp.computeCovariances<pcl::PointXYZ>(cloud, tree, pcl_covariances);
+  ASSERT_EQ(pcl_covariances.size(), cloud->size());
+  for (const int threads : {1, 2, 3}) {
+    GicpCovariances covariances;
+    ASSERT_TRUE(ComputeGicpCovariances(*cloud, *tree, 10, 0.001, threads, &covariances));
+    ASSERT_EQ(covariances.size(), cloud->size());
+    int different = 0;
+    for (std::size_t i = 0; i < cloud->size(); ++i) different += covariances[i] != pcl_covariances[i];
+    EXPECT_EQ(different, 0) << threads << " threads";
+  }
+  // A plane's covariance: unit spread in it, 0.001 m^2 across it.
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(pcl_covariances[0]);
+  EXPECT_NEAR(eig.eigenvalues()[0], 0.001, 1e-9);
+  EXPECT_NEAR(eig.eigenvalues()[2], 1.0, 1e-9);
+}
+
+TEST(GicpCovariancesTest, FewerPointsThanNeighboursIsRefused) {
+  const Cloud::Ptr cloud = RoomCloud(6, 9, false);
+  SingleQueryKdTree tree;
+  tree.setInputCloud(cloud);
+  GicpCovariances covariances(3, Eigen::Matrix3d::Identity());
+  EXPECT_FALSE(ComputeGicpCovariances(*cloud, tree, 10, 0.001, 2, &covariances));
+  EXPECT_EQ(covariances.size(), 3u) << "left untouched";
+}
+
+// The odometry's use: trees built beforehand (GICP told not to rebuild
+// them) and both clouds' covariances given; the same transformation as
+// GICP computing everything itself.
+TEST(GicpCovariancesTest, GicpGivenTheCovariancesAlignsExactlyAsOnItsOwn) {
+  const Cloud::Ptr target = RoomCloud(7, 4000, false);
+  Cloud::Ptr source(new Cloud);
+  Eigen::Affine3f motion = Eigen::Affine3f::Identity();
+  motion.rotate(Eigen::AngleAxisf(0.04f, Eigen::Vector3f(-0.1f, 0.2f, 1.0f).normalized()));
+  motion.translation() << -0.15f, 0.1f, 0.02f;
+  pcl::transformPointCloud(*RoomCloud(8, 2000, false), *source, motion);
+  Eigen::Matrix4f results[2];
+  for (int run = 0; run < 2; ++run) {
+    pcl::GeneralizedIterativeClosestPoint<pcl::PointXYZ, pcl::PointXYZ> gicp;
+    gicp.setMaxCorrespondenceDistance(1.0);
+    auto target_tree = std::make_shared<SingleQueryKdTree>();
+    auto source_tree = std::make_shared<SingleQueryKdTree>();
+    if (run == 0) {
+      gicp.setSearchMethodTarget(target_tree);
+      gicp.setSearchMethodSource(source_tree);
+      gicp.setInputTarget(target);
+      gicp.setInputSource(source);
+    } else {
+      gicp.setSearchMethodTarget(target_tree, /*force_no_recompute=*/true);
+      gicp.setSearchMethodSource(source_tree, /*force_no_recompute=*/true);
+      target_tree->setInputCloud(target);
+      source_tree->setInputCloud(source);
+      gicp.setInputTarget(target);
+      gicp.setInputSource(source);
+      auto target_covariances = std::make_shared<GicpCovariances>();
+      auto source_covariances = std::make_shared<GicpCovariances>();
+      ASSERT_TRUE(ComputeGicpCovariances(*target, *target_tree, 20, 0.001, 2, target_covariances.get()));
+      ASSERT_TRUE(ComputeGicpCovariances(*source, *source_tree, 20, 0.001, 2, source_covariances.get()));
+      gicp.setTargetCovariances(target_covariances);
+      gicp.setSourceCovariances(source_covariances);
+    }
+    Cloud aligned;
+    gicp.align(aligned);
+    ASSERT_TRUE(gicp.hasConverged()) << run;
+    results[run] = gicp.getFinalTransformation();
+  }
+  EXPECT_EQ(results[1], results[0]);
   EXPECT_LT((results[0] * motion.matrix() - Eigen::Matrix4f::Identity()).norm(), 0.02f);
 }
 

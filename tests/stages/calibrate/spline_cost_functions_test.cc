@@ -10,14 +10,20 @@
 #include <string>
 #include <vector>
 
+#include <ceres/loss_function.h>
+#include <ceres/problem.h>
+#include <ceres/solver.h>
 #include <gtest/gtest.h>
 
 #include "common/geometry/so3.h"
+#include "common/spline/quaternion_manifold.h"
 #include "stages/calibrate/accel_cost_function.h"
 #include "stages/calibrate/bias_random_walk_cost_function.h"
 #include "stages/calibrate/gyro_cost_function.h"
 #include "stages/calibrate/orientation_sample_cost_function.h"
+#include "stages/calibrate/interval_manifold.h"
 #include "stages/calibrate/point_to_plane_cost_function.h"
+#include "stages/calibrate/stacked_cost_function.h"
 #include "tests/stages/calibrate/cost_function_twins.h"
 #include "tests/stages/calibrate/jacobian_checks.h"
 #include "tests/testing/random_vector.h"
@@ -259,6 +265,248 @@ TEST(BiasRandomWalkCostFunctionTest, ValueAndJacobians) {
   const std::vector<Block> blocks = {Block::kEuclidean, Block::kEuclidean};
   ExpectTangentDifferencesMatch(cost, params, blocks, "bias random walk");
   ExpectGradientCheckerPasses(cost, params, blocks, "bias random walk");
+}
+
+// ---- Stacked residual blocks (stacked_cost_function.h) ----
+
+// Rows of LiDAR points on one knot window: ranges of residuals from inliers
+// (|r| ~ 0.1) to outliers (|r| ~ 30, far beyond the Cauchy scale 2) and one
+// exactly on its plane (r = 0).
+std::vector<std::unique_ptr<ceres::CostFunction>> PlaneRows(const State& s, double dt,
+                                                            std::mt19937* rng) {
+  std::normal_distribution<double> n(0.0, 1.0);
+  std::vector<std::unique_ptr<ceres::CostFunction>> rows;
+  const double segment_start = 10.0, sigma = 0.03;
+  const double offsets[] = {-1.3, -0.5, 0.2, 0.9, 4.0};
+  for (int i = 0; i < 5; ++i) {
+    const double point_time = segment_start + (0.1 + 0.2 * i) * dt - s.tau;
+    const Eigen::Vector3d point = 4.0 * tiltcal::testing::RandomVector3(n, *rng);
+    const Eigen::Vector3d normal = tiltcal::testing::RandomVector3(n, *rng).normalized();
+    rows.emplace_back(new PointToPlaneCostFunction(segment_start, 1.0 / dt, point_time, point,
+                                                   normal, offsets[i], sigma));
+  }
+  return rows;
+}
+
+double RowResidual(const ceres::CostFunction& row, const std::vector<double*>& params) {
+  double r = 0.0;
+  EXPECT_TRUE(row.Evaluate(params.data(), &r, nullptr));
+  return r;
+}
+
+TEST(StackedCostFunctionTest, WithoutALossRowsAreStackedUnchanged) {
+  std::mt19937 rng(61);
+  State s = RandomState(&rng, 0.05);
+  const std::vector<double*> params = PlaneParams(&s, 0);
+  auto rows = PlaneRows(s, 0.05, &rng);
+  std::vector<const ceres::CostFunction*> plain;
+  for (const auto& r : rows) plain.push_back(r.get());
+  const StackedCostFunction stacked(std::move(rows), nullptr);
+  ASSERT_EQ(stacked.num_residuals(), 5);
+  Eigen::VectorXd residual;
+  std::vector<testing::RowMajor> jacobians;
+  testing::EvaluateAll(stacked, params, &residual, &jacobians);
+  for (int i = 0; i < 5; ++i) {
+    Eigen::VectorXd row_residual;
+    std::vector<testing::RowMajor> row_jacobians;
+    testing::EvaluateAll(*plain[i], params, &row_residual, &row_jacobians);
+    EXPECT_EQ(residual[i], row_residual[0]);
+    for (std::size_t k = 0; k < params.size(); ++k) {
+      EXPECT_EQ(jacobians[k].row(i), row_jacobians[k].row(0)) << "row " << i << " block " << k;
+    }
+  }
+}
+
+TEST(StackedCostFunctionTest, FoldedCauchyLossKeepsTheCostAndDifferentiatesCorrectly) {
+  std::mt19937 rng(67);
+  const ceres::CauchyLoss loss(2.0);
+  for (double dt : kSpacings) {
+    State s = RandomState(&rng, dt);
+    const std::vector<double*> params = PlaneParams(&s, 0);
+    auto rows = PlaneRows(s, dt, &rng);
+    double raw[5];
+    for (int i = 0; i < 5; ++i) raw[i] = RowResidual(*rows[static_cast<std::size_t>(i)], params);
+    const StackedCostFunction stacked(std::move(rows), &loss);
+    double folded[5];
+    ASSERT_TRUE(stacked.Evaluate(params.data(), folded, nullptr));
+    double rows_again[5];
+    ASSERT_TRUE(stacked.EvaluateRows(params.data(), rows_again));
+    bool has_outlier = false;
+    for (int i = 0; i < 5; ++i) {
+      EXPECT_EQ(rows_again[i], raw[i]);
+      // 1/2 r~^2 = 1/2 rho(r^2), same sign as r.
+      double rho[3];
+      loss.Evaluate(raw[i] * raw[i], rho);
+      EXPECT_NEAR(folded[i] * folded[i], rho[0], 1e-12 * (1.0 + rho[0])) << "row " << i;
+      EXPECT_GE(folded[i] * raw[i], 0.0);
+      has_outlier = has_outlier || std::abs(raw[i]) > 10.0;
+    }
+    EXPECT_TRUE(has_outlier) << "the rows should include one far beyond the Cauchy scale";
+    ExpectTangentDifferencesMatch(stacked, params, kPlaneBlocks, "stacked dt " + std::to_string(dt));
+  }
+}
+
+TEST(StackedCostFunctionTest, FoldedLossAtAZeroResidual) {
+  // r = x (one row, one parameter): at x = 0, r~ = 0 and dr~/dx = sqrt(rho'(0)) = 1.
+  class Identity final : public ceres::SizedCostFunction<1, 1> {
+   public:
+    bool Evaluate(double const* const* p, double* r, double** j) const override {
+      r[0] = p[0][0];
+      if (j != nullptr && j[0] != nullptr) j[0][0] = 1.0;
+      return true;
+    }
+  };
+  const ceres::CauchyLoss loss(2.0);
+  std::vector<std::unique_ptr<ceres::CostFunction>> rows;
+  rows.emplace_back(new Identity);
+  const StackedCostFunction stacked(std::move(rows), &loss);
+  double x = 0.0;
+  const double* params[] = {&x};
+  double r = 1.0, jacobian = 0.0;
+  double* jacobians[] = {&jacobian};
+  ASSERT_TRUE(stacked.Evaluate(params, &r, jacobians));
+  EXPECT_EQ(r, 0.0);
+  EXPECT_DOUBLE_EQ(jacobian, 1.0);
+  // Near zero: r~ = b sqrt(log(1 + x^2 / b^2)) and its derivative, to
+  // rounding (Ceres' own log(1 + s / b^2) is inexact there).
+  for (const double v : {1e-9, 1e-7, 1e-4, 1e-2, 0.5, 3.0, 30.0}) {
+    x = v;
+    ASSERT_TRUE(stacked.Evaluate(params, &r, jacobians));
+    const double expected = 2.0 * std::sqrt(std::log1p(v * v / 4.0));
+    // d/dx of 2 sqrt(L), L = log1p(x^2 / 4): (x / 2) / ((1 + x^2 / 4) sqrt(L)).
+    const double expected_derivative =
+        v < 1e-3 ? 1.0 - 3.0 * v * v / 16.0
+                 : (v / 2.0) / ((1.0 + v * v / 4.0) * std::sqrt(std::log1p(v * v / 4.0)));
+    EXPECT_NEAR(r, expected, 1e-10 * expected) << "x " << v;
+    EXPECT_NEAR(jacobian, expected_derivative, 1e-9) << "x " << v;
+  }
+}
+
+TEST(StackedCostFunctionTest, SameMinimumAsOneBlockPerRowWithTheLoss) {
+  // Fit the extrinsic translation (and tau) to points on planes with Cauchy
+  // outliers: per-row blocks with Ceres' loss and stacked blocks with the
+  // folded loss minimise the same cost.
+  std::mt19937 rng(71);
+  const double dt = 0.05, sigma = 0.03;
+  State truth = RandomState(&rng, dt);
+  std::normal_distribution<double> n(0.0, 1.0);
+  struct Point {
+    double time_s;
+    Eigen::Vector3d point, normal;
+    double offset;
+  };
+  // Planes through the points as the true state maps them, with 1 cm of
+  // noise; every 7th point 0.5 m off its plane (an outlier).
+  std::vector<Point> points;
+  const std::vector<double*> truth_params = PlaneParams(&truth, 0);
+  for (int i = 0; i < 60; ++i) {
+    Point p;
+    p.time_s = 10.0 + (i % 20) / 20.0 * dt - truth.tau;
+    p.point = 5.0 * tiltcal::testing::RandomVector3(n, rng);
+    p.normal = tiltcal::testing::RandomVector3(n, rng).normalized();
+    const PointToPlaneCostFunction through_origin(10.0, 1.0 / dt, p.time_s, p.point, p.normal,
+                                                  0.0, sigma);
+    p.offset = -RowResidual(through_origin, truth_params) * sigma + 0.01 * n(rng) +
+               (i % 7 == 0 ? 0.5 : 0.0);
+    points.push_back(p);
+  }
+  State start = truth;
+  start.r_b_lb += Eigen::Vector3d(0.05, -0.03, 0.04);
+  ceres::CauchyLoss loss(2.0);
+  auto solve = [&](bool stack) {
+    State s = start;
+    ceres::Problem::Options options;
+    options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    ceres::Problem problem(options);
+    spline::RightQuaternionManifold quaternion;
+    const std::vector<double*> params = PlaneParams(&s, 0);
+    for (std::size_t k = 0; k < params.size(); ++k) {
+      problem.AddParameterBlock(params[k], kPlaneBlocks[k] == Block::kQuaternion ? 4 : (k == 10 ? 1 : 3),
+                                kPlaneBlocks[k] == Block::kQuaternion ? &quaternion : nullptr);
+      if (k != 9) problem.SetParameterBlockConstant(params[k]);
+    }
+    StackedResidualAdder adder(&loss);
+    for (const Point& p : points) {
+      auto* row = new PointToPlaneCostFunction(10.0, 1.0 / dt, p.time_s, p.point, p.normal,
+                                               p.offset, sigma);
+      if (stack) {
+        adder.Add(row, params);
+      } else {
+        problem.AddResidualBlock(row, &loss, params);
+      }
+    }
+    EXPECT_EQ(adder.Flush(&problem), stack ? 1 : 0);
+    ceres::Solver::Options solver;
+    solver.function_tolerance = 1e-14;
+    solver.gradient_tolerance = 1e-14;
+    solver.parameter_tolerance = 1e-14;
+    solver.max_num_iterations = 200;
+    ceres::Solver::Summary summary;
+    ceres::Solve(solver, &problem, &summary);
+    EXPECT_EQ(summary.termination_type, ceres::CONVERGENCE);
+    return std::make_pair(s.r_b_lb, summary.final_cost);
+  };
+  const auto [per_row, per_row_cost] = solve(false);
+  const auto [stacked, stacked_cost] = solve(true);
+  EXPECT_LT((per_row - stacked).norm(), 1e-7) << per_row.transpose() << " vs " << stacked.transpose();
+  EXPECT_NEAR(per_row_cost, stacked_cost, 1e-9 * per_row_cost);
+  EXPECT_LT((stacked - truth.r_b_lb).norm(), 0.01) << "the outliers should not pull it away";
+}
+
+TEST(StackedResidualAdderTest, GroupsRowsWithTheSameParameterBlocks) {
+  std::mt19937 rng(73);
+  State s = RandomState(&rng, 0.05);
+  ceres::Problem problem;
+  StackedResidualAdder adder(nullptr);
+  auto rows = PlaneRows(s, 0.05, &rng);
+  // Rows 0, 2, 4 on the window starting at knot 0, rows 1, 3 at knot 1.
+  for (int i = 0; i < 5; ++i) adder.Add(rows[static_cast<std::size_t>(i)].release(), PlaneParams(&s, i % 2));
+  EXPECT_EQ(adder.Flush(&problem), 2);
+  EXPECT_EQ(problem.NumResidualBlocks(), 2);
+  EXPECT_EQ(problem.NumResiduals(), 5);
+  EXPECT_EQ(adder.Flush(&problem), 0) << "a flush empties the adder";
+}
+
+// ---- The time offset's interval (interval_manifold.h) ----
+
+TEST(IntervalManifoldTest, StepsAreProjectedOntoTheInterval) {
+  const IntervalManifold interval(-0.01, 0.02);
+  double x = 0.015, delta = 0.01, out = 0.0;
+  ASSERT_TRUE(interval.Plus(&x, &delta, &out));
+  EXPECT_EQ(out, 0.02);
+  delta = -0.1;
+  ASSERT_TRUE(interval.Plus(&x, &delta, &out));
+  EXPECT_EQ(out, -0.01);
+  delta = -0.005;
+  ASSERT_TRUE(interval.Plus(&x, &delta, &out));
+  EXPECT_DOUBLE_EQ(out, 0.01);
+  double jacobian = 0.0;
+  ASSERT_TRUE(interval.PlusJacobian(&x, &jacobian));
+  EXPECT_EQ(jacobian, 1.0);
+}
+
+TEST(IntervalManifoldTest, SolveEndsAtTheBoundLikeCeresBounds) {
+  // r = x - 1 with x in [-0.5, 0.25]: the minimum of the interval is its upper end.
+  class Offset final : public ceres::SizedCostFunction<1, 1> {
+   public:
+    bool Evaluate(double const* const* p, double* r, double** j) const override {
+      r[0] = p[0][0] - 1.0;
+      if (j != nullptr && j[0] != nullptr) j[0][0] = 1.0;
+      return true;
+    }
+  };
+  const IntervalManifold interval(-0.5, 0.25);
+  ceres::Problem::Options options;
+  options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem problem(options);
+  double x = 0.0;
+  problem.AddParameterBlock(&x, 1, const_cast<IntervalManifold*>(&interval));
+  problem.AddResidualBlock(new Offset, nullptr, &x);
+  ceres::Solver::Summary summary;
+  ceres::Solve(ceres::Solver::Options(), &problem, &summary);
+  EXPECT_EQ(x, 0.25);
+  EXPECT_FALSE(summary.is_constrained) << "no Ceres bounds: no projected line search";
 }
 
 }  // namespace
