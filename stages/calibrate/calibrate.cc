@@ -196,7 +196,7 @@ Status RunOuterRound(const OuterLoopSetup& setup, CalibrationState* state, Outer
   const double tau_before = state->time_offset_s[0];
   AssociationStageSummary assoc;
   BuildMapAndAssociate(*state, setup.inputs.scans, params.map(), params.association(),
-                       &loop->lidar, &assoc);
+                       static_cast<int>(params.num_threads()), &loop->lidar, &assoc);
   loop->map_s += assoc.map_seconds;
   loop->assoc_s += assoc.associate_seconds;
   if (loop->lidar.empty()) {

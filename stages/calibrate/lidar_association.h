@@ -39,9 +39,12 @@ struct AssociationStageSummary {
   double associate_seconds = 0.0;
 };
 
+// num_threads: scans are put in frame a on a second thread while the map
+// is built, and associated on num_threads threads; the result does not
+// depend on it.
 void BuildMapAndAssociate(const CalibrationState& state, const std::vector<LidarScan>& scans,
                           const proto::SurfelMapParams& map_params,
-                          const proto::AssociationParams& params,
+                          const proto::AssociationParams& params, int num_threads,
                           std::vector<LidarPointResidual>* residuals,
                           AssociationStageSummary* summary);
 
