@@ -353,10 +353,6 @@ void FillEstimate(const CalibrationState& state, const std::vector<std::string>&
   result->set_ground_residuals_reason(ground_reason);
 }
 
-// What the verdict is decided from besides the estimate and the covariance:
-// residual statistics and tau bounds of the last problem, the map sharpness
-// with the estimate and with the rig's extrinsic (same trajectory and tau),
-// the move from the rig, hand-eye and static start.
 // The map sharpness with the estimate and with the rig's extrinsic.
 struct MapSharpnessPair {
   proto::MapSharpness estimate;
@@ -377,6 +373,11 @@ MapSharpnessPair MeasureBothMapSharpnesses(const CalibrateInputs& inputs,
   return out;
 }
 
+// What the verdict is decided from besides the estimate and the covariance:
+// residual statistics and tau bounds of the last problem, the map sharpness
+// with the estimate and with the rig's extrinsic (same trajectory and tau,
+// measured by MeasureBothMapSharpnesses),
+// the move from the rig, hand-eye and static start.
 void FillVerdictFacts(const CalibrateInputs& inputs, const proto::CalibrateParams& params,
                       const InitialisationReport& init, CalibrationProblem* problem,
                       const CalibrationState& state, MapSharpnessPair sharpness,
