@@ -26,7 +26,6 @@ void KeepEvenlySpaced(size_t keep, std::vector<T>* v) {
   v->swap(out);
 }
 
-
 // Scan k's associations against the finished map, appended to *out (in
 // point order); the surfels they use go into *surfels_used.
 void AssociateScan(const CalibrationState& state, const LidarScan& scan, size_t k,
@@ -114,7 +113,8 @@ void BuildMapAndAssociate(const CalibrationState& state, const std::vector<Lidar
   // The association: the scans split into num_threads runs, each scan's
   // associations independent of the others', concatenated in scan order.
   start = std::chrono::steady_clock::now();
-  const size_t runs = std::min<size_t>(static_cast<size_t>(num_threads), std::max<size_t>(scans.size(), 1));
+  const size_t runs =
+      std::min<size_t>(static_cast<size_t>(num_threads), std::max<size_t>(scans.size(), 1));
   std::vector<std::vector<LidarPointResidual>> found(runs);
   std::vector<std::unordered_set<int>> surfels(runs);
   auto associate_run = [&](size_t run) {
@@ -125,7 +125,9 @@ void BuildMapAndAssociate(const CalibrationState& state, const std::vector<Lidar
     }
   };
   std::vector<std::future<void>> workers;
-  for (size_t run = 1; run < runs; ++run) workers.push_back(std::async(std::launch::async, associate_run, run));
+  for (size_t run = 1; run < runs; ++run) {
+    workers.push_back(std::async(std::launch::async, associate_run, run));
+  }
   associate_run(0);
   for (std::future<void>& w : workers) w.get();
   std::unordered_set<int> surfels_used;
