@@ -29,6 +29,26 @@ using Cloud = pcl::PointCloud<pcl::PointXYZ>;
 // no setter for, so the covariances computed here are the ones it would use.
 constexpr double kGicpEpsilon = 0.001;
 
+// GICP's search structures for one cloud, built here rather than by GICP so
+// that the point covariances use num_threads threads (gicp_covariances.h):
+// its k-d tree and, when it has at least k points, its covariances (null
+// otherwise: GICP then computes and refuses them itself).
+struct GicpSearch {
+  std::shared_ptr<SingleQueryKdTree> tree;
+  std::shared_ptr<GicpCovariances> covariances;
+};
+
+GicpSearch MakeGicpSearch(const Cloud::ConstPtr& cloud, int k, int num_threads) {
+  GicpSearch search{std::make_shared<SingleQueryKdTree>(), nullptr};
+  search.tree->setInputCloud(cloud);
+  auto covariances = std::make_shared<GicpCovariances>();
+  if (ComputeGicpCovariances(*cloud, *search.tree, k, kGicpEpsilon, num_threads,
+                             covariances.get())) {
+    search.covariances = std::move(covariances);
+  }
+  return search;
+}
+
 Cloud::Ptr Downsample(const Cloud::ConstPtr& in, double leaf_m) {
   Cloud::Ptr out(new Cloud);
   if (in->empty() || !(leaf_m > 0.0)) {
@@ -143,10 +163,10 @@ class VoxelIcpOdometry {
 
 struct LidarOdometry::PreparedScan {
   std::vector<Eigen::Vector3f> points_lidar;  // VOXEL_ICP: the scan as given
-  std::vector<Eigen::Vector3f> cropped;       // GICP / NDT: cropped, full resolution
-  Cloud::Ptr source;                          // GICP / NDT: downsampled at scan_voxel_m
-  std::shared_ptr<SingleQueryKdTree> tree;    // GICP: of `source`
-  std::shared_ptr<GicpCovariances> covariances;  // GICP: of `source` (null: too few points)
+  // GICP / NDT: cropped, full resolution (shared with a keyframe made of it).
+  std::shared_ptr<const std::vector<Eigen::Vector3f>> cropped;
+  Cloud::Ptr source;        // GICP / NDT: downsampled at scan_voxel_m
+  GicpSearch source_search;  // GICP: of `source`
 };
 
 struct LidarOdometry::Impl {
@@ -172,11 +192,7 @@ struct LidarOdometry::Impl {
   pcl::GeneralizedIterativeClosestPoint<pcl::PointXYZ, pcl::PointXYZ> gicp;
   pcl::NormalDistributionsTransform<pcl::PointXYZ, pcl::PointXYZ> ndt;
   std::unique_ptr<VoxelIcpOdometry> voxel_icp;  // set for method VOXEL_ICP
-  // GICP's target tree, built here so that the point covariances are
-  // computed on num_threads threads (gicp_covariances.h) and GICP only
-  // reuses it; each prepared scan brings its own source tree.
-  std::shared_ptr<SingleQueryKdTree> target_tree = std::make_shared<SingleQueryKdTree>();
-  int num_threads = 1;
+  int num_threads = 1;  // of GICP's point covariances
 
   Impl(const proto::LidarOdometryParams& p, const proto::LidarScanParams& s, int threads)
       : params(p), scans(s), num_threads(std::max(threads, 1)) {
@@ -189,9 +205,6 @@ struct LidarOdometry::Impl {
     gicp.setMaxCorrespondenceDistance(p.max_correspondence_m());
     gicp.setCorrespondenceRandomness(static_cast<int>(p.gicp_neighbours()));
     gicp.setMaximumOptimizerIterations(static_cast<int>(p.gicp_optimizer_iterations()));
-    // Same neighbours as PCL's own trees, without an OpenMP region per query;
-    // built by SetGicpTarget and Prepare, not by GICP.
-    gicp.setSearchMethodTarget(target_tree, /*force_no_recompute=*/true);
     ndt.setResolution(static_cast<float>(p.ndt_resolution_m()));
     ndt.setStepSize(p.ndt_step_size_m());
     ndt.setTransformationEpsilon(p.transformation_epsilon());
@@ -200,22 +213,20 @@ struct LidarOdometry::Impl {
 
   bool UsesGicp() const { return params.method() == proto::LidarOdometryParams::GICP; }
 
-  // GICP's input clouds with their trees and point covariances (when the
-  // cloud has at least gicp_neighbours points; otherwise GICP computes and
-  // refuses them itself).
+  // GICP's input clouds with their search structures (MakeGicpSearch): the
+  // same neighbours as PCL's own trees, without an OpenMP region per query,
+  // and trees GICP is told not to rebuild.
   void SetGicpTarget(const Cloud::ConstPtr& cloud) {
-    target_tree->setInputCloud(cloud);
+    const GicpSearch search =
+        MakeGicpSearch(cloud, static_cast<int>(params.gicp_neighbours()), num_threads);
+    gicp.setSearchMethodTarget(search.tree, /*force_no_recompute=*/true);
     gicp.setInputTarget(cloud);
-    auto covariances = std::make_shared<GicpCovariances>();
-    if (ComputeGicpCovariances(*cloud, *target_tree, gicp.getCorrespondenceRandomness(),
-                               kGicpEpsilon, num_threads, covariances.get())) {
-      gicp.setTargetCovariances(covariances);
-    }
+    if (search.covariances) gicp.setTargetCovariances(search.covariances);
   }
   void SetGicpSource(const PreparedScan& scan) {
-    gicp.setSearchMethodSource(scan.tree, /*force_no_recompute=*/true);
+    gicp.setSearchMethodSource(scan.source_search.tree, /*force_no_recompute=*/true);
     gicp.setInputSource(scan.source);
-    if (scan.covariances) gicp.setSourceCovariances(scan.covariances);
+    if (scan.source_search.covariances) gicp.setSourceCovariances(scan.source_search.covariances);
   }
 
   // Range crop (into *cropped) and voxel downsampling (returned).
@@ -235,13 +246,12 @@ struct LidarOdometry::Impl {
     return Downsample(cloud, params.scan_voxel_m());
   }
 
-  void AddKeyframe(const Cloud::ConstPtr& scan_lidar, std::vector<Eigen::Vector3f> points,
+  void AddKeyframe(const Cloud::ConstPtr& scan_lidar,
+                   std::shared_ptr<const std::vector<Eigen::Vector3f>> points,
                    const Eigen::Isometry3d& pose) {
     Cloud::Ptr in_l0(new Cloud);
     pcl::transformPointCloud(*scan_lidar, *in_l0, pose.matrix().cast<float>());
-    keyframes.push_back(Keyframe{Downsample(in_l0, params.map_voxel_m()),
-                                 std::make_shared<const std::vector<Eigen::Vector3f>>(std::move(points)),
-                                 pose});
+    keyframes.push_back(Keyframe{Downsample(in_l0, params.map_voxel_m()), std::move(points), pose});
     while (static_cast<int>(keyframes.size()) > std::max(static_cast<int>(params.local_map_keyframes()), 1)) {
       keyframes.pop_front();
     }
@@ -343,16 +353,12 @@ std::shared_ptr<LidarOdometry::PreparedScan> LidarOdometry::Prepare(
     scan->points_lidar = points_lidar;
     return scan;
   }
-  scan->source = m.Preprocess(points_lidar, &scan->cropped);
+  std::vector<Eigen::Vector3f> cropped;
+  scan->source = m.Preprocess(points_lidar, &cropped);
+  scan->cropped = std::make_shared<const std::vector<Eigen::Vector3f>>(std::move(cropped));
   if (m.UsesGicp() && !scan->source->empty()) {
-    scan->tree = std::make_shared<SingleQueryKdTree>();
-    scan->tree->setInputCloud(scan->source);
-    auto covariances = std::make_shared<GicpCovariances>();
-    if (ComputeGicpCovariances(*scan->source, *scan->tree,
-                               static_cast<int>(m.params.gicp_neighbours()), kGicpEpsilon,
-                               num_threads, covariances.get())) {
-      scan->covariances = std::move(covariances);
-    }
+    scan->source_search =
+        MakeGicpSearch(scan->source, static_cast<int>(m.params.gicp_neighbours()), num_threads);
   }
   return scan;
 }

@@ -4,6 +4,7 @@
 // covariances, bit for bit.
 
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <random>
@@ -81,39 +82,65 @@ TEST(SingleQueryKdTreeTest, SameNeighboursAsPclKdTree) {
   }
 }
 
-TEST(SingleQueryKdTreeTest, GicpAlignsExactlyAsWithPclKdTrees) {
-  const Cloud::Ptr target = RoomCloud(3, 4000, false);
-  Cloud::Ptr source(new Cloud);
-  Eigen::Affine3f motion = Eigen::Affine3f::Identity();
-  motion.rotate(Eigen::AngleAxisf(0.05f, Eigen::Vector3f(0.2f, 0.1f, 1.0f).normalized()));
-  motion.translation() << 0.2f, -0.1f, 0.05f;
-  pcl::transformPointCloud(*RoomCloud(4, 2000, false), *source, motion);
+using Gicp = pcl::GeneralizedIterativeClosestPoint<pcl::PointXYZ, pcl::PointXYZ>;
 
-  Eigen::Matrix4f results[2];
-  for (int run = 0; run < 2; ++run) {
-    pcl::GeneralizedIterativeClosestPoint<pcl::PointXYZ, pcl::PointXYZ> gicp;
-    if (run == 1) {
-      gicp.setSearchMethodTarget(std::make_shared<SingleQueryKdTree>());
-      gicp.setSearchMethodSource(std::make_shared<SingleQueryKdTree>());
-    }
-    gicp.setMaxCorrespondenceDistance(1.0);
-    gicp.setInputTarget(target);
-    gicp.setInputSource(source);
-    Cloud aligned;
-    gicp.align(aligned);
-    ASSERT_TRUE(gicp.hasConverged()) << run;
-    results[run] = gicp.getFinalTransformation();
-  }
-  EXPECT_EQ(results[1], results[0]);
-  // It undid the motion.
-  EXPECT_LT((results[0] * motion.matrix() - Eigen::Matrix4f::Identity()).norm(), 0.02f);
+// A room (target, `target_seed`) and another sample of it (source,
+// `source_seed`) moved by a small rotation about `axis` and `translation`.
+struct MovedRoom {
+  Cloud::Ptr target;
+  Cloud::Ptr source{new Cloud};
+  Eigen::Affine3f motion = Eigen::Affine3f::Identity();
+};
+
+MovedRoom MakeMovedRoom(unsigned target_seed, unsigned source_seed, float angle_rad,
+                        const Eigen::Vector3f& axis, const Eigen::Vector3f& translation) {
+  MovedRoom room;
+  room.target = RoomCloud(target_seed, 4000, false);
+  room.motion.rotate(Eigen::AngleAxisf(angle_rad, axis.normalized()));
+  room.motion.translation() = translation;
+  pcl::transformPointCloud(*RoomCloud(source_seed, 2000, false), *room.source, room.motion);
+  return room;
+}
+
+// GICP's final transformation on `room` after `set_up` gave it its clouds
+// (and whatever else it sets).
+Eigen::Matrix4f Align(const MovedRoom& room, const std::function<void(Gicp*)>& set_up) {
+  Gicp gicp;
+  gicp.setMaxCorrespondenceDistance(1.0);
+  set_up(&gicp);
+  Cloud aligned;
+  gicp.align(aligned);
+  EXPECT_TRUE(gicp.hasConverged());
+  return gicp.getFinalTransformation();
+}
+
+// Both transformations are equal, and the first undid the motion.
+void ExpectSameAlignmentThatUndidTheMotion(const MovedRoom& room, const Eigen::Matrix4f& first,
+                                           const Eigen::Matrix4f& second) {
+  EXPECT_EQ(second, first);
+  EXPECT_LT((first * room.motion.matrix() - Eigen::Matrix4f::Identity()).norm(), 0.02f);
+}
+
+TEST(SingleQueryKdTreeTest, GicpAlignsExactlyAsWithPclKdTrees) {
+  const MovedRoom room = MakeMovedRoom(3, 4, 0.05f, Eigen::Vector3f(0.2f, 0.1f, 1.0f),
+                                       Eigen::Vector3f(0.2f, -0.1f, 0.05f));
+  const Eigen::Matrix4f with_pcl_trees = Align(room, [&](Gicp* gicp) {
+    gicp->setInputTarget(room.target);
+    gicp->setInputSource(room.source);
+  });
+  const Eigen::Matrix4f with_own_trees = Align(room, [&](Gicp* gicp) {
+    gicp->setSearchMethodTarget(std::make_shared<SingleQueryKdTree>());
+    gicp->setSearchMethodSource(std::make_shared<SingleQueryKdTree>());
+    gicp->setInputTarget(room.target);
+    gicp->setInputSource(room.source);
+  });
+  ExpectSameAlignmentThatUndidTheMotion(room, with_pcl_trees, with_own_trees);
 }
 
 // GICP with its protected covariance computation made callable.
-class GicpExposingCovariances
-    : public pcl::GeneralizedIterativeClosestPoint<pcl::PointXYZ, pcl::PointXYZ> {
+class GicpExposingCovariances : public Gicp {
  public:
-  using pcl::GeneralizedIterativeClosestPoint<pcl::PointXYZ, pcl::PointXYZ>::computeCovariances;
+  using Gicp::computeCovariances;
 };
 
 TEST(GicpCovariancesTest, SameAsPclBitForBitOnAnyNumberOfThreads) {
@@ -152,44 +179,33 @@ TEST(GicpCovariancesTest, FewerPointsThanNeighboursIsRefused) {
 // them) and both clouds' covariances given; the same transformation as
 // GICP computing everything itself.
 TEST(GicpCovariancesTest, GicpGivenTheCovariancesAlignsExactlyAsOnItsOwn) {
-  const Cloud::Ptr target = RoomCloud(7, 4000, false);
-  Cloud::Ptr source(new Cloud);
-  Eigen::Affine3f motion = Eigen::Affine3f::Identity();
-  motion.rotate(Eigen::AngleAxisf(0.04f, Eigen::Vector3f(-0.1f, 0.2f, 1.0f).normalized()));
-  motion.translation() << -0.15f, 0.1f, 0.02f;
-  pcl::transformPointCloud(*RoomCloud(8, 2000, false), *source, motion);
-  Eigen::Matrix4f results[2];
-  for (int run = 0; run < 2; ++run) {
-    pcl::GeneralizedIterativeClosestPoint<pcl::PointXYZ, pcl::PointXYZ> gicp;
-    gicp.setMaxCorrespondenceDistance(1.0);
+  const MovedRoom room = MakeMovedRoom(7, 8, 0.04f, Eigen::Vector3f(-0.1f, 0.2f, 1.0f),
+                                       Eigen::Vector3f(-0.15f, 0.1f, 0.02f));
+  const Eigen::Matrix4f on_its_own = Align(room, [&](Gicp* gicp) {
+    gicp->setSearchMethodTarget(std::make_shared<SingleQueryKdTree>());
+    gicp->setSearchMethodSource(std::make_shared<SingleQueryKdTree>());
+    gicp->setInputTarget(room.target);
+    gicp->setInputSource(room.source);
+  });
+  const Eigen::Matrix4f given = Align(room, [&](Gicp* gicp) {
     auto target_tree = std::make_shared<SingleQueryKdTree>();
     auto source_tree = std::make_shared<SingleQueryKdTree>();
-    if (run == 0) {
-      gicp.setSearchMethodTarget(target_tree);
-      gicp.setSearchMethodSource(source_tree);
-      gicp.setInputTarget(target);
-      gicp.setInputSource(source);
-    } else {
-      gicp.setSearchMethodTarget(target_tree, /*force_no_recompute=*/true);
-      gicp.setSearchMethodSource(source_tree, /*force_no_recompute=*/true);
-      target_tree->setInputCloud(target);
-      source_tree->setInputCloud(source);
-      gicp.setInputTarget(target);
-      gicp.setInputSource(source);
-      auto target_covariances = std::make_shared<GicpCovariances>();
-      auto source_covariances = std::make_shared<GicpCovariances>();
-      ASSERT_TRUE(ComputeGicpCovariances(*target, *target_tree, 20, 0.001, 2, target_covariances.get()));
-      ASSERT_TRUE(ComputeGicpCovariances(*source, *source_tree, 20, 0.001, 2, source_covariances.get()));
-      gicp.setTargetCovariances(target_covariances);
-      gicp.setSourceCovariances(source_covariances);
-    }
-    Cloud aligned;
-    gicp.align(aligned);
-    ASSERT_TRUE(gicp.hasConverged()) << run;
-    results[run] = gicp.getFinalTransformation();
-  }
-  EXPECT_EQ(results[1], results[0]);
-  EXPECT_LT((results[0] * motion.matrix() - Eigen::Matrix4f::Identity()).norm(), 0.02f);
+    gicp->setSearchMethodTarget(target_tree, /*force_no_recompute=*/true);
+    gicp->setSearchMethodSource(source_tree, /*force_no_recompute=*/true);
+    target_tree->setInputCloud(room.target);
+    source_tree->setInputCloud(room.source);
+    gicp->setInputTarget(room.target);
+    gicp->setInputSource(room.source);
+    auto target_covariances = std::make_shared<GicpCovariances>();
+    auto source_covariances = std::make_shared<GicpCovariances>();
+    ASSERT_TRUE(ComputeGicpCovariances(*room.target, *target_tree, 20, 0.001, 2,
+                                       target_covariances.get()));
+    ASSERT_TRUE(ComputeGicpCovariances(*room.source, *source_tree, 20, 0.001, 2,
+                                       source_covariances.get()));
+    gicp->setTargetCovariances(target_covariances);
+    gicp->setSourceCovariances(source_covariances);
+  });
+  ExpectSameAlignmentThatUndidTheMotion(room, on_its_own, given);
 }
 
 }  // namespace
