@@ -1,5 +1,6 @@
 #include "common/io/atomic_file.h"
 
+#include <fcntl.h>
 #include <signal.h>
 #include <sys/types.h>
 #include <unistd.h>
@@ -53,6 +54,7 @@ AtomicFile::~AtomicFile() { Abandon(); }
 
 Status AtomicFile::Open(const std::string& path) {
   Abandon();
+  write_behind_end_ = 0;
   path_ = path;
   RemoveStaleTemporaries(path);
   temp_path_ = path + ".tmp." + std::to_string(::getpid());
@@ -104,6 +106,23 @@ void AtomicFile::Abandon() {
     std::remove(temp_path_.c_str());
     temp_path_.clear();
   }
+}
+
+void AtomicFile::WriteBehind() {
+#ifdef __linux__
+  if (file_ == nullptr) return;
+  const int fd = ::fileno(file_);
+  const off_t in_kernel = ::lseek(fd, 0, SEEK_CUR);
+  while (in_kernel >= write_behind_end_ + kWriteBehindBytes) {
+    ::sync_file_range(fd, write_behind_end_, kWriteBehindBytes, SYNC_FILE_RANGE_WRITE);
+    if (write_behind_end_ >= 2 * kWriteBehindBytes) {
+      ::sync_file_range(fd, write_behind_end_ - 2 * kWriteBehindBytes, kWriteBehindBytes,
+                        SYNC_FILE_RANGE_WAIT_BEFORE | SYNC_FILE_RANGE_WRITE |
+                            SYNC_FILE_RANGE_WAIT_AFTER);
+    }
+    write_behind_end_ += kWriteBehindBytes;
+  }
+#endif
 }
 
 std::string CommitManifestPath(const std::string& path) { return path + ".commit"; }

@@ -31,6 +31,16 @@ class AtomicFile {
   Status Commit();
   // Removes the temporary file; no-op after Commit().
   void Abandon();
+  // Starts the device write of each completed kWriteBehindBytes window of
+  // what has reached the kernel (Linux sync_file_range), and waits for the
+  // window two before it. The device then writes while the rest is produced,
+  // so Finish()'s sync waits for at most three windows, and a large output
+  // keeps at most three windows of dirty pages. Call after writing; without
+  // a new complete window it costs one lseek. Write errors still surface in
+  // Finish().
+  void WriteBehind();
+  // Bytes from the start whose device write WriteBehind() has started.
+  long long write_behind_bytes() const { return write_behind_end_; }
 
   std::FILE* file() { return file_; }
   const std::string& path() const { return path_; }
@@ -40,7 +50,11 @@ class AtomicFile {
   std::string path_;
   std::string temp_path_;
   std::FILE* file_ = nullptr;
+  long long write_behind_end_ = 0;  // bytes whose device write has started
 };
+
+// The window of AtomicFile::WriteBehind.
+inline constexpr long long kWriteBehindBytes = 8 << 20;
 
 // Commits several outputs of one run so that a reader sees either all the
 // old files or all the new ones. Every file is finished (synced under its

@@ -112,6 +112,7 @@ Status RecordWriter::Write(const google::protobuf::Message& record) {
                          std::to_string(num_records_));
   }
   ++num_records_;
+  impl_->file.WriteBehind();
   return Status::Ok();
 }
 
