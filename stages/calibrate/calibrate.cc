@@ -167,6 +167,8 @@ struct OuterLoop {
   bool converged = false;
   std::string termination;
   int rounds = 0;
+  // The trust-region radius the last solve ended with (0: no solve yet).
+  double last_trust_region_radius = 0.0;
   // How far the last round moved C_bl (deg), r_b^{lb} (m) and tau (s).
   double moved_deg = 0.0, moved_m = 0.0, moved_s = 0.0;
 };
@@ -214,7 +216,16 @@ Status RunOuterRound(const OuterLoopSetup& setup, CalibrationState* state, Outer
   loop->build_s += Seconds(start);
   start = Clock::now();
   const double cpu_start = CpuSeconds();
-  ceres::Solve(setup.solver_options, loop->problem->problem(), &loop->summary);
+  ceres::Solver::Options solver_options = setup.solver_options;
+  if (params.solver().warm_start_trust_region() && loop->last_trust_region_radius > 0.0) {
+    solver_options.initial_trust_region_radius =
+        std::clamp(loop->last_trust_region_radius, solver_options.initial_trust_region_radius,
+                   solver_options.max_trust_region_radius);
+  }
+  ceres::Solve(solver_options, loop->problem->problem(), &loop->summary);
+  if (!loop->summary.iterations.empty()) {
+    loop->last_trust_region_radius = loop->summary.iterations.back().trust_region_radius;
+  }
   const double solve_seconds = Seconds(start);
   loop->solve_cpu_s += CpuSeconds() - cpu_start;
   loop->solve_s += solve_seconds;
