@@ -196,10 +196,10 @@ TEST(ProblemBuilderTest, ImuOnlyProblemKeepsTheTruthAndDropsUnusedBlocks) {
 // init.solver_initial_trust_region_radius) only changes the path of LM: from
 // the same start the same minimum, in fewer iterations than Ceres' default
 // radius of 1e4.
-TEST(ProblemBuilderTest, LargeInitialTrustRegionReachesTheSameMinimumInFewerIterations) {
-  const CalibrationState truth = MakeState(1.0);
-  // Deterministic "noise" (sigma-sized) so that the minimum has a cost well
-  // above zero and the relative function tolerance means convergence.
+// IMU readings of `truth` with deterministic "noise" (sigma-sized), so that
+// the minimum has a cost well above zero and the relative function tolerance
+// means convergence.
+std::vector<imu::ImuReading> NoisyImuFromState(const CalibrationState& truth) {
   std::vector<imu::ImuReading> imu = ImuFromState(truth, 1.0);
   for (size_t k = 0; k < imu.size(); ++k) {
     imu[k].angular_velocity_radps += 0.01 * Eigen::Vector3d(std::sin(1.7 * k), std::cos(2.9 * k),
@@ -208,26 +208,48 @@ TEST(ProblemBuilderTest, LargeInitialTrustRegionReachesTheSameMinimumInFewerIter
                                                               std::sin(1.1 * k + 2.0),
                                                               std::cos(3.7 * k));
   }
-  CalibrationState start = truth;
-  for (int i = 1; i < start.trajectory.num_knots(); ++i) {
-    start.trajectory.SetPositionKnot(
-        i, start.trajectory.PositionKnot(i) + Eigen::Vector3d(0.03 * std::sin(i), -0.02, 0.01));
-    start.trajectory.SetRotationKnot(
-        i, (start.trajectory.RotationKnot(i) *
-            Eigen::Quaterniond(Eigen::AngleAxisd(0.02 * std::cos(i), Eigen::Vector3d::UnitZ())))
+  return imu;
+}
+
+// `state` with every knot but the first moved by `scale` times a few cm and
+// a degree.
+CalibrationState PerturbedKnots(CalibrationState state, double scale) {
+  for (int i = 1; i < state.trajectory.num_knots(); ++i) {
+    state.trajectory.SetPositionKnot(
+        i, state.trajectory.PositionKnot(i) +
+               scale * Eigen::Vector3d(0.03 * std::sin(i), -0.02, 0.01));
+    state.trajectory.SetRotationKnot(
+        i, (state.trajectory.RotationKnot(i) *
+            Eigen::Quaterniond(Eigen::AngleAxisd(scale * 0.02 * std::cos(i),
+                                                 Eigen::Vector3d::UnitZ())))
                .normalized());
   }
+  return state;
+}
+
+// Solves the IMU-only problem of `imu` from *state with LM starting at
+// `radius` (0: Ceres' default); returns its summary.
+ceres::Solver::Summary SolveImuOnly(const std::vector<imu::ImuReading>& imu, double radius,
+                                    CalibrationState* state) {
   const proto::CalibrateParams params = ImuOnlyParams();
-  const ProblemOptions options = ImuOnlyProblemOptions(params);
+  CalibrationProblem problem(state, params.imu_noise(), params.lidar(),
+                             ImuOnlyProblemOptions(params));
+  problem.AddImuResiduals(imu, true, true);
+  problem.RemoveUnusedKnots();
+  ceres::Solver::Summary summary;
+  ceres::Solve(MakeSolverOptions(SolverSettings{100, 1, 1e-12, radius}), problem.problem(),
+               &summary);
+  EXPECT_EQ(summary.termination_type, ceres::CONVERGENCE) << summary.BriefReport();
+  return summary;
+}
+
+TEST(ProblemBuilderTest, LargeInitialTrustRegionReachesTheSameMinimumInFewerIterations) {
+  const CalibrationState truth = MakeState(1.0);
+  const std::vector<imu::ImuReading> imu = NoisyImuFromState(truth);
+  const CalibrationState start = PerturbedKnots(truth, 1.0);
   // Returns the iterations; *cost the final cost.
   auto solve = [&](double radius, CalibrationState* state, double* cost) {
-    CalibrationProblem problem(state, params.imu_noise(), params.lidar(), options);
-    problem.AddImuResiduals(imu, true, true);
-    problem.RemoveUnusedKnots();
-    ceres::Solver::Summary summary;
-    ceres::Solve(MakeSolverOptions(SolverSettings{100, 1, 1e-12, radius}), problem.problem(),
-                 &summary);
-    EXPECT_EQ(summary.termination_type, ceres::CONVERGENCE) << summary.BriefReport();
+    const ceres::Solver::Summary summary = SolveImuOnly(imu, radius, state);
     *cost = summary.final_cost;
     return static_cast<int>(summary.iterations.size()) - 1;
   };
@@ -252,6 +274,33 @@ TEST(ProblemBuilderTest, LargeInitialTrustRegionReachesTheSameMinimumInFewerIter
     damped.trajectory.Evaluate(t, 0, nullptr, &a);
     undamped.trajectory.Evaluate(t, 0, nullptr, &b);
     EXPECT_LT((a.acceleration - b.acceleration).norm(), 1e-6) << "t " << t;
+  }
+}
+
+// An outer round after the first starts near its minimum: LM started at the
+// radius the previous solve ended with (solver.warm_start_trust_region)
+// reaches the same minimum as a start at Ceres' default radius, in fewer
+// iterations.
+TEST(ProblemBuilderTest, WarmStartedRadiusReachesTheNextMinimumInFewerIterations) {
+  const CalibrationState truth = MakeState(1.0);
+  const std::vector<imu::ImuReading> imu = NoisyImuFromState(truth);
+  CalibrationState first = PerturbedKnots(truth, 1.0);
+  const ceres::Solver::Summary first_summary = SolveImuOnly(imu, 0.0, &first);
+  const double last_radius = first_summary.iterations.back().trust_region_radius;
+  ASSERT_GT(last_radius, 1e4);
+  // The next round: the previous minimum, moved by a tenth of the first
+  // perturbation (a redrawn association moves it by about its sigma).
+  const CalibrationState next = PerturbedKnots(first, 0.1);
+  CalibrationState cold = next, warm = next;
+  const ceres::Solver::Summary cold_summary = SolveImuOnly(imu, 0.0, &cold);
+  const ceres::Solver::Summary warm_summary = SolveImuOnly(imu, last_radius, &warm);
+  // Iterations: 5 from the default radius, 2 warm-started.
+  EXPECT_LE(2 * (warm_summary.iterations.size() - 1), cold_summary.iterations.size() - 1);
+  EXPECT_NEAR(warm_summary.final_cost, cold_summary.final_cost, 1e-6 * cold_summary.final_cost);
+  for (int i = 0; i < next.trajectory.num_knots(); ++i) {
+    EXPECT_LT(cold.trajectory.RotationKnot(i).angularDistance(warm.trajectory.RotationKnot(i)),
+              1e-7)
+        << "knot " << i;
   }
 }
 
