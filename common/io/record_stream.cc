@@ -23,6 +23,9 @@ class RecordWriter::Impl {
  public:
   AtomicFile file;
   bool finished = false;
+  // Record bytes since the last AtomicFile::WriteBehind(): it is called once
+  // per MiB, not per record (an IMU stream has thousands of small records).
+  size_t bytes_since_write_behind = 0;
   std::unique_ptr<Lz4FrameOutput> lz4;
   std::unique_ptr<pbio::CopyingOutputStreamAdaptor> lz4_adaptor;
   std::unique_ptr<pbio::FileOutputStream> plain;
@@ -112,7 +115,11 @@ Status RecordWriter::Write(const google::protobuf::Message& record) {
                          std::to_string(num_records_));
   }
   ++num_records_;
-  impl_->file.WriteBehind();
+  impl_->bytes_since_write_behind += size;
+  if (impl_->bytes_since_write_behind >= (size_t{1} << 20)) {
+    impl_->file.WriteBehind();
+    impl_->bytes_since_write_behind = 0;
+  }
   return Status::Ok();
 }
 

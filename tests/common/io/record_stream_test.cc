@@ -174,6 +174,30 @@ TEST(RecordStream, StoredBlocksAreLargerThanCompressedOnes) {
   EXPECT_EQ(stored, plain + 7 + 4 * ((plain + 256 * 1024 - 1) / (256 * 1024)) + 4 + 4);
 }
 
+// A stream of several write-behind windows (AtomicFile::WriteBehind): the
+// device write of the completed windows has started before Close(), and the
+// stream reads back whole.
+TEST(RecordStream, LargeStreamStartsTheDeviceWriteBeforeClose) {
+  TempDir dir;
+  const std::string path = dir.File("scans.binpb.lz4");
+  RecordWriter writer;
+  Lz4FrameOptions stored;
+  stored.compress_blocks = false;
+  ASSERT_TRUE(writer.Open(path, "tiltcal.proto.Scan", proto::Provenance(), stored).ok());
+  // 40 scans of 30,000 points: ~25 MiB, three windows.
+  constexpr int kScans = 40, kPoints = 30000;
+  for (int i = 0; i < kScans; ++i) ASSERT_TRUE(writer.Write(MakeScan(i, kPoints)).ok());
+  EXPECT_GE(writer.file()->write_behind_bytes(), 2 * kWriteBehindBytes);
+  ASSERT_TRUE(writer.Close().ok());
+  const auto size = static_cast<long long>(std::filesystem::file_size(path));
+  ASSERT_GE(size, 3 * kWriteBehindBytes);
+  std::vector<proto::Scan> scans;
+  const Status status = ReadAllRecords<proto::Scan>(path, &scans);
+  ASSERT_TRUE(status.ok()) << status.message();
+  ASSERT_EQ(scans.size(), static_cast<size_t>(kScans));
+  EXPECT_EQ(scans.back().SerializeAsString(), MakeScan(kScans - 1, kPoints).SerializeAsString());
+}
+
 TEST(RecordStream, CorruptByteOfStoredBlocksFailsTheContentChecksum) {
   TempDir dir;
   const std::string path = dir.File("scans.binpb.lz4");
