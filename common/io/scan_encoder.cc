@@ -30,25 +30,50 @@ constexpr size_t kBlockValues = 2048;
 // (room for 5 * n + 3 bytes); returns the end. Values below 2^28 take one
 // 4-byte store: the 7-bit groups spread to bytes, continuation bits set on
 // all but the last byte of the varint.
-inline uint8_t* EncodeVarints(const uint32_t* values, size_t n, uint8_t* out) {
-  for (size_t i = 0; i < n; ++i) {
-    uint32_t v = values[i];
-    if (v < (1u << 28)) {
-      const uint32_t extra = ExtraBytes(v);  // 0..3
-      const uint32_t spread = (v & 0x7Fu) | ((v << 1) & 0x7F00u) | ((v << 2) & 0x7F0000u) |
-                              ((v << 3) & 0x7F000000u);
-      const uint32_t continuation = 0x00808080u >> (8 * (3 - extra));
-      const uint32_t word = spread | continuation;
-      std::memcpy(out, &word, 4);  // little-endian: first byte first
-      out += extra + 1;
-    } else {
-      while (v >= 0x80) {
-        *out++ = static_cast<uint8_t>(v | 0x80);
-        v >>= 7;
-      }
-      *out++ = static_cast<uint8_t>(v);
-    }
+inline uint32_t Spread(uint32_t v) {
+  return (v & 0x7Fu) | ((v << 1) & 0x7F00u) | ((v << 2) & 0x7F0000u) | ((v << 3) & 0x7F000000u);
+}
+
+inline uint8_t* EncodeVarint(uint32_t v, uint8_t* out) {
+  if (v < (1u << 28)) {
+    const uint32_t extra = ExtraBytes(v);  // 0..3
+    const uint32_t word = Spread(v) | (0x00808080u >> (8 * (3 - extra)));
+    std::memcpy(out, &word, 4);  // little-endian: first byte first
+    return out + extra + 1;
   }
+  while (v >= 0x80) {
+    *out++ = static_cast<uint8_t>(v | 0x80);
+    v >>= 7;
+  }
+  *out++ = static_cast<uint8_t>(v);
+  return out;
+}
+
+// Values per run of the fixed-width path of EncodeVarints.
+constexpr size_t kRunValues = 8;
+
+inline uint8_t* EncodeVarints(const uint32_t* values, size_t n, uint8_t* out) {
+  size_t i = 0;
+  while (i + kRunValues <= n) {
+    // A run whose values all take 4 bytes (2^21 <= v < 2^28: a Velodyne
+    // scan's zigzagged time offsets beyond 1 ms) has fixed byte positions,
+    // so its loop vectorises; any other run is encoded value by value.
+    bool four_bytes = true;
+    for (size_t k = 0; k < kRunValues; ++k) {
+      four_bytes &= values[i + k] - (1u << 21) < (1u << 28) - (1u << 21);
+    }
+    if (four_bytes) {
+      for (size_t k = 0; k < kRunValues; ++k) {
+        const uint32_t word = Spread(values[i + k]) | 0x00808080u;
+        std::memcpy(out + 4 * k, &word, 4);
+      }
+      out += 4 * kRunValues;
+    } else {
+      for (size_t k = 0; k < kRunValues; ++k) out = EncodeVarint(values[i + k], out);
+    }
+    i += kRunValues;
+  }
+  for (; i < n; ++i) out = EncodeVarint(values[i], out);
   return out;
 }
 

@@ -100,6 +100,27 @@ TEST(ScanEncoder, VarintBoundariesInTheColumns) {
   ExpectSameBytes(scan, "boundaries");
 }
 
+// Runs of values that all take 4 bytes (the encoder's fixed-width path),
+// each with one value of another length, or on a length boundary, at every
+// position of a run, and columns that end inside a run.
+TEST(ScanEncoder, FourByteRunsWithOneOtherValueAtEveryPosition) {
+  const std::vector<uint32_t> others = {0,           127,         (1u << 21) - 1, 1u << 21,
+                                        (1u << 28) - 1, 1u << 28, 0xFFFFFFFFu};
+  for (const uint32_t other : others) {
+    for (int position = 0; position < 16; ++position) {
+      proto::Scan scan;
+      for (int i = 0; i < 16 + position; ++i) {
+        const uint32_t v = i == position ? other : (1u << 21) + 12345u * static_cast<uint32_t>(i);
+        scan.add_ring(v);
+        // Zigzag of t is 2|t| or 2|t| - 1: these times give the same varints.
+        scan.add_time_offset_ns(static_cast<int32_t>(v % 2 ? -static_cast<int64_t>(v / 2) - 1
+                                                           : static_cast<int64_t>(v / 2)));
+      }
+      ExpectSameBytes(scan, "other " + std::to_string(other) + " at " + std::to_string(position));
+    }
+  }
+}
+
 TEST(ScanEncoder, ColumnsOfDifferentLengthsAndEmptyColumns) {
   proto::Scan scan;
   scan.add_x(1.5f);
