@@ -704,6 +704,12 @@ TEST(CalibratePipelineTest, ShortFlatSequenceAgainstTruth) {
   EXPECT_GT(result.solver().seconds_per_iteration(), 0.0);
   EXPECT_EQ(result.provenance().producer(), "tiltcal_calibrate");
   EXPECT_GE(result.timings_size(), 8);
+  // The map-sharpness checks run beside the covariance, with a timing of their own.
+  const auto sharpness_timing =
+      std::find_if(result.timings().begin(), result.timings().end(),
+                   [](const proto::PhaseTiming& t) { return t.phase() == "map_sharpness"; });
+  ASSERT_NE(sharpness_timing, result.timings().end());
+  EXPECT_GT(sharpness_timing->seconds(), 0.0);
   // Clean data: usable, with the vertical translation (and, on 16 s of
   // planar motion, perhaps the yaw) from the rig.
   EXPECT_TRUE(result.verdict() == proto::CalibrationResult::OK ||
