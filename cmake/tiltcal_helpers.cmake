@@ -31,8 +31,8 @@ endfunction()
 # object library with the same options, and reused by every target
 # (REUSE_FROM). GCC uses a precompiled header only when it was made with the
 # same options and macros, and otherwise reads the header as text: a target
-# that cannot share one (tiltcal_common, compiled with -fopenmp) makes its
-# own. Under clang (the sanitizer build) a mismatch would be an error, so
+# that cannot share one (tiltcal_registration, compiled with -fopenmp) makes
+# its own. Under clang (the sanitizer build) a mismatch would be an error, so
 # clang builds go without.
 function(tiltcal_pch_enabled out)
   if(TILTCAL_PCH AND CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
