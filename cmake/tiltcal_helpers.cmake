@@ -31,8 +31,8 @@ endfunction()
 # object library with the same options, and reused by every target
 # (REUSE_FROM). GCC uses a precompiled header only when it was made with the
 # same options and macros, and otherwise reads the header as text: a target
-# that cannot share one (tiltcal_common, compiled with -fopenmp) makes its
-# own. Under clang (the sanitizer build) a mismatch would be an error, so
+# that cannot share one (tiltcal_registration, compiled with -fopenmp) makes
+# its own. Under clang (the sanitizer build) a mismatch would be an error, so
 # clang builds go without.
 function(tiltcal_pch_enabled out)
   if(TILTCAL_PCH AND CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
@@ -120,17 +120,27 @@ function(tiltcal_add_stage)
   tiltcal_set_target_options(tiltcal_${ARG_NAME})
 endfunction()
 
-# tiltcal_add_test(NAME SRCS ... DEPS ... [LABELS ...] [COST SECONDS])
+# tiltcal_add_test(NAME SRCS ... DEPS ... [LABELS ...] [COST SECONDS]
+#                  [ONE_PROCESS_SUITES SUITE ...])
 # One GoogleTest executable; every test case is registered with CTest. Tests
 # find the shared fixtures and the project tree through compile definitions.
+# The executable is a unity build: its sources are compiled as one file, so
+# the headers and templates they share are compiled once for it (about half
+# the CPU time of compiling them one by one). Names at file scope, anonymous
+# namespaces included, must then differ between the files of one executable.
 # COST: about the seconds of its slowest test case. ctest -j starts the tests
 # of highest cost first; a fresh build has no timings of an earlier run, and
 # without it the long tests declared last would run alone at the end.
+# ONE_PROCESS_SUITES: suites whose cases share what their SetUpTestSuite
+# makes (a simulated sequence, say). Each is one CTest test, named after the
+# suite, that runs its cases in one process, so that it is made once rather
+# than once per case; COST is then about the seconds of the whole suite.
 function(tiltcal_add_test)
-  cmake_parse_arguments(ARG "" "NAME;COST" "SRCS;DEPS;LABELS" ${ARGN})
+  cmake_parse_arguments(ARG "" "NAME;COST" "SRCS;DEPS;LABELS;ONE_PROCESS_SUITES" ${ARGN})
   add_executable(${ARG_NAME} ${ARG_SRCS})
   target_link_libraries(${ARG_NAME} PRIVATE ${ARG_DEPS} tiltcal_testing GTest::gtest GTest::gtest_main)
-  set_target_properties(${ARG_NAME} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR}/tests)
+  set_target_properties(${ARG_NAME} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR}/tests
+                                               UNITY_BUILD ON)
   tiltcal_set_target_options(${ARG_NAME})
   tiltcal_use_pch(${ARG_NAME} TEST)
   if(NOT ARG_LABELS)
@@ -139,8 +149,19 @@ function(tiltcal_add_test)
   if(NOT ARG_COST)
     set(ARG_COST 0)
   endif()
+  set(others "")
+  foreach(suite IN LISTS ARG_ONE_PROCESS_SUITES)
+    add_test(NAME ${suite} COMMAND ${ARG_NAME} --gtest_filter=${suite}.*
+             WORKING_DIRECTORY ${PROJECT_BINARY_DIR})
+    set_tests_properties(${suite} PROPERTIES LABELS "${ARG_LABELS}" COST ${ARG_COST})
+    string(APPEND others "${suite}.*:")
+  endforeach()
+  if(others)
+    set(others TEST_FILTER "-${others}")
+  endif()
   gtest_discover_tests(${ARG_NAME}
     WORKING_DIRECTORY ${PROJECT_BINARY_DIR}
+    ${others}
     PROPERTIES LABELS "${ARG_LABELS}" COST ${ARG_COST}
     DISCOVERY_TIMEOUT 60)
 endfunction()

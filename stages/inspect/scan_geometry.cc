@@ -7,6 +7,26 @@
 #include "common/geometry/plane_fit.h"
 
 namespace tiltcal::inspect {
+namespace {
+
+// Eigen::Quaterniond::FromTwoVectors(up, +z) as a rotation matrix, the same
+// arithmetic, except that when up is -z it turns half about x instead of
+// about an axis from a JacobiSVD, whose instantiation was most of this
+// file's compile time (the heights and horizontal ranges measured below do
+// not depend on the axis of a half turn).
+Eigen::Matrix3d Levelling(const Eigen::Vector3d& up) {
+  const Eigen::Vector3d v0 = up.normalized();
+  const double c = v0.z();
+  if (c < -1.0 + 1e-12) return Eigen::Vector3d(1.0, -1.0, -1.0).asDiagonal();
+  const double s = std::sqrt((1.0 + c) * 2.0);
+  const double inverse_s = 1.0 / s;
+  Eigen::Quaterniond q;
+  q.vec() = v0.cross(Eigen::Vector3d::UnitZ()) * inverse_s;
+  q.w() = s * 0.5;
+  return q.toRotationMatrix();
+}
+
+}  // namespace
 
 ScanGeometry MeasureScanGeometry(const std::vector<float>& x, const std::vector<float>& y,
                                  const std::vector<float>& z, const Eigen::Vector3d& up_in_lidar,
@@ -15,10 +35,7 @@ ScanGeometry MeasureScanGeometry(const std::vector<float>& x, const std::vector<
   g.num_points = x.size();
   if (x.empty()) return g;
   // Rotation to a frame whose z is up.
-  const Eigen::Matrix3f level =
-      Eigen::Quaterniond::FromTwoVectors(up_in_lidar.normalized(), Eigen::Vector3d::UnitZ())
-          .toRotationMatrix()
-          .cast<float>();
+  const Eigen::Matrix3f level = Levelling(up_in_lidar.normalized()).cast<float>();
   std::vector<float> gx, gy, gz;
   size_t num_structure = 0;
   const float ground_range2 =

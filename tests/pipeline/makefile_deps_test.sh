@@ -58,7 +58,12 @@ expect() {  # expect "<description>" "<planned>" "<expected>"
   [ "$2" = "$3" ] || fail "$1: planned '$2', expected '$3'"
   echo "ok: $1"
 }
-sleep_past() { sleep 1.1; }  # make compares mtimes
+# make compares mtimes: returns once a file written now is newer than every
+# file written so far (file times advance by the file system's clock tick).
+sleep_past() {
+  touch "$WORK/last"
+  until [ "$WORK/now" -nt "$WORK/last" ]; do sleep 0.01; touch "$WORK/now"; done
+}
 
 expect "fresh dataset runs every stage" "$(planned)" \
 "plot_extrinsics.py;plot_ground_timeline.py seq_a;plot_ground_timeline.py seq_b;tiltcal_calibrate seq_a;tiltcal_calibrate seq_b;tiltcal_dataset_calibration;tiltcal_decode seq_a;tiltcal_decode seq_b;tiltcal_gravity seq_a;tiltcal_gravity seq_b;tiltcal_ground seq_a;tiltcal_ground seq_b;tiltcal_inspect seq_a;tiltcal_inspect seq_b;tiltcal_report;"

@@ -7,12 +7,13 @@
 #include <gtest/gtest.h>
 
 #include "tests/stages/calibrate/calibrate_params_text.h"
+#include "tests/testing/angles.h"
 #include "tests/testing/random_vector.h"
 
 namespace tiltcal::calibrate {
 namespace {
 
-constexpr double kDegToRad = M_PI / 180.0;
+using tiltcal::testing::kDegToRad;
 
 // The program's hand-eye settings: at least 15 pairs, excited from 0.02 rad,
 // pairs disagreeing by more than 1 deg down-weighted.

@@ -10,6 +10,7 @@
 #include <random>
 
 #include <gtest/gtest.h>
+#include "tests/testing/angles.h"
 #include "tests/testing/random_vector.h"
 
 namespace tiltcal::calibrate {
@@ -25,7 +26,7 @@ using imu::StaticDetectionOptions;
 using imu::StaticInterval;
 using imu::ValidateImuReadings;
 
-constexpr double kDegToRad = M_PI / 180.0;
+using tiltcal::testing::kDegToRad;
 
 // Ground truth attitude C_wb(t) = Rz(yaw) Ry(pitch) Rx(roll) with smooth
 // angles, and its body rate from the ZYX kinematics (independent of the

@@ -10,6 +10,7 @@
 
 #include "tests/stages/calibrate/calibrate_params_text.h"
 #include "tests/stages/calibrate/synthetic_room.h"
+#include "tests/testing/angles.h"
 
 namespace tiltcal::calibrate {
 namespace {
@@ -19,7 +20,7 @@ using testing::MakeDefaultScene;
 using testing::Scene;
 using testing::ScanScene;
 
-constexpr double kDegToRad = M_PI / 180.0;
+using tiltcal::testing::kDegToRad;
 
 // True LiDAR pose in the scene frame w at time t: driving along the room at
 // 1.2 m/s with yaw swings and small roll / pitch / bounce.

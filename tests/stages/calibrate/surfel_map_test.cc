@@ -13,6 +13,7 @@
 #include "stages/calibrate/point_priority.h"
 #include "tests/stages/calibrate/calibrate_params_text.h"
 #include "tests/stages/calibrate/synthetic_room.h"
+#include "tests/testing/angles.h"
 
 namespace tiltcal::calibrate {
 namespace {
@@ -23,7 +24,7 @@ using testing::Scene;
 using testing::ScanScene;
 using testing::SimulatedScan;
 
-constexpr double kDegToRad = M_PI / 180.0;
+using tiltcal::testing::kDegToRad;
 
 double NormalAngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   // Sign-free: a plane's normal is defined up to sign.
