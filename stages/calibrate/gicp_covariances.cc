@@ -1,6 +1,6 @@
 #include "stages/calibrate/gicp_covariances.h"
 
-#include <Eigen/SVD>
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <thread>
 
@@ -40,14 +40,13 @@ void CovariancesOfRange(const pcl::PointCloud<pcl::PointXYZ>& cloud,
         s(c, r) = s(r, c);
       }
     }
-    const Eigen::JacobiSVD<Eigen::Matrix3d> svd(s, Eigen::ComputeFullU);
-    const Eigen::Matrix3d u = svd.matrixU();
-    Eigen::Matrix3d& c = (*out)[i];
-    c.setZero();
-    for (int axis = 0; axis < 3; ++axis) {
-      const Eigen::Vector3d column = u.col(axis);
-      c += (axis == 2 ? epsilon : 1.0) * column * column.transpose();
-    }
+    // U diag(1, 1, epsilon) U^T = I - (1 - epsilon) n n^T, n the eigenvector
+    // of S's smallest eigenvalue (S is symmetric positive semi-definite, so
+    // its singular vectors are its eigenvectors).
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen;
+    eigen.computeDirect(s, Eigen::ComputeEigenvectors);
+    const Eigen::Vector3d n = eigen.eigenvectors().col(0);
+    (*out)[i] = Eigen::Matrix3d::Identity() - (1.0 - epsilon) * n * n.transpose();
   }
 }
 
