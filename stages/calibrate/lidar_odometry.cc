@@ -263,6 +263,8 @@ struct LidarOdometry::Impl {
     } else {
       ndt.setInputTarget(target);
     }
+    last_keyframe_pose = pose;
+    if (!params.registration_quality()) return;
     // Quality reference: surfels of the full-resolution local map.
     std::vector<std::pair<Eigen::Isometry3d, std::shared_ptr<const std::vector<Eigen::Vector3f>>>>
         map_scans;
@@ -275,7 +277,6 @@ struct LidarOdometry::Impl {
           map->ExtractSurfels();
           return map;
         });
-    last_keyframe_pose = pose;
   }
 
   Eigen::Isometry3d Predict(double time_s, const std::optional<Eigen::Quaterniond>& prior) const {

@@ -27,8 +27,8 @@
 // - GICP (default) or NDT (PCL) against a local map made of the last
 //   local_map_keyframes keyframes (a scan becomes a keyframe when it moved
 //   more than keyframe_distance_m or keyframe_angle_deg from the last
-//   keyframe), voxel-downsampled at map_voxel_m; quality against the surfels
-//   of the full-resolution keyframes. GICP's neighbour searches use
+//   keyframe), voxel-downsampled at map_voxel_m; quality (optional) against
+//   the surfels of the full-resolution keyframes. GICP's neighbour searches use
 //   single_query_kd_tree.h (PCL's tree without an OpenMP region per query);
 //   ~12 ms of one core per scan with the keyframe maps on a 40 s sequence.
 // PCL only appears in the .cc file.
@@ -51,10 +51,11 @@ struct LidarOdometryPose {
   bool converged = false;    // the registration reported convergence
   bool keyframe = false;
   int num_source_points = 0;  // after downsampling and cropping
-  // Quality after alignment. GICP / NDT: against planar surfels of the local
-  // map (the keyframes at full resolution, surfel map quality_map): of the
-  // source points that fall in a surfel voxel (num_quality_points), the
-  // fraction within quality_inlier_distance_m of the plane and their RMS
+  // Quality after alignment. GICP / NDT, when registration_quality is set
+  // (zero otherwise): against planar surfels of the local map (the
+  // keyframes at full resolution, surfel map quality_map): of the source
+  // points that fall in a surfel voxel (num_quality_points), the fraction
+  // within quality_inlier_distance_m of the plane and their RMS
   // point-to-plane distance (m). VOXEL_ICP: the point-to-plane
   // correspondences, the fraction within voxel_icp.kernel_scale_m and their
   // RMS. A good registration gives ~1 and ~the range noise.
@@ -67,7 +68,7 @@ struct LidarOdometryPose {
 class LidarOdometry {
  public:
   // num_threads: threads of GICP's point covariances (gicp_covariances.h);
-  // with two or more, a new keyframe's quality map is built while the next
+  // with two or more, a new keyframe's quality map (if any) is built while the next
   // scan is registered. The registration itself is sequential; the results
   // do not depend on the thread count.
   LidarOdometry(const proto::LidarOdometryParams& params, const proto::LidarScanParams& scans,

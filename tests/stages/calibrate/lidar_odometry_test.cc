@@ -50,11 +50,15 @@ struct OdometryErrors {
 // The odometry these tests measure: the program's settings but a 0.4 m local
 // map voxel, 10 registration iterations, 2 m NDT cells, a keyframe every
 // 1 m and a local map of 6 keyframes (the room is small).
-proto::CalibrateParams RoomOdometryParams(const std::string& method) {
+// The room's odometry settings, with the registration quality measured
+// unless `registration_quality` is false.
+proto::CalibrateParams RoomOdometryParams(const std::string& method,
+                                          bool registration_quality = true) {
   return tiltcal::testing::DefaultCalibrateParamsWith(
       "odometry { method: " + method +
       " map_voxel_m: 0.4 max_iterations: 10 ndt_resolution_m: 2.0 keyframe_distance_m: 1.0 "
-      "local_map_keyframes: 6 }");
+      "local_map_keyframes: 6 registration_quality: " +
+      (registration_quality ? "true" : "false") + " }");
 }
 
 OdometryErrors RunOdometry(const proto::CalibrateParams& params, bool with_prior, int num_scans,
@@ -146,6 +150,26 @@ TEST(LidarOdometryTest, GicpOnTwoThreadsGivesTheResultsOfOne) {
     keyframes += one[k].keyframe;
   }
   EXPECT_GE(keyframes, 3) << "the local map should change during the run";
+}
+
+// The quality maps are a diagnostic: without them the poses are the same
+// and the quality fields zero.
+TEST(LidarOdometryTest, GicpWithoutRegistrationQualityGivesTheSamePoses) {
+  std::vector<LidarOdometryPose> with_quality, without;
+  RunOdometry(RoomOdometryParams("GICP"), /*with_prior=*/true, 25, 2, &with_quality);
+  RunOdometry(RoomOdometryParams("GICP", /*registration_quality=*/false), /*with_prior=*/true, 25,
+              2, &without);
+  ASSERT_EQ(with_quality.size(), without.size());
+  int measured = 0;
+  for (std::size_t k = 0; k < without.size(); ++k) {
+    EXPECT_EQ(without[k].l0_from_lidar.matrix(), with_quality[k].l0_from_lidar.matrix()) << k;
+    EXPECT_EQ(without[k].keyframe, with_quality[k].keyframe) << k;
+    EXPECT_EQ(without[k].num_quality_points, 0) << k;
+    EXPECT_EQ(without[k].fitness_rms_m, 0.0) << k;
+    EXPECT_EQ(without[k].inlier_fraction, 0.0) << k;
+    measured += with_quality[k].num_quality_points > 0;
+  }
+  EXPECT_GE(measured, 20) << "with it set, the scans after the first are measured";
 }
 
 TEST(LidarOdometryTest, GicpWithoutPriorUsesConstantVelocity) {
