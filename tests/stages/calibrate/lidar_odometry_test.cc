@@ -49,9 +49,8 @@ struct OdometryErrors {
 
 // The odometry these tests measure: the program's settings but a 0.4 m local
 // map voxel, 10 registration iterations, 2 m NDT cells, a keyframe every
-// 1 m and a local map of 6 keyframes (the room is small).
-// The room's odometry settings, with the registration quality measured
-// unless `registration_quality` is false.
+// 1 m and a local map of 6 keyframes (the room is small); the registration
+// quality measured unless `registration_quality` is false.
 proto::CalibrateParams RoomOdometryParams(const std::string& method,
                                           bool registration_quality = true) {
   return tiltcal::testing::DefaultCalibrateParamsWith(
