@@ -163,7 +163,8 @@ class VoxelIcpOdometry {
 
 struct LidarOdometry::PreparedScan {
   std::vector<Eigen::Vector3f> points_lidar;  // VOXEL_ICP: the scan as given
-  // GICP / NDT: cropped, full resolution (shared with a keyframe made of it).
+  // GICP / NDT with registration_quality: cropped, full resolution (shared
+  // with a keyframe made of it); null otherwise.
   std::shared_ptr<const std::vector<Eigen::Vector3f>> cropped;
   Cloud::Ptr source;        // GICP / NDT: downsampled at scan_voxel_m
   GicpSearch source_search;  // GICP: of `source`
@@ -173,7 +174,7 @@ struct LidarOdometry::Impl {
   struct Keyframe {
     Cloud::Ptr map_cloud;  // in l0, downsampled at map_voxel_m
     // Cropped, full resolution, LiDAR frame; shared with the quality map's
-    // builder.
+    // builder (null without registration_quality).
     std::shared_ptr<const std::vector<Eigen::Vector3f>> points;
     Eigen::Isometry3d pose;  // T_{l0 l}
   };
@@ -229,19 +230,22 @@ struct LidarOdometry::Impl {
     if (scan.source_search.covariances) gicp.setSourceCovariances(scan.source_search.covariances);
   }
 
-  // Range crop (into *cropped) and voxel downsampling (returned).
+  // Range crop (also into *cropped, unless null) and voxel downsampling
+  // (returned).
   Cloud::Ptr Preprocess(const std::vector<Eigen::Vector3f>& points, std::vector<Eigen::Vector3f>* cropped) const {
     Cloud::Ptr cloud(new Cloud);
     cloud->reserve(points.size());
-    cropped->clear();
-    cropped->reserve(points.size());
+    if (cropped != nullptr) {
+      cropped->clear();
+      cropped->reserve(points.size());
+    }
     const float min_sq = static_cast<float>(scans.min_range_m() * scans.min_range_m());
     const float max_sq = static_cast<float>(scans.max_range_m() * scans.max_range_m());
     for (const Eigen::Vector3f& p : points) {
       const float r_sq = p.squaredNorm();
       if (!p.allFinite() || r_sq < min_sq || r_sq > max_sq) continue;
       cloud->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
-      cropped->push_back(p);
+      if (cropped != nullptr) cropped->push_back(p);
     }
     return Downsample(cloud, params.scan_voxel_m());
   }
@@ -354,9 +358,13 @@ std::shared_ptr<LidarOdometry::PreparedScan> LidarOdometry::Prepare(
     scan->points_lidar = points_lidar;
     return scan;
   }
-  std::vector<Eigen::Vector3f> cropped;
-  scan->source = m.Preprocess(points_lidar, &cropped);
-  scan->cropped = std::make_shared<const std::vector<Eigen::Vector3f>>(std::move(cropped));
+  if (m.params.registration_quality()) {
+    std::vector<Eigen::Vector3f> cropped;
+    scan->source = m.Preprocess(points_lidar, &cropped);
+    scan->cropped = std::make_shared<const std::vector<Eigen::Vector3f>>(std::move(cropped));
+  } else {
+    scan->source = m.Preprocess(points_lidar, nullptr);
+  }
   if (m.UsesGicp() && !scan->source->empty()) {
     scan->source_search =
         MakeGicpSearch(scan->source, static_cast<int>(m.params.gicp_neighbours()), num_threads);
