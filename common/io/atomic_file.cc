@@ -13,6 +13,8 @@
 #include <sstream>
 #include <system_error>
 
+#include "common/io/direct_file_output.h"
+
 namespace tiltcal {
 
 namespace fs = std::filesystem;
@@ -20,6 +22,22 @@ namespace fs = std::filesystem;
 namespace {
 
 std::string ErrnoText() { return std::strerror(errno); }
+
+// stdio's side of a stream over a DirectFileOutput (glibc fopencookie).
+ssize_t WriteToDirectFileOutput(void* cookie, const char* data, size_t size) {
+  return static_cast<DirectFileOutput*>(cookie)->Write(data, size) ? static_cast<ssize_t>(size)
+                                                                   : 0;
+}
+
+// A stdio stream whose writes go to `output`; closing it leaves `output`
+// open (AtomicFile closes it). Unbuffered: `output` gathers the bytes.
+std::FILE* OpenStdioStream(DirectFileOutput* output) {
+  cookie_io_functions_t functions{};
+  functions.write = WriteToDirectFileOutput;
+  std::FILE* file = ::fopencookie(output, "w", functions);
+  if (file != nullptr) std::setvbuf(file, nullptr, _IONBF, 0);
+  return file;
+}
 
 // True when no process `pid` exists (kill(pid, 0) fails with ESRCH).
 bool ProcessIsGone(long long pid) {
@@ -50,17 +68,28 @@ void RemoveStaleTemporaries(const std::string& path) {
 
 }  // namespace
 
+AtomicFile::AtomicFile() = default;
 AtomicFile::~AtomicFile() { Abandon(); }
 
-Status AtomicFile::Open(const std::string& path) {
+Status AtomicFile::Open(const std::string& path, const AtomicFileOptions& options) {
   Abandon();
   write_behind_end_ = 0;
   path_ = path;
   RemoveStaleTemporaries(path);
   temp_path_ = path + ".tmp." + std::to_string(::getpid());
-  file_ = std::fopen(temp_path_.c_str(), "wb");
+  if (options.bypass_page_cache) {
+    direct_ = std::make_unique<DirectFileOutput>();
+    if (direct_->Open(temp_path_)) {
+      file_ = OpenStdioStream(direct_.get());
+      if (file_ == nullptr) direct_->Abandon();
+    }
+  } else {
+    file_ = std::fopen(temp_path_.c_str(), "wb");
+  }
   if (file_ == nullptr) {
     const std::string error = ErrnoText();
+    std::remove(temp_path_.c_str());
+    direct_.reset();
     temp_path_.clear();
     return Status::Error(path + ": cannot create output: " + error);
   }
@@ -71,13 +100,21 @@ Status AtomicFile::Finish() {
   if (file_ == nullptr) {
     return temp_path_.empty() ? Status::Error(path_ + ": output is not open") : Status::Ok();
   }
-  bool ok = std::fflush(file_) == 0 && ::fsync(::fileno(file_)) == 0;
+  bool ok = std::fflush(file_) == 0 && (direct_ != nullptr || ::fsync(::fileno(file_)) == 0);
   std::string error = ok ? "" : ErrnoText();
   if (std::fclose(file_) != 0 && ok) {
     ok = false;
     error = ErrnoText();
   }
   file_ = nullptr;
+  if (direct_ != nullptr) {
+    // Writes what it holds, syncs and closes.
+    if (ok && !direct_->Close()) {
+      ok = false;
+      error = ErrnoText();
+    }
+    direct_.reset();
+  }
   if (!ok) {
     std::remove(temp_path_.c_str());
     temp_path_.clear();
@@ -102,6 +139,7 @@ void AtomicFile::Abandon() {
     std::fclose(file_);
     file_ = nullptr;
   }
+  direct_.reset();  // stops its writes, closes the file
   if (!temp_path_.empty()) {
     std::remove(temp_path_.c_str());
     temp_path_.clear();
@@ -110,7 +148,7 @@ void AtomicFile::Abandon() {
 
 void AtomicFile::WriteBehind() {
 #ifdef __linux__
-  if (file_ == nullptr) return;
+  if (file_ == nullptr || direct_ != nullptr) return;
   const int fd = ::fileno(file_);
   const off_t in_kernel = ::lseek(fd, 0, SEEK_CUR);
   while (in_kernel >= write_behind_end_ + kWriteBehindBytes) {

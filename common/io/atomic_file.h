@@ -2,12 +2,22 @@
 #define TILTCAL_COMMON_IO_ATOMIC_FILE_H_
 
 #include <cstdio>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "common/status.h"
 
 namespace tiltcal {
+
+class DirectFileOutput;
+
+struct AtomicFileOptions {
+  // Writes go past the page cache (DirectFileOutput, common/io/
+  // direct_file_output.h): for large outputs no one reads right away.
+  // WriteBehind() then has nothing to do.
+  bool bypass_page_cache = false;
+};
 
 // Writes a file under a temporary name in the same directory
 // (`<path>.tmp.<pid>`) and renames it to its final path on Commit(). Without
@@ -17,12 +27,12 @@ namespace tiltcal {
 // by processes that no longer run (killed runs).
 class AtomicFile {
  public:
-  AtomicFile() = default;
+  AtomicFile();
   ~AtomicFile();
   AtomicFile(const AtomicFile&) = delete;
   AtomicFile& operator=(const AtomicFile&) = delete;
 
-  Status Open(const std::string& path);
+  Status Open(const std::string& path, const AtomicFileOptions& options = {});
   // Flushes, syncs and closes the temporary file, which stays under its
   // temporary name (see CommitTogether).
   Status Finish();
@@ -50,6 +60,8 @@ class AtomicFile {
   std::string path_;
   std::string temp_path_;
   std::FILE* file_ = nullptr;
+  // With bypass_page_cache: what file_ (a stdio stream over it) writes to.
+  std::unique_ptr<DirectFileOutput> direct_;
   long long write_behind_end_ = 0;  // bytes whose device write has started
 };
 

@@ -42,21 +42,23 @@ RecordWriter::~RecordWriter() = default;
 Status RecordWriter::Open(const std::string& path, const std::string& payload_type,
                           const proto::Provenance& provenance, bool compress) {
   const Lz4FrameOptions lz4_options;
-  return OpenImpl(path, payload_type, provenance, compress ? &lz4_options : nullptr);
+  return OpenImpl(path, payload_type, provenance, compress ? &lz4_options : nullptr, {});
 }
 
 Status RecordWriter::Open(const std::string& path, const std::string& payload_type,
                           const proto::Provenance& provenance,
-                          const Lz4FrameOptions& lz4_options) {
-  return OpenImpl(path, payload_type, provenance, &lz4_options);
+                          const Lz4FrameOptions& lz4_options,
+                          const AtomicFileOptions& file_options) {
+  return OpenImpl(path, payload_type, provenance, &lz4_options, file_options);
 }
 
 Status RecordWriter::OpenImpl(const std::string& path, const std::string& payload_type,
                               const proto::Provenance& provenance,
-                              const Lz4FrameOptions* lz4_options) {
+                              const Lz4FrameOptions* lz4_options,
+                              const AtomicFileOptions& file_options) {
   impl_ = std::make_unique<Impl>();
   num_records_ = 0;
-  TILTCAL_RETURN_IF_ERROR(impl_->file.Open(path));
+  TILTCAL_RETURN_IF_ERROR(impl_->file.Open(path, file_options));
   if (lz4_options != nullptr) {
     impl_->lz4 = std::make_unique<Lz4FrameOutput>(impl_->file.file(), *lz4_options);
     // One LZ4 block (256 KiB) per Write(): liblz4 then compresses straight

@@ -39,9 +39,11 @@ class RecordWriter {
   // stream in an LZ4 frame.
   Status Open(const std::string& path, const std::string& payload_type,
               const proto::Provenance& provenance, bool compress);
-  // The stream wrapped in one LZ4 frame built as `lz4_options` say.
+  // The stream wrapped in one LZ4 frame built as `lz4_options` say, the
+  // file written as `file_options` say.
   Status Open(const std::string& path, const std::string& payload_type,
-              const proto::Provenance& provenance, const Lz4FrameOptions& lz4_options);
+              const proto::Provenance& provenance, const Lz4FrameOptions& lz4_options,
+              const AtomicFileOptions& file_options = {});
   // An empty record (one that serialises to zero bytes) is an error: a zero
   // length marks the end of the stream.
   Status Write(const google::protobuf::Message& record);
@@ -56,7 +58,8 @@ class RecordWriter {
 
  private:
   Status OpenImpl(const std::string& path, const std::string& payload_type,
-                  const proto::Provenance& provenance, const Lz4FrameOptions* lz4_options);
+                  const proto::Provenance& provenance, const Lz4FrameOptions* lz4_options,
+                  const AtomicFileOptions& file_options);
   class Impl;
   std::unique_ptr<Impl> impl_;
   int64_t num_records_ = 0;

@@ -23,8 +23,10 @@ void AsyncRecordWriter::Stop() {
 
 Status AsyncRecordWriter::Open(const std::string& path, const std::string& payload_type,
                                const proto::Provenance& provenance,
-                               const Lz4FrameOptions& lz4_options) {
-  TILTCAL_RETURN_IF_ERROR(writer_.Open(path, payload_type, provenance, lz4_options));
+                               const Lz4FrameOptions& lz4_options,
+                               const AtomicFileOptions& file_options) {
+  TILTCAL_RETURN_IF_ERROR(
+      writer_.Open(path, payload_type, provenance, lz4_options, file_options));
   thread_ = std::thread([this] { Work(); });
   return Status::Ok();
 }

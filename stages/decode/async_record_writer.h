@@ -28,9 +28,11 @@ class AsyncRecordWriter {
   AsyncRecordWriter(const AsyncRecordWriter&) = delete;
   AsyncRecordWriter& operator=(const AsyncRecordWriter&) = delete;
 
-  // The stream in one LZ4 frame built as `lz4_options` say.
+  // The stream in one LZ4 frame built as `lz4_options` say, the file written
+  // as `file_options` say.
   Status Open(const std::string& path, const std::string& payload_type,
-              const proto::Provenance& provenance, const Lz4FrameOptions& lz4_options);
+              const proto::Provenance& provenance, const Lz4FrameOptions& lz4_options,
+              const AtomicFileOptions& file_options);
 
   // A record object to fill; it holds the values of an earlier record (the
   // caller overwrites every field it uses). Blocks while all are in flight.

@@ -335,8 +335,11 @@ Status Decode(const DecodePaths& paths, const proto::DecodeParams& params, std::
   Lz4FrameOptions scans_frame;
   scans_frame.compress_blocks = !params.scans_output().store_blocks();
   scans_frame.content_checksum = !params.scans_output().omit_content_checksum();
-  TILTCAL_RETURN_IF_ERROR(scans_writer.Open(
-      paths.out_scans, proto::Scan::descriptor()->full_name(), provenance, scans_frame));
+  AtomicFileOptions scans_file;
+  scans_file.bypass_page_cache = params.scans_output().bypass_page_cache();
+  TILTCAL_RETURN_IF_ERROR(scans_writer.Open(paths.out_scans,
+                                            proto::Scan::descriptor()->full_name(),
+                                            provenance, scans_frame, scans_file));
   ImuSink imu(paths.bag, reader.MessageCount(s.imu_topic));
   ScanSink scans(paths.bag, params, s.lidar_type, &scans_writer);
   {

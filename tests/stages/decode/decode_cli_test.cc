@@ -7,9 +7,11 @@
 
 #include <gtest/gtest.h>
 
+#include "common/io/record_stream.h"
 #include "tests/bag/ros1/bag_test_util.h"
 #include "tests/stages/decode/vehicle_bag.h"
 #include "tests/testing/test_env.h"
+#include "tiltcal/proto/scan.pb.h"
 
 namespace tiltcal {
 namespace {
@@ -269,6 +271,43 @@ TEST_F(DecodeCli, ScansFrameStoredByDefaultCompressedOnRequest) {
   ASSERT_GT(plain_a.size(), 1000u);
   ASSERT_GT(plain_b.size(), 1000u);
   EXPECT_EQ(plain_a.substr(plain_a.size() - 1000), plain_b.substr(plain_b.size() - 1000));
+}
+
+// Every record of a scan stream, serialized.
+std::vector<std::string> ReadScanRecords(const std::string& path) {
+  std::vector<std::string> records;
+  RecordReader reader;
+  EXPECT_TRUE(reader.Open(path, proto::Scan::descriptor()->full_name()).ok()) << path;
+  proto::Scan scan;
+  for (bool end = false;;) {
+    const Status status = reader.Read(&scan, &end);
+    EXPECT_TRUE(status.ok()) << status.message();
+    if (!status.ok() || end) break;
+    records.push_back(scan.SerializeAsString());
+  }
+  return records;
+}
+
+// The scans are written past the page cache by default; through it with
+// bypass_page_cache false. The file is the same but for the params in its
+// header.
+TEST_F(DecodeCli, ScansPastThePageCacheAreTheSameRecords) {
+  REQUIRE_WRITTEN_BAG(bag, "velodyne_bz2.bag");
+  const std::string rig = WriteRigWithTopics();
+  std::string output;
+  ASSERT_EQ(Decode(bag, params_, &output, "--rig=" + rig), 0) << output;
+  const std::string past = tmp_.File("past.binpb.lz4");
+  fs::rename(tmp_.File("out/scans.binpb.lz4"), past);
+  const std::string params = tmp_.File("through.txtpb");
+  std::string text = testing::ReadFileOrEmpty(params_);
+  const size_t at = text.find("bypass_page_cache: true");
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, 23, "bypass_page_cache: false");
+  WriteFile(params, text);
+  ASSERT_EQ(Decode(bag, params, &output, "--rig=" + rig), 0) << output;
+  const std::vector<std::string> through = ReadScanRecords(tmp_.File("out/scans.binpb.lz4"));
+  ASSERT_FALSE(through.empty());
+  EXPECT_TRUE(ReadScanRecords(past) == through);
 }
 
 // A missing output flag is a usage error (exit 2) naming the flag.
