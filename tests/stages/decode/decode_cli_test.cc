@@ -56,6 +56,17 @@ class DecodeCli : public ::testing::Test {
     return dir.empty() ? "" : dir + "/" + name;
   }
 
+  // A copy of the default params at `path` with the line `from` replaced by
+  // `to`; false when the defaults have no such line.
+  bool WriteDefaultParamsWith(const std::string& path, const std::string& from,
+                              const std::string& to) {
+    std::string text = testing::ReadFileOrEmpty(params_);
+    const size_t at = text.find(from);
+    if (at == std::string::npos) return false;
+    WriteFile(path, text.replace(at, from.size(), to));
+    return true;
+  }
+
   void WriteFile(const std::string& path, const std::string& contents) {
     std::ofstream out(path, std::ios::binary);
     out << contents;
@@ -250,11 +261,7 @@ TEST_F(DecodeCli, ScansFrameStoredByDefaultCompressedOnRequest) {
   EXPECT_EQ(stored.substr(0, 6), std::string("\x04\x22\x4d\x18\x64\x50", 6));
   EXPECT_NE(static_cast<unsigned char>(stored[10]) & 0x80, 0);
   const std::string params = tmp_.File("compressed.txtpb");
-  std::string text = testing::ReadFileOrEmpty(params_);
-  const size_t at = text.find("store_blocks: true");
-  ASSERT_NE(at, std::string::npos);
-  text.replace(at, 18, "store_blocks: false");
-  WriteFile(params, text);
+  ASSERT_TRUE(WriteDefaultParamsWith(params, "store_blocks: true", "store_blocks: false"));
   ASSERT_EQ(Decode(bag, params, &output, "--rig=" + rig), 0) << output;
   const std::string compressed = testing::ReadFileOrEmpty(tmp_.File("out/scans.binpb.lz4"));
   ASSERT_GT(compressed.size(), 11u);
@@ -299,11 +306,8 @@ TEST_F(DecodeCli, ScansPastThePageCacheAreTheSameRecords) {
   const std::string past = tmp_.File("past.binpb.lz4");
   fs::rename(tmp_.File("out/scans.binpb.lz4"), past);
   const std::string params = tmp_.File("through.txtpb");
-  std::string text = testing::ReadFileOrEmpty(params_);
-  const size_t at = text.find("bypass_page_cache: true");
-  ASSERT_NE(at, std::string::npos);
-  text.replace(at, 23, "bypass_page_cache: false");
-  WriteFile(params, text);
+  ASSERT_TRUE(
+      WriteDefaultParamsWith(params, "bypass_page_cache: true", "bypass_page_cache: false"));
   ASSERT_EQ(Decode(bag, params, &output, "--rig=" + rig), 0) << output;
   const std::vector<std::string> through = ReadScanRecords(tmp_.File("out/scans.binpb.lz4"));
   ASSERT_FALSE(through.empty());
