@@ -81,12 +81,10 @@ void DirectFileOutput::WriteQueued() {
     if (queue_.empty()) return;  // stopping and drained
     const Buffer buffer = queue_.front();
     queue_.pop_front();
-    busy_ = true;
     const bool skip = error_ != 0;
     lock.unlock();
     const int error = skip || WriteAt(buffer.data, buffer.size, buffer.offset) ? 0 : errno;
     lock.lock();
-    busy_ = false;
     if (error != 0 && error_ == 0) error_ = error;
     free_.push_back(buffer.data);
     changed_.notify_all();

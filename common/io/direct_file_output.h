@@ -24,13 +24,13 @@ inline constexpr size_t kDirectWriteBuffers = 3;
 // aligned buffers that a background thread writes straight from user memory
 // to the device, so the kernel neither copies them into page-cache pages nor
 // allocates, tracks and writes back those pages. For a large output that no
-// one reads again soon this saves the kernel's copy and page handling (about
-// 0.2 CPU s per GB, bench/decode/README.md) and keeps the page cache for the
+// one reads again soon this saves the kernel's copy and page handling (0.3-0.9
+// CPU s per GB, bench/decode/README.md) and keeps the page cache for the
 // inputs; a later reader of the file reads it from the device.
 //
 // The last partial block is written through the page cache (O_DIRECT
 // cleared), so the file has exactly the bytes written. A file system that
-// refuses O_DIRECT at open (tmpfs) or on a write (an alignment it does not
+// refuses O_DIRECT at open (tmpfs before Linux 6.6) or on a write (an alignment it does not
 // accept) gets the same bytes through the page cache instead.
 class DirectFileOutput {
  public:
@@ -75,7 +75,6 @@ class DirectFileOutput {
   std::condition_variable changed_;
   std::vector<char*> free_;
   std::deque<Buffer> queue_;  // full buffers, in file order
-  bool busy_ = false;         // the thread is writing a buffer
   bool stopping_ = false;
   int error_ = 0;             // errno of the first failed write
   std::thread thread_;
