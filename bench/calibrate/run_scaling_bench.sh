@@ -55,27 +55,9 @@ while [ $# -gt 0 ]; do
 done
 [ -n "$ANCHOR_PARAMS" ] || ANCHOR_PARAMS=$PARAMS
 BIN="$BUILD_DIR/bin"
-for b in tiltcal_simulate tiltcal_decode tiltcal_ground tiltcal_gravity tiltcal_calibrate; do
-  [ -x "$BIN/$b" ] || { echo "run_scaling_bench: $BIN/$b missing (build it first)" >&2; exit 2; }
-done
-if [ -n "$ANCHOR_BIN" ] && [ ! -x "$ANCHOR_BIN/tiltcal_calibrate" ]; then
-  echo "run_scaling_bench: $ANCHOR_BIN/tiltcal_calibrate missing" >&2; exit 2
-fi
+. "$REPO/bench/calibrate/simulated_inputs.sh"
+require_binaries "$BIN" "$ANCHOR_BIN"
 mkdir -p "$SCRATCH"
-
-calibrate_params() {  # in, out: threads set, ground residuals off
-  sed -e "s/^num_threads: .*/num_threads: $THREADS/" \
-      -e "s/mode: AUTO/mode: OFF/; s/mode: ON/mode: OFF/" "$1" > "$2"
-}
-
-run_calibrate() {  # label, bin dir, params, work dir
-  local label=$1 bin=$2 params=$3 w=$4
-  /usr/bin/time -v -o "$w/time_$label.txt" "$bin/tiltcal_calibrate" --imu="$w/imu.binpb" \
-    --scans="$w/scans.binpb.lz4" --ground="$w/ground.binpb" --gravity="$w/gravity.txtpb" \
-    --rig="$w/rig.txtpb" --params="$params" --out="$w/calibration_$label.txtpb" \
-    2> "$w/log_$label.txt" || {
-      echo "run_scaling_bench: $label calibrate failed:" >&2; tail -3 "$w/log_$label.txt" >&2; exit 1; }
-}
 
 echo "load before: $(uptime)"
 RESULTS="$SCRATCH/results.tsv"
@@ -83,22 +65,9 @@ RESULTS="$SCRATCH/results.tsv"
 round=0
 for d in $DURATIONS; do
   w="$SCRATCH/d$d"
-  mkdir -p "$w"
-  sed -e 's/write_gravity_flat: false/write_gravity_flat: true/' \
-      -e 's/gravity_reference: ".*"/gravity_reference: ""/' \
-      -e "s/^duration_s: .*/duration_s: $d/" "$SCENARIO" > "$w/scenario.txtpb"
-  [ -n "$SEED" ] && sed -i -e "s/^seed: .*/seed: $SEED/" "$w/scenario.txtpb"
-  "$BIN/tiltcal_simulate" --params="$w/scenario.txtpb" --out_bag="$w/seq.bag" \
-    --out_truth="$w/truth.txtpb" --out_rig="$w/rig.txtpb" 2> "$w/log_simulate.txt"
-  "$BIN/tiltcal_decode" --bag="$w/seq.bag" --params="$REPO/stages/decode/default_params.txtpb" \
-    --rig="$w/rig.txtpb" --out_imu="$w/imu.binpb" --out_scans="$w/scans.binpb.lz4" 2> "$w/log_decode.txt"
-  rm -f "$w/seq.bag"
-  "$BIN/tiltcal_ground" --imu="$w/imu.binpb" --scans="$w/scans.binpb.lz4" --rig="$w/rig.txtpb" \
-    --params="$REPO/stages/ground/default_params.txtpb" --out_ground="$w/ground.binpb" 2> "$w/log_ground.txt"
-  "$BIN/tiltcal_gravity" --imu="$w/imu.binpb" --ground="$w/ground.binpb" --rig="$w/rig.txtpb" \
-    --params="$REPO/stages/gravity/default_params.txtpb" --out="$w/gravity.txtpb" 2> "$w/log_gravity.txt"
-  calibrate_params "$PARAMS" "$w/params_this.txtpb"
-  calibrate_params "$ANCHOR_PARAMS" "$w/params_anchor.txtpb"
+  simulate_inputs "$BIN" "$REPO" "$SCENARIO" "$w" "$SEED" "$d"
+  calibrate_params "$PARAMS" "$w/params_this.txtpb" "$THREADS"
+  calibrate_params "$ANCHOR_PARAMS" "$w/params_anchor.txtpb" "$THREADS"
   labels="this"
   if [ -n "$ANCHOR_BIN" ]; then
     if [ $((round % 2)) -eq 0 ]; then labels="anchor this"; else labels="this anchor"; fi
