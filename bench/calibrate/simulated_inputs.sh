@@ -1,7 +1,8 @@
-# Sourced by the calibrate benchmarks: the calibrator's inputs for one
-# simulated sequence, and its params with the thread count set and the
-# ground residuals off (LiDAR + IMU only, the setting the accuracy targets
-# are stated for).
+# Sourced by the calibrate benchmarks (run_scaling_bench.sh,
+# run_seeds_bench.sh): the calibrator's inputs for one simulated sequence,
+# its params with the thread count set and the ground residuals off (LiDAR +
+# IMU only, the setting the accuracy targets are stated for), the check of
+# the binaries, one calibrate run under GNU time, and the steal counter.
 
 # simulate_inputs BIN REPO SCENARIO WORKDIR [SEED [DURATION_S]]: simulates the
 # scenario (gravity_flat written, no gravity reference; seed and duration
