@@ -11,7 +11,7 @@
 # ground residuals as the params set them) with each params file.
 # mid360_report.py prints per run the yaw (about up) and tilt errors, the
 # planar translation and τ errors and the verdict, and per params file the
-# RMS and maximum over the seeds and the count of WEAK / SUSPECT verdicts.
+# RMS and maximum over the seeds and the seeds whose verdict was not OK.
 #
 # Usage: bench/calibrate/run_mid360_seeds.sh [options]
 #   --build_dir DIR    the build whose bin/ runs (default <repo>/build)

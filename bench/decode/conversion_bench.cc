@@ -98,9 +98,15 @@ int main(int argc, char** argv) {
     } else if (arg.rfind("--no_return=", 0) == 0) {
       no_return = std::atof(arg.c_str() + 12);
     } else {
-      std::fprintf(stderr, "usage: conversion_bench [--clouds=N] [--passes=N] [--no_return=F]\n");
-      return 2;
+      num_clouds = 0;  // the usage below
+      break;
     }
+  }
+  if (num_clouds < 1 || passes < 1 || !(no_return >= 0.0 && no_return <= 1.0)) {
+    std::fprintf(stderr,
+                 "usage: conversion_bench [--clouds=N >= 1] [--passes=N >= 1] "
+                 "[--no_return=F in [0, 1]]\n");
+    return 2;
   }
   std::mt19937 rng(7);
   std::vector<std::vector<uint8_t>> clouds;
