@@ -19,7 +19,8 @@
 #
 # Usage: bench/calibrate/run_seeds_bench.sh [options]
 #   --build_dir DIR    this build (default <repo>/build)
-#   --anchor_bin DIR   the anchor's bin/ directory (default: none, this build only)
+#   --anchor_bin DIR   the anchor's bin/ directory (default: none, this build
+#                      only; this build when only --anchor_params is given)
 #   --seeds "N.."      simulator seeds (default "1 2 ... 16")
 #   --passes N         runs of every binary on every seed (default 1)
 #   --scenario FILE    simulate params (default flat_vlp16_40s.txtpb)
@@ -58,8 +59,10 @@ while [ $# -gt 0 ]; do
     *) echo "run_seeds_bench: unknown argument $1" >&2; exit 2 ;;
   esac
 done
-[ -n "$ANCHOR_PARAMS" ] || ANCHOR_PARAMS=$PARAMS
 BIN="$BUILD_DIR/bin"
+# Params alone compared: the anchor is this build with --anchor_params.
+[ -n "$ANCHOR_PARAMS" ] && [ -z "$ANCHOR_BIN" ] && ANCHOR_BIN=$BIN
+[ -n "$ANCHOR_PARAMS" ] || ANCHOR_PARAMS=$PARAMS
 . "$REPO/bench/calibrate/simulated_inputs.sh"
 require_binaries "$BIN" "$ANCHOR_BIN"
 mkdir -p "$SCRATCH"
