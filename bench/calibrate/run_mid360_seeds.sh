@@ -37,6 +37,11 @@ while [ $# -gt 0 ]; do
   esac
 done
 [ ${#PARAMS[@]} -gt 0 ] || PARAMS=("$REPO/stages/calibrate/default_params.txtpb")
+labels=$(for params in "${PARAMS[@]}"; do basename "$params" .txtpb; done)
+if [ "$(echo "$labels" | sort | uniq -d)" != "" ]; then
+  echo "run_mid360_seeds: two --params files share a file name (the label): $(echo "$labels" | sort | uniq -d)" >&2
+  exit 2
+fi
 BIN="$BUILD_DIR/bin"
 for b in tiltcal_simulate tiltcal_decode tiltcal_ground tiltcal_calibrate; do
   [ -x "$BIN/$b" ] || { echo "run_mid360_seeds: $BIN/$b missing (build it first)" >&2; exit 2; }
