@@ -14,29 +14,22 @@ import re
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from calibration_errors import get, parse, quat, qmul, vec  # noqa: E402
+from calibration_errors import parse, quat, qmul  # noqa: E402
+from scaling_report import errors, up_in_imu  # noqa: E402
 
 
-def errors(cal, truth):
-    """(yaw deg, tilt deg, planar cm, |tau| ms) of cal against truth."""
-    g = vec(truth, 'gravity_in_world')
-    n = math.sqrt(sum(x * x for x in g))
-    up = [-x / n for x in g]
+def yaw_tilt_deg(cal, truth):
+    """The rotation error split into its angle about up and the rest (deg)."""
     q = quat(truth, 'imu_from_lidar.rotation')
     d = qmul(quat(cal, 'imu_from_lidar.rotation'), (q[0], -q[1], -q[2], -q[3]))
     if d[0] < 0:
-        d = tuple(-x for x in d)
+        d = [-x for x in d]
     s = math.sqrt(d[1] ** 2 + d[2] ** 2 + d[3] ** 2)
     angle = 2.0 * math.atan2(s, d[0])
     phi = [angle * d[i] / s for i in (1, 2, 3)] if s > 0 else [0.0, 0.0, 0.0]
-    about_up = sum(p * u for p, u in zip(phi, up))
+    about_up = sum(p * u for p, u in zip(phi, up_in_imu(truth)))
     tilt = math.sqrt(max(0.0, sum(p * p for p in phi) - about_up ** 2))
-    dt = [e - t for e, t in zip(vec(cal, 'imu_from_lidar.translation'),
-                                vec(truth, 'imu_from_lidar.translation'))]
-    vertical = sum(a * u for a, u in zip(dt, up))
-    planar = math.sqrt(max(0.0, sum(x * x for x in dt) - vertical ** 2))
-    tau = abs(get(cal, 'time_offset_s') - get(truth, 'time_offset_s'))
-    return math.degrees(abs(about_up)), math.degrees(tilt), planar * 100.0, tau * 1e3
+    return math.degrees(abs(about_up)), math.degrees(tilt)
 
 
 def main():
@@ -48,8 +41,11 @@ def main():
         text = open(os.path.join(work, 'calibration_%s.txtpb' % label)).read()
         truth = parse(open(os.path.join(work, 'truth.txtpb')).read())
         verdict = re.search(r'^verdict: (\w+)', text, re.M)
-        runs.append((label, seed) + errors(parse(text), truth) +
-                    (verdict.group(1) if verdict else 'OK',))
+        cal = parse(text)
+        _, planar_cm, tau_ms = errors(cal, truth)
+        yaw_deg, tilt_deg = yaw_tilt_deg(cal, truth)
+        runs.append((label, seed, yaw_deg, tilt_deg, planar_cm, abs(tau_ms),
+                     verdict.group(1) if verdict else 'OK'))
     print('%-24s %5s %8s %8s %10s %8s %8s' % ('params', 'seed', 'yaw_deg', 'tilt_deg',
                                               'planar_cm', 'tau_ms', 'verdict'))
     for r in runs:

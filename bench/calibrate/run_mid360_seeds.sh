@@ -43,9 +43,8 @@ if [ "$(echo "$labels" | sort | uniq -d)" != "" ]; then
   exit 2
 fi
 BIN="$BUILD_DIR/bin"
-for b in tiltcal_simulate tiltcal_decode tiltcal_ground tiltcal_calibrate; do
-  [ -x "$BIN/$b" ] || { echo "run_mid360_seeds: $BIN/$b missing (build it first)" >&2; exit 2; }
-done
+. "$REPO/bench/calibrate/simulated_inputs.sh"
+require_binaries "$BIN" ""
 SCENARIO="$REPO/tests/stages/calibrate/short_flat_mid360.txtpb"
 mkdir -p "$SCRATCH"
 RESULTS="$SCRATCH/results.tsv"

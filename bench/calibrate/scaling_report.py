@@ -35,13 +35,19 @@ def gnu_time(path):
     return seconds, cpu, float(field('Maximum resident set size (kbytes)')) / 1024.0
 
 
-def errors(cal, truth):
-    rot = angle_deg(quat(cal, 'imu_from_lidar.rotation'), quat(truth, 'imu_from_lidar.rotation'))
+def up_in_imu(truth):
+    """Unit up in b, the normal of the plane of motion: -g_f (flat ground), else -g at t0."""
     up = vec(truth, 'gravity_flat_in_imu')
     if not any(up):
         up = vec(truth, 'gravity_in_world')
     n = math.sqrt(sum(x * x for x in up))
-    up = [-x / n for x in up]
+    return [-x / n for x in up]
+
+
+def errors(cal, truth):
+    """Rotation error (deg), translation error in the plane of motion (cm), tau error (ms)."""
+    rot = angle_deg(quat(cal, 'imu_from_lidar.rotation'), quat(truth, 'imu_from_lidar.rotation'))
+    up = up_in_imu(truth)
     dt = [e - t for e, t in zip(vec(cal, 'imu_from_lidar.translation'),
                                 vec(truth, 'imu_from_lidar.translation'))]
     vertical = sum(a * b for a, b in zip(dt, up))
