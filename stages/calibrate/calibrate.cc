@@ -108,8 +108,14 @@ void LogRigChecks(const InitialisationReport& init, std::ostream* log) {
                        check.rms_horizontal_acceleration_mps2));
 }
 
-// The initialisation's findings for the verdict (CalibrationResult 80-89).
+// The initialisation's findings for the verdict (CalibrationResult 80-89)
+// and its odometry's counts and registration quality (111-115).
 void FillInitialisationFacts(const InitialisationReport& init, proto::CalibrationResult* result) {
+  result->set_odometry_scans(init.odometry_scans);
+  result->set_odometry_registered_scans(init.odometry_registered);
+  result->set_odometry_quality_scans(init.odometry_quality_scans);
+  result->set_odometry_mean_fitness_m(init.odometry_mean_fitness_m);
+  result->set_odometry_mean_inlier_fraction(init.odometry_mean_inlier_fraction);
   result->set_coarse_time_offset_s(init.coarse.alignment.time_offset_s);
   result->set_coarse_time_offset_correlation(init.coarse.alignment.correlation);
   result->set_coarse_time_offset_second_peak_correlation(
@@ -144,6 +150,12 @@ Status Initialise(const CalibrateInputs& inputs, const proto::CalibrateParams& p
                        init->hand_eye.excitation_rad, init->hand_eye.num_pairs,
                        init->position_fit_rms, Seconds(start),
                        init->rotation_from_hand_eye ? "hand-eye" : "the rig"));
+  if (init->odometry_quality_scans > 0) {
+    Log(log, fmt::format("init: odometry registration quality over {} scans: inlier rms {:.1f} mm, "
+                         "inliers {:.1f} %",
+                         init->odometry_quality_scans, init->odometry_mean_fitness_m * 1e3,
+                         init->odometry_mean_inlier_fraction * 100.0));
+  }
   LogCoarseTimeOffset(*init, log);
   Log(log, fmt::format("init: rotation-axis alignment {:d} ({:.3f} deg), coarse tau {:.2f} ms",
                        init->axis_alignment_applied ? 1 : 0, init->axis_alignment_deg,

@@ -336,7 +336,9 @@ OdometryRun RunOdometry(const std::vector<LidarScan>& scans, const CalibrationSt
                         InitialisationReport* report) {
   report->odometry_scans = 0;
   report->odometry_registered = 0;
+  report->odometry_quality_scans = 0;
   report->odometry_mean_fitness_m = 0.0;
+  report->odometry_mean_inlier_fraction = 0.0;
   const double tau = state.time_offset_s[0];
   const int num_threads = std::max(static_cast<int>(params.num_threads()), 1);
   LidarOdometry odometry(params.odometry(), params.scans(), num_threads);
@@ -395,19 +397,28 @@ OdometryRun RunOdometry(const std::vector<LidarScan>& scans, const CalibrationSt
   }
   run.poses = odometry.poses();
   report->odometry_scans = static_cast<int>(run.poses.size());
-  double fitness = 0.0;
+  double fitness_sum = 0.0;
+  double inlier_fraction_sum = 0.0;
+  int measured = 0;
   for (size_t i = 0; i < run.poses.size(); ++i) {
-    if (i > 0 && !run.poses[i].registered) continue;
+    const LidarOdometryPose& pose = run.poses[i];
+    if (i > 0 && !pose.registered) continue;
     if (i > 0) {
       ++report->odometry_registered;
-      fitness += run.poses[i].fitness_rms_m;
+      if (pose.num_quality_points > 0) {
+        fitness_sum += pose.fitness_rms_m;
+        inlier_fraction_sum += pose.inlier_fraction;
+        ++measured;
+      }
     }
     run.used.push_back(i);
     run.imu_used.push_back(run.imu_rotations[i]);
-    run.lidar_used.push_back(Eigen::Quaterniond(run.poses[i].l0_from_lidar.rotation()));
+    run.lidar_used.push_back(Eigen::Quaterniond(pose.l0_from_lidar.rotation()));
   }
-  if (report->odometry_registered > 0) {
-    report->odometry_mean_fitness_m = fitness / report->odometry_registered;
+  report->odometry_quality_scans = measured;
+  if (measured > 0) {
+    report->odometry_mean_fitness_m = fitness_sum / measured;
+    report->odometry_mean_inlier_fraction = inlier_fraction_sum / measured;
   }
   return run;
 }

@@ -72,9 +72,16 @@ struct InitialisationReport {
   imu::ImuInitialisation imu;
   HandEyeResult hand_eye;
   bool rotation_from_hand_eye = false;
+  // The odometry whose poses the initialisation used (the last run): its
+  // scans, those registered (scan 0 not counted), and the registered scans
+  // whose registration quality was measured (VOXEL_ICP always; GICP / NDT
+  // with odometry.registration_quality) with the means of their
+  // LidarOdometryPose::fitness_rms_m (m) and inlier_fraction.
   int odometry_scans = 0;
   int odometry_registered = 0;
+  int odometry_quality_scans = 0;
   double odometry_mean_fitness_m = 0.0;
+  double odometry_mean_inlier_fraction = 0.0;
   double gyro_fit_rms = 0.0;      // RMS weighted gyro residual after the fit
   double rotation_refit_rms = 0.0;  // RMS weighted residual of step 4c
   double position_fit_rms = 0.0;  // RMS weighted residual of the position fit
