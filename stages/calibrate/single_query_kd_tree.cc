@@ -1,41 +1,113 @@
 #include "stages/calibrate/single_query_kd_tree.h"
 
-// The KdTreeFLANN template's definitions, instantiated here for
-// SingleQueryL2 in a library compiled without OpenMP (the omp pragmas of
-// FLANN's headers are then ignored).
-#include <pcl/kdtree/impl/kdtree_flann.hpp>
+#include <algorithm>
+#include <cmath>
+#include <utility>
 
-#ifdef _OPENMP
-#error "single_query_kd_tree.cc must be compiled without OpenMP (single_query_kd_tree.h)"
-#endif
-
-template class pcl::KdTreeFLANN<pcl::PointXYZ, tiltcal::calibrate::SingleQueryL2>;
+#include <nanoflann.hpp>
 
 namespace tiltcal::calibrate {
 
-SingleQueryKdTree::SingleQueryKdTree(bool sorted) : Base(sorted), tree_without_openmp_(sorted) {}
+namespace {
 
-void SingleQueryKdTree::setSortedResults(bool sorted) {
-  Base::setSortedResults(sorted);
-  tree_without_openmp_.setSortedResults(sorted);
-}
+// nanoflann's view of the packed x, y, z floats.
+struct PackedPoints {
+  const std::vector<float>* xyz;
+  size_t kdtree_get_point_count() const { return xyz->size() / 3; }
+  float kdtree_get_pt(size_t i, size_t dim) const { return (*xyz)[3 * i + dim]; }
+  template <class BoundingBox>
+  bool kdtree_get_bbox(BoundingBox&) const {
+    return false;  // nanoflann computes it
+  }
+};
+
+// Squared Euclidean distance in float, summed over x, y, z in that order
+// (FLANN's L2_Simple<float>).
+using Metric = nanoflann::L2_Simple_Adaptor<float, PackedPoints, float, uint32_t>;
+
+// Points per leaf (FLANN's single-index tree in PCL: 15).
+constexpr size_t kLeafSize = 15;
+
+}  // namespace
+
+struct SingleQueryKdTree::Index {
+  explicit Index(const std::vector<float>* xyz)
+      : points{xyz}, tree(3, points, nanoflann::KDTreeSingleIndexAdaptorParams(kLeafSize)) {}
+  PackedPoints points;
+  nanoflann::KDTreeSingleIndexAdaptor<Metric, PackedPoints, 3, uint32_t> tree;
+};
+
+SingleQueryKdTree::SingleQueryKdTree(bool sorted) : Base(sorted) {}
+
+SingleQueryKdTree::~SingleQueryKdTree() = default;
 
 void SingleQueryKdTree::setInputCloud(const PointCloudConstPtr& cloud,
                                       const pcl::IndicesConstPtr& indices) {
-  tree_without_openmp_.setInputCloud(cloud, indices);
   input_ = cloud;
   indices_ = indices;
+  index_.reset();
+  xyz_.clear();
+  cloud_index_.clear();
+  if (cloud == nullptr) return;
+  auto add = [&](int i) {
+    const pcl::PointXYZ& p = (*cloud)[i];
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) return;
+    xyz_.insert(xyz_.end(), {p.x, p.y, p.z});
+    cloud_index_.push_back(i);
+  };
+  if (indices != nullptr) {
+    xyz_.reserve(3 * indices->size());
+    cloud_index_.reserve(indices->size());
+    for (const int i : *indices) add(i);
+  } else {
+    xyz_.reserve(3 * cloud->size());
+    cloud_index_.reserve(cloud->size());
+    for (int i = 0; i < static_cast<int>(cloud->size()); ++i) add(i);
+  }
+  if (!cloud_index_.empty()) index_ = std::make_unique<Index>(&xyz_);
 }
 
 int SingleQueryKdTree::nearestKSearch(const pcl::PointXYZ& point, int k, pcl::Indices& k_indices,
                                       std::vector<float>& k_sqr_distances) const {
-  return tree_without_openmp_.nearestKSearch(point, k, k_indices, k_sqr_distances);
+  const size_t wanted = index_ == nullptr ? 0 : std::min<size_t>(std::max(k, 0), cloud_index_.size());
+  k_indices.resize(wanted);
+  k_sqr_distances.resize(wanted);
+  if (wanted == 0) return 0;
+  const float query[3] = {point.x, point.y, point.z};
+  // nanoflann's indices are uint32_t, pcl::Indices' int: found in a buffer
+  // of the former, then mapped to the cloud's indices.
+  uint32_t found_local[32];
+  std::vector<uint32_t> found_heap;
+  uint32_t* found = found_local;
+  if (wanted > 32) {
+    found_heap.resize(wanted);
+    found = found_heap.data();
+  }
+  const size_t n = index_->tree.knnSearch(query, wanted, found, k_sqr_distances.data());
+  k_indices.resize(n);
+  k_sqr_distances.resize(n);
+  for (size_t j = 0; j < n; ++j) k_indices[j] = cloud_index_[found[j]];
+  return static_cast<int>(n);
 }
 
 int SingleQueryKdTree::radiusSearch(const pcl::PointXYZ& point, double radius,
                                     pcl::Indices& k_indices, std::vector<float>& k_sqr_distances,
                                     unsigned int max_nn) const {
-  return tree_without_openmp_.radiusSearch(point, radius, k_indices, k_sqr_distances, max_nn);
+  k_indices.clear();
+  k_sqr_distances.clear();
+  if (index_ == nullptr) return 0;
+  const float query[3] = {point.x, point.y, point.z};
+  std::vector<std::pair<uint32_t, float>> matches;
+  index_->tree.radiusSearch(query, static_cast<float>(radius * radius), matches,
+                            nanoflann::SearchParams(32, 0.0f, /*sorted=*/true));
+  if (max_nn > 0 && matches.size() > max_nn) matches.resize(max_nn);
+  k_indices.reserve(matches.size());
+  k_sqr_distances.reserve(matches.size());
+  for (const auto& [i, d] : matches) {
+    k_indices.push_back(cloud_index_[i]);
+    k_sqr_distances.push_back(d);
+  }
+  return static_cast<int>(matches.size());
 }
 
 }  // namespace tiltcal::calibrate

@@ -1,38 +1,28 @@
 #ifndef TILTCAL_STAGES_CALIBRATE_SINGLE_QUERY_KD_TREE_H_
 #define TILTCAL_STAGES_CALIBRATE_SINGLE_QUERY_KD_TREE_H_
 
-// The k-d tree of PCL's GICP (its target and source neighbour searches)
-// without an OpenMP parallel region per query.
+// The k-d tree of PCL's GICP (its target and source neighbour searches) and
+// of the GICP covariances (gicp_covariances.h): a pcl::search::KdTree, so
+// GICP's setSearchMethodTarget and setSearchMethodSource take it, whose
+// queries go to a nanoflann k-d tree over the cloud's finite points.
 //
 // pcl::search::KdTree answers each query through FLANN's batch search, which
-// opens `#pragma omp parallel num_threads(cores)` even for a single point.
-// In Debian's libpcl_kdtree, built with OpenMP, entering and leaving that
-// region took ~40 % of the GICP odometry's CPU samples
-// (stages/calibrate/README.md, "Speed"). SingleQueryKdTree is a
-// pcl::search::KdTree, so GICP's setSearchMethodTarget and
-// setSearchMethodSource take it, and its queries go to a pcl::KdTreeFLANN
-// instantiated in this library, which is compiled without OpenMP. It is the
-// same tree (FLANN's single-index k-d tree, 15 points per leaf, invalid
-// points left out), the same exact search and the same sorting, so it gives
-// the same neighbours in the same order as pcl::search::KdTree.
+// opens `#pragma omp parallel num_threads(cores)` even for a single point
+// (in Debian's libpcl_kdtree, built with OpenMP, ~40 % of the GICP
+// odometry's CPU samples); FLANN's single-index tree without that region was
+// still ~25 % of the stage's CPU (stages/calibrate/README.md, "Speed").
+// The searches are exact and the distances are computed as FLANN's
+// L2_Simple<float> does (the sum of (q_i - p_i)^2 over x, y, z in float), so
+// the neighbours, their order and their squared distances are those of
+// pcl::search::KdTree, except which of several points at exactly the same
+// distance comes first.
 
+#include <cstdint>
+#include <memory>
 #include <vector>
 
-#include <flann/algorithms/dist.h>
-#include <pcl/kdtree/kdtree_flann.h>
 #include <pcl/point_types.h>
 #include <pcl/search/kdtree.h>
-
-namespace tiltcal::calibrate {
-
-// FLANN's L2_Simple<float> under a name of its own: the FLANN and
-// KdTreeFLANN templates instantiated for it here are not libpcl_kdtree's.
-struct SingleQueryL2 : flann::L2_Simple<float> {};
-
-}  // namespace tiltcal::calibrate
-
-// Instantiated once, in single_query_kd_tree.cc.
-extern template class pcl::KdTreeFLANN<pcl::PointXYZ, tiltcal::calibrate::SingleQueryL2>;
 
 namespace tiltcal::calibrate {
 
@@ -43,18 +33,26 @@ class SingleQueryKdTree final : public pcl::search::KdTree<pcl::PointXYZ> {
   using Base::radiusSearch;
 
   explicit SingleQueryKdTree(bool sorted = true);
+  ~SingleQueryKdTree() override;
 
-  void setSortedResults(bool sorted) override;
   void setInputCloud(const PointCloudConstPtr& cloud,
                      const pcl::IndicesConstPtr& indices = pcl::IndicesConstPtr()) override;
-  // Squared distances, m^2; sorted by distance when sorted results are set.
+  // The k nearest (all when fewer), sorted by distance; squared distances,
+  // m^2. Safe to call from several threads at once.
   int nearestKSearch(const pcl::PointXYZ& point, int k, pcl::Indices& k_indices,
                      std::vector<float>& k_sqr_distances) const override;
+  // The points within `radius` (m), the max_nn nearest of them when max_nn
+  // > 0, sorted by distance.
   int radiusSearch(const pcl::PointXYZ& point, double radius, pcl::Indices& k_indices,
                    std::vector<float>& k_sqr_distances, unsigned int max_nn = 0) const override;
 
  private:
-  pcl::KdTreeFLANN<pcl::PointXYZ, SingleQueryL2> tree_without_openmp_;
+  struct Index;
+  // x, y, z of the finite points of the cloud (of `indices` when given), in
+  // their order, and each one's index in the cloud.
+  std::vector<float> xyz_;
+  std::vector<int> cloud_index_;
+  std::unique_ptr<Index> index_;
 };
 
 }  // namespace tiltcal::calibrate
