@@ -1,6 +1,7 @@
 // SingleQueryKdTree against PCL's own pcl::search::KdTree: the same
-// neighbours in the same order with the same distances, and the same GICP
-// alignment to the last bit; ComputeGicpCovariances against GICP's own
+// neighbours in the same order with the same distances (on a grid, where
+// many points tie, the same distances, the tied points in any order), and
+// the same GICP alignment to the last bit; ComputeGicpCovariances against GICP's own
 // covariances (its closed-form eigenvector against PCL's SVD: equal to
 // rounding), and GICP given them against GICP on its own.
 
@@ -82,6 +83,42 @@ TEST(SingleQueryKdTreeTest, SameNeighboursAsPclKdTree) {
       }
     }
   }
+}
+
+// A grid of 0.25 m, queried at grid points and between them: neighbours at
+// exactly the same distance everywhere. Both trees are exact, so the
+// distances are PCL's, every index is a point at its distance, and only
+// the order among tied points (and which tied point is the k-th) may differ.
+TEST(SingleQueryKdTreeTest, TiedNeighboursHaveThePclDistances) {
+  Cloud::Ptr grid(new Cloud);
+  for (int i = 0; i < 12; ++i) {
+    for (int j = 0; j < 12; ++j) {
+      for (int l = 0; l < 6; ++l) grid->push_back(pcl::PointXYZ(0.25f * i, 0.25f * j, 0.25f * l));
+    }
+  }
+  pcl::search::KdTree<pcl::PointXYZ> pcl_tree;
+  SingleQueryKdTree tree;
+  pcl_tree.setInputCloud(grid);
+  tree.setInputCloud(grid);
+  int queries_with_ties = 0;
+  for (int q = 0; q < 200; ++q) {
+    const pcl::PointXYZ& p = (*grid)[(q * 37) % grid->size()];
+    const pcl::PointXYZ query(p.x + (q % 2) * 0.125f, p.y, p.z + (q % 3 == 0) * 0.125f);
+    for (const int k : {1, 10}) {
+      pcl::Indices expected_indices, indices;
+      std::vector<float> expected_distances, distances;
+      ASSERT_EQ(tree.nearestKSearch(query, k, indices, distances),
+                pcl_tree.nearestKSearch(query, k, expected_indices, expected_distances));
+      EXPECT_EQ(distances, expected_distances);
+      for (size_t j = 0; j < indices.size(); ++j) {
+        const pcl::PointXYZ& n = (*grid)[indices[j]];
+        const float dx = query.x - n.x, dy = query.y - n.y, dz = query.z - n.z;
+        EXPECT_EQ(dx * dx + dy * dy + dz * dz, distances[j]);
+      }
+      if (k == 10 && distances.size() == 10 && distances[0] == distances[1]) ++queries_with_ties;
+    }
+  }
+  EXPECT_GT(queries_with_ties, 50);
 }
 
 using Gicp = pcl::GeneralizedIterativeClosestPoint<pcl::PointXYZ, pcl::PointXYZ>;
