@@ -29,7 +29,9 @@
 #   --threads N        num_threads of the calibrator (default 2)
 #   --wall_goal S      the wall time the report counts runs over (default 10)
 #   --scratch DIR      work directory (default /tmp/tiltcal_seeds_bench)
-# Ground residuals are off (LiDAR + IMU only), as in run_calibrate_bench.sh.
+#   --ground_residuals keep the ground residuals as the params set them
+# Ground residuals are off (LiDAR + IMU only) unless --ground_residuals, as
+# in run_calibrate_bench.sh.
 set -euo pipefail
 
 REPO=$(cd "$(dirname "$0")/../.." && pwd)
@@ -43,6 +45,7 @@ ANCHOR_PARAMS=""
 THREADS=2
 WALL_GOAL=10
 SCRATCH=/tmp/tiltcal_seeds_bench
+GROUND_RESIDUALS=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --build_dir) BUILD_DIR=$2; shift 2 ;;
@@ -55,6 +58,7 @@ while [ $# -gt 0 ]; do
     --threads) THREADS=$2; shift 2 ;;
     --wall_goal) WALL_GOAL=$2; shift 2 ;;
     --scratch) SCRATCH=$2; shift 2 ;;
+    --ground_residuals) GROUND_RESIDUALS=1; shift ;;
     -h|--help) sed -n '2,/^set -euo/p' "$0" | sed '$d'; exit 0 ;;
     *) echo "run_seeds_bench: unknown argument $1" >&2; exit 2 ;;
   esac
@@ -66,8 +70,8 @@ BIN="$BUILD_DIR/bin"
 . "$REPO/bench/calibrate/simulated_inputs.sh"
 require_binaries "$BIN" "$ANCHOR_BIN"
 mkdir -p "$SCRATCH"
-calibrate_params "$PARAMS" "$SCRATCH/params_this.txtpb" "$THREADS"
-calibrate_params "$ANCHOR_PARAMS" "$SCRATCH/params_anchor.txtpb" "$THREADS"
+calibrate_params "$PARAMS" "$SCRATCH/params_this.txtpb" "$THREADS" "$GROUND_RESIDUALS"
+calibrate_params "$ANCHOR_PARAMS" "$SCRATCH/params_anchor.txtpb" "$THREADS" "$GROUND_RESIDUALS"
 
 for seed in $SEEDS; do
   w="$SCRATCH/s$seed"

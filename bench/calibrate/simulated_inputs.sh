@@ -27,11 +27,15 @@ simulate_inputs() {
     --params="$repo/stages/gravity/default_params.txtpb" --out="$w/gravity.txtpb" 2> "$w/log_gravity.txt"
 }
 
-# calibrate_params IN OUT THREADS: IN with num_threads THREADS and every
-# ground residual OFF.
+# calibrate_params IN OUT THREADS [GROUND]: IN with num_threads THREADS and
+# every ground residual OFF, or as IN sets them when GROUND is 1.
 calibrate_params() {
-  sed -e "s/^num_threads: .*/num_threads: $3/" \
-      -e "s/mode: AUTO/mode: OFF/; s/mode: ON/mode: OFF/" "$1" > "$2"
+  if [ "${4:-0}" = 1 ]; then
+    sed -e "s/^num_threads: .*/num_threads: $3/" "$1" > "$2"
+  else
+    sed -e "s/^num_threads: .*/num_threads: $3/" \
+        -e "s/mode: AUTO/mode: OFF/; s/mode: ON/mode: OFF/" "$1" > "$2"
+  fi
 }
 
 # steal_ticks: CPU time the hypervisor gave to other guests since boot, in
