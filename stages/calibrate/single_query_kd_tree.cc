@@ -23,7 +23,8 @@ struct PackedPoints {
 
 // Squared Euclidean distance in float, summed over x, y, z in that order
 // (FLANN's L2_Simple<float>).
-using Metric = nanoflann::L2_Simple_Adaptor<float, PackedPoints, float, uint32_t>;
+// Indices are pcl::index_t, so searches write straight into pcl::Indices.
+using Metric = nanoflann::L2_Simple_Adaptor<float, PackedPoints, float, pcl::index_t>;
 
 // Points per leaf (FLANN's single-index tree in PCL: 15).
 constexpr size_t kLeafSize = 15;
@@ -34,7 +35,7 @@ struct SingleQueryKdTree::Index {
   explicit Index(const std::vector<float>* xyz)
       : points{xyz}, tree(3, points, nanoflann::KDTreeSingleIndexAdaptorParams(kLeafSize)) {}
   PackedPoints points;
-  nanoflann::KDTreeSingleIndexAdaptor<Metric, PackedPoints, 3, uint32_t> tree;
+  nanoflann::KDTreeSingleIndexAdaptor<Metric, PackedPoints, 3, pcl::index_t> tree;
 };
 
 SingleQueryKdTree::SingleQueryKdTree(bool sorted) : Base(sorted) {}
@@ -55,38 +56,25 @@ void SingleQueryKdTree::setInputCloud(const PointCloudConstPtr& cloud,
     xyz_.insert(xyz_.end(), {p.x, p.y, p.z});
     cloud_index_.push_back(i);
   };
-  if (indices != nullptr) {
-    xyz_.reserve(3 * indices->size());
-    cloud_index_.reserve(indices->size());
-    for (const int i : *indices) add(i);
-  } else {
-    xyz_.reserve(3 * cloud->size());
-    cloud_index_.reserve(cloud->size());
-    for (int i = 0; i < static_cast<int>(cloud->size()); ++i) add(i);
-  }
+  const size_t n = indices != nullptr ? indices->size() : cloud->size();
+  xyz_.reserve(3 * n);
+  cloud_index_.reserve(n);
+  for (size_t j = 0; j < n; ++j) add(indices != nullptr ? (*indices)[j] : static_cast<int>(j));
   if (!cloud_index_.empty()) index_ = std::make_unique<Index>(&xyz_);
 }
 
 int SingleQueryKdTree::nearestKSearch(const pcl::PointXYZ& point, int k, pcl::Indices& k_indices,
                                       std::vector<float>& k_sqr_distances) const {
-  const size_t wanted = index_ == nullptr ? 0 : std::min<size_t>(std::max(k, 0), cloud_index_.size());
+  // cloud_index_ is empty when there is no tree.
+  const size_t wanted = std::min<size_t>(std::max(k, 0), cloud_index_.size());
   k_indices.resize(wanted);
   k_sqr_distances.resize(wanted);
   if (wanted == 0) return 0;
   const float query[3] = {point.x, point.y, point.z};
-  // nanoflann's indices are uint32_t, pcl::Indices' int: found in a buffer
-  // of the former, then mapped to the cloud's indices.
-  uint32_t found_local[32];
-  std::vector<uint32_t> found_heap;
-  uint32_t* found = found_local;
-  if (wanted > 32) {
-    found_heap.resize(wanted);
-    found = found_heap.data();
-  }
-  const size_t n = index_->tree.knnSearch(query, wanted, found, k_sqr_distances.data());
+  const size_t n = index_->tree.knnSearch(query, wanted, k_indices.data(), k_sqr_distances.data());
   k_indices.resize(n);
   k_sqr_distances.resize(n);
-  for (size_t j = 0; j < n; ++j) k_indices[j] = cloud_index_[found[j]];
+  for (pcl::index_t& i : k_indices) i = cloud_index_[i];  // tree order -> cloud index
   return static_cast<int>(n);
 }
 
@@ -97,7 +85,7 @@ int SingleQueryKdTree::radiusSearch(const pcl::PointXYZ& point, double radius,
   k_sqr_distances.clear();
   if (index_ == nullptr) return 0;
   const float query[3] = {point.x, point.y, point.z};
-  std::vector<std::pair<uint32_t, float>> matches;
+  std::vector<std::pair<pcl::index_t, float>> matches;
   index_->tree.radiusSearch(query, static_cast<float>(radius * radius), matches,
                             nanoflann::SearchParams(32, 0.0f, /*sorted=*/true));
   if (max_nn > 0 && matches.size() > max_nn) matches.resize(max_nn);

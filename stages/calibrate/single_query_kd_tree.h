@@ -17,7 +17,6 @@
 // pcl::search::KdTree, except which of several points at exactly the same
 // distance comes first.
 
-#include <cstdint>
 #include <memory>
 #include <vector>
 
