@@ -7,6 +7,7 @@
 # on the same large bag:
 #   tiltcal_decode                      (ours, full decode to .binpb files)
 #   C++ rosbag library reader           (anchor: rosbag::View + instantiate)
+#   the same reader writing what it reads (second anchor: + stdio writes)
 #   Python rosbag reader                (read_points, and numpy.frombuffer)
 # each under /usr/bin/time -v, and prints wall s, MB/s (bag bytes / wall),
 # points/s, peak RSS and the speed ratio against the C++ rosbag reader
@@ -196,6 +197,10 @@ for ((r = 1; r <= REPEATS; ++r)); do
   [ $HAVE_DECODE = 1 ] && run_decode tiltcal_decode "$BAG" "$r"
   if [ $HAVE_ROS_CPP = 1 ]; then
     run_timed rosbag_cpp "$BAG" "$r" "$CPP_READER" "$BAG"
+    # The same reader writing what it reads (rosbag_cpp_reader.cc, --out).
+    mkdir -p "$RUN_DIR/out"
+    run_timed rosbag_cpp_write "$BAG" "$r" "$CPP_READER" --out="$RUN_DIR/out/points.bin" "$BAG"
+    rm -rf "$RUN_DIR/out"
   fi
 done
 if [ "$PYTHON_POINTS" = read_points ] || [ "$PYTHON_POINTS" = both ]; then
@@ -302,7 +307,9 @@ for b in "$BAG" "$SMALL_BAG"; do
 done
 echo "  MB = 1e6 bytes of the bag file; median wall and cpu (user + sys) of $REPEATS runs for"
 echo "  tiltcal_decode and the C++ reader, largest peak RSS; vs C++ = C++ rosbag wall / tool wall"
-echo "  on the same bag (> 1: faster than the C++ rosbag library); cpu vs = the same on cpu s."
+echo "  on the same bag (> 1: faster than the C++ rosbag library); cpu vs = the same on cpu s;"
+echo "  rw vs and rw cpu = the same against rosbag_cpp_write (the C++ reader writing the points"
+echo "  and IMU samples it reads to one file through stdio, no checksum, no fsync)."
 echo "  Load average before the runs: $LOAD_BEFORE, after: $(cut -d' ' -f1-3 /proc/loadavg)"
 awk -v big="$BAG" '
   function median(list, n,   a, i, j, t) {
@@ -320,10 +327,13 @@ awk -v big="$BAG" '
     if ($6 != 0) failed[key] = 1
   }
   END {
-    printf "\n%-40s %-25s %7s %7s %7s %9s %7s %7s %7s\n", "tool", "bag", "wall s", "cpu s", "MB/s", "Mpoints/s", "RSS MB", "vs C++", "cpu vs"
+    printf "\n%-40s %-25s %7s %7s %7s %9s %7s %7s %7s %7s %7s\n", "tool", "bag", "wall s", "cpu s", "MB/s", "Mpoints/s", "RSS MB", "vs C++", "cpu vs", "rw vs", "rw cpu"
     anchor_key = "rosbag_cpp" SUBSEP big
     anchor = (anchor_key in walls) ? median(walls[anchor_key]) : 0
     anchor_cpu = (anchor_key in cpus) ? median(cpus[anchor_key]) : 0
+    rw_key = "rosbag_cpp_write" SUBSEP big
+    rw = (rw_key in walls) ? median(walls[rw_key]) : 0
+    rw_cpu = (rw_key in cpus) ? median(cpus[rw_key]) : 0
     for (k = 1; k <= n; ++k) {
       key = order[k]; split(key, parts, SUBSEP)
       w = median(walls[key])
@@ -333,14 +343,16 @@ awk -v big="$BAG" '
       c = median(cpus[key])
       ratio = (anchor > 0 && parts[2] == big && w > 0) ? sprintf("%.2fx", anchor / w) : "-"
       cratio = (anchor_cpu > 0 && parts[2] == big && c > 0) ? sprintf("%.2fx", anchor_cpu / c) : "-"
+      rwratio = (rw > 0 && parts[2] == big && w > 0) ? sprintf("%.2fx", rw / w) : "-"
+      rwcratio = (rw_cpu > 0 && parts[2] == big && c > 0) ? sprintf("%.2fx", rw_cpu / c) : "-"
       bn = parts[2]; sub(".*/", "", bn)
       # A prefix run (python read_points with --python_max_bytes) reads only
       # part of the bag: MB/s is scaled by the fraction of points it read.
       cmd = "sed -n s/^points=//p " parts[2] ".meta"; cmd | getline total; close(cmd)
       frac = (total > 0) ? points[key] / total : 1
-      if (frac < 0.999) { name = name sprintf(" [%.0f%% prefix]", 100 * frac); if (ratio != "-") { ratio = sprintf("%.2fx", anchor * frac / w); cratio = sprintf("%.2fx", anchor_cpu * frac / c) } }
-      printf "%-40s %-25s %7.2f %7.2f %7.1f %9.2f %7.1f %7s %7s\n", name, bn, w, c,
-             (w > 0 ? size * frac / w / 1e6 : 0), (w > 0 ? points[key] / w / 1e6 : 0), rss[key] / 1024, ratio, cratio
+      if (frac < 0.999) { name = name sprintf(" [%.0f%% prefix]", 100 * frac); if (ratio != "-") { ratio = sprintf("%.2fx", anchor * frac / w); cratio = sprintf("%.2fx", anchor_cpu * frac / c) } if (rwratio != "-") { rwratio = sprintf("%.2fx", rw * frac / w); rwcratio = sprintf("%.2fx", rw_cpu * frac / c) } }
+      printf "%-40s %-25s %7.2f %7.2f %7.1f %9.2f %7.1f %7s %7s %7s %7s\n", name, bn, w, c,
+             (w > 0 ? size * frac / w / 1e6 : 0), (w > 0 ? points[key] / w / 1e6 : 0), rss[key] / 1024, ratio, cratio, rwratio, rwcratio
     }
   }' "$RESULTS" | tee "$LOGS/table.txt"
 echo
