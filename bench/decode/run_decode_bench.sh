@@ -150,9 +150,14 @@ SMALL_BAG=$(make_bag "$SMALL_GB")
 meta() { sed -n "s/^$2=//p" "$1.meta"; }
 
 # ---- Timed runs. ----
-# Results, one line per run: label bag wall_s max_rss_kb points_read exit cpu_s
+# Results, one line per run: label bag wall_s max_rss_kb points_read exit cpu_s steal_s
 RESULTS="$LOGS/results.txt"
 : >"$RESULTS"
+# CPU time the hypervisor gave other guests since boot, USER_HZ ticks
+# (/proc/stat, field 9 of the cpu line): on a shared VM a run that lost
+# seconds to steal has a long wall time for that reason alone.
+steal_ticks() { awk '/^cpu / {print $9}' /proc/stat; }
+TICKS_PER_S=$(getconf CLK_TCK)
 # run_timed LABEL BAG POINTS_READ_CMD|- CMD...   (POINTS_READ "-" = all points of BAG)
 run_timed() {
   local label=$1 bag=$2 i=$3
@@ -160,8 +165,12 @@ run_timed() {
   local tag
   tag="$label.$(basename "$bag" .bag).$i"
   local tlog="$LOGS/$tag.time" out="$LOGS/$tag.out"
-  local status=0
+  local status=0 steal_before
+  steal_before=$(steal_ticks)
   /usr/bin/time -v -o "$tlog" "$@" >"$out" 2>&1 || status=$?
+  local steal
+  steal=$(awk -v a="$steal_before" -v b="$(steal_ticks)" -v hz="$TICKS_PER_S" \
+    'BEGIN { printf "%.2f", (b - a) / hz }')
   local wall rss
   wall=$(awk -F': ' '/Elapsed \(wall clock\)/ { n = split($2, p, ":"); s = 0;
            for (k = 1; k <= n; ++k) s = s * 60 + p[k]; print s }' "$tlog")
@@ -171,7 +180,7 @@ run_timed() {
   local points
   points=$(sed -n 's/.* points=\([0-9]*\).*/\1/p' "$out" | tail -1)
   [ -z "$points" ] && points=$(meta "$bag" points)
-  echo "$label $bag $wall $rss $points $status $cpu" >>"$RESULTS"
+  echo "$label $bag $wall $rss $points $status $cpu $steal" >>"$RESULTS"
   if [ $status -ne 0 ]; then
     log "$label failed (exit $status), output in $out:"
     tail -5 "$out" >&2
@@ -309,7 +318,8 @@ echo "  MB = 1e6 bytes of the bag file; median wall and cpu (user + sys) of $REP
 echo "  tiltcal_decode and the C++ reader, largest peak RSS; vs C++ = C++ rosbag wall / tool wall"
 echo "  on the same bag (> 1: faster than the C++ rosbag library); cpu vs = the same on cpu s;"
 echo "  rw vs and rw cpu = the same against rosbag_cpp_write (the C++ reader writing the points"
-echo "  and IMU samples it reads to one file through stdio, no checksum, no fsync)."
+echo "  and IMU samples it reads to one file through stdio, no checksum, no fsync);"
+echo "  steal s = CPU time the host gave other guests during the row's runs, summed."
 echo "  Load average before the runs: $LOAD_BEFORE, after: $(cut -d' ' -f1-3 /proc/loadavg)"
 awk -v big="$BAG" '
   function median(list, n,   a, i, j, t) {
@@ -322,12 +332,13 @@ awk -v big="$BAG" '
     if (!(key in walls)) { order[++n] = key }
     walls[key] = walls[key] " " $3
     cpus[key] = cpus[key] " " $7
+    steal[key] += $8
     if ($4 > rss[key]) rss[key] = $4
     points[key] = $5
     if ($6 != 0) failed[key] = 1
   }
   END {
-    printf "\n%-40s %-25s %7s %7s %7s %9s %7s %7s %7s %7s %7s\n", "tool", "bag", "wall s", "cpu s", "MB/s", "Mpoints/s", "RSS MB", "vs C++", "cpu vs", "rw vs", "rw cpu"
+    printf "\n%-40s %-25s %7s %7s %7s %9s %7s %7s %7s %7s %7s %7s\n", "tool", "bag", "wall s", "cpu s", "MB/s", "Mpoints/s", "RSS MB", "vs C++", "cpu vs", "rw vs", "rw cpu", "steal s"
     anchor_key = "rosbag_cpp" SUBSEP big
     anchor = (anchor_key in walls) ? median(walls[anchor_key]) : 0
     anchor_cpu = (anchor_key in cpus) ? median(cpus[anchor_key]) : 0
@@ -351,8 +362,8 @@ awk -v big="$BAG" '
       cmd = "sed -n s/^points=//p " parts[2] ".meta"; cmd | getline total; close(cmd)
       frac = (total > 0) ? points[key] / total : 1
       if (frac < 0.999) { name = name sprintf(" [%.0f%% prefix]", 100 * frac); if (ratio != "-") { ratio = sprintf("%.2fx", anchor * frac / w); cratio = sprintf("%.2fx", anchor_cpu * frac / c) } if (rwratio != "-") { rwratio = sprintf("%.2fx", rw * frac / w); rwcratio = sprintf("%.2fx", rw_cpu * frac / c) } }
-      printf "%-40s %-25s %7.2f %7.2f %7.1f %9.2f %7.1f %7s %7s %7s %7s\n", name, bn, w, c,
-             (w > 0 ? size * frac / w / 1e6 : 0), (w > 0 ? points[key] / w / 1e6 : 0), rss[key] / 1024, ratio, cratio, rwratio, rwcratio
+      printf "%-40s %-25s %7.2f %7.2f %7.1f %9.2f %7.1f %7s %7s %7s %7s %7.2f\n", name, bn, w, c,
+             (w > 0 ? size * frac / w / 1e6 : 0), (w > 0 ? points[key] / w / 1e6 : 0), rss[key] / 1024, ratio, cratio, rwratio, rwcratio, steal[key]
     }
   }' "$RESULTS" | tee "$LOGS/table.txt"
 echo
