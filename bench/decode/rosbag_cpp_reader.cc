@@ -84,10 +84,12 @@ int main(int argc, char** argv) {
     return 2;
   }
   std::FILE* out = nullptr;
-  std::vector<char> out_buffer(1 << 20);
+  // Static: an early return leaves `out` open, and exit() flushes it after
+  // main's locals are gone.
+  static char out_buffer[1 << 20];
   if (!out_path.empty()) {
     out = std::fopen(out_path.c_str(), "wb");
-    if (out == nullptr || std::setvbuf(out, out_buffer.data(), _IOFBF, out_buffer.size()) != 0) {
+    if (out == nullptr || std::setvbuf(out, out_buffer, _IOFBF, sizeof(out_buffer)) != 0) {
       std::fprintf(stderr, "%s: cannot open for writing\n", out_path.c_str());
       return 1;
     }

@@ -322,6 +322,10 @@ echo "  and IMU samples it reads to one file through stdio, no checksum, no fsyn
 echo "  steal s = CPU time the host gave other guests during the row's runs, summed."
 echo "  Load average before the runs: $LOAD_BEFORE, after: $(cut -d' ' -f1-3 /proc/loadavg)"
 awk -v big="$BAG" '
+  # anchor / tool as "N.NNx" ("-" when either is missing or not on the big bag).
+  function ratio(anchor_s, tool_s) {
+    return (on_big && anchor_s > 0 && tool_s > 0) ? sprintf("%.2fx", anchor_s / tool_s) : "-"
+  }
   function median(list, n,   a, i, j, t) {
     n = split(list, a, " ")
     for (i = 1; i <= n; ++i) for (j = i + 1; j <= n; ++j) if (a[j] < a[i]) { t = a[i]; a[i] = a[j]; a[j] = t }
@@ -352,18 +356,18 @@ awk -v big="$BAG" '
       name = parts[1]
       if (failed[key]) name = name " (FAILED)"
       c = median(cpus[key])
-      ratio = (anchor > 0 && parts[2] == big && w > 0) ? sprintf("%.2fx", anchor / w) : "-"
-      cratio = (anchor_cpu > 0 && parts[2] == big && c > 0) ? sprintf("%.2fx", anchor_cpu / c) : "-"
-      rwratio = (rw > 0 && parts[2] == big && w > 0) ? sprintf("%.2fx", rw / w) : "-"
-      rwcratio = (rw_cpu > 0 && parts[2] == big && c > 0) ? sprintf("%.2fx", rw_cpu / c) : "-"
       bn = parts[2]; sub(".*/", "", bn)
       # A prefix run (python read_points with --python_max_bytes) reads only
-      # part of the bag: MB/s is scaled by the fraction of points it read.
+      # part of the bag: MB/s and the ratios are scaled by the fraction of
+      # points it read.
       cmd = "sed -n s/^points=//p " parts[2] ".meta"; cmd | getline total; close(cmd)
       frac = (total > 0) ? points[key] / total : 1
-      if (frac < 0.999) { name = name sprintf(" [%.0f%% prefix]", 100 * frac); if (ratio != "-") { ratio = sprintf("%.2fx", anchor * frac / w); cratio = sprintf("%.2fx", anchor_cpu * frac / c) } if (rwratio != "-") { rwratio = sprintf("%.2fx", rw * frac / w); rwcratio = sprintf("%.2fx", rw_cpu * frac / c) } }
+      if (frac < 0.999) name = name sprintf(" [%.0f%% prefix]", 100 * frac)
+      on_big = (parts[2] == big)
       printf "%-40s %-25s %7.2f %7.2f %7.1f %9.2f %7.1f %7s %7s %7s %7s %7.2f\n", name, bn, w, c,
-             (w > 0 ? size * frac / w / 1e6 : 0), (w > 0 ? points[key] / w / 1e6 : 0), rss[key] / 1024, ratio, cratio, rwratio, rwcratio, steal[key]
+             (w > 0 ? size * frac / w / 1e6 : 0), (w > 0 ? points[key] / w / 1e6 : 0), rss[key] / 1024,
+             ratio(anchor * frac, w), ratio(anchor_cpu * frac, c), ratio(rw * frac, w),
+             ratio(rw_cpu * frac, c), steal[key]
     }
   }' "$RESULTS" | tee "$LOGS/table.txt"
 echo
