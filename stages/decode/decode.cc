@@ -7,6 +7,7 @@
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <set>
 #include <vector>
 
 #include <fmt/format.h>
@@ -15,6 +16,7 @@
 #include "common/checked_conversion.h"
 #include "common/cli/command_line.h"
 #include "common/io/atomic_file.h"
+#include "common/io/directory_lock.h"
 #include "common/io/provenance.h"
 #include "common/io/record_stream.h"
 #include "common/io/rig.h"
@@ -307,6 +309,16 @@ Status Decode(const DecodePaths& paths, const proto::DecodeParams& params, std::
   const Clock::time_point t0 = Clock::now();
   DecodeSummary s;
   TILTCAL_RETURN_IF_ERROR(CheckPaths(paths));
+  // One run at a time writes into the outputs' folders (two decodes of the
+  // same outputs would race on the commit manifests); folders locked in
+  // name order, so that two runs never wait for each other.
+  std::set<std::string> out_dirs = {OutputDirectory(paths.out_imu),
+                                    OutputDirectory(paths.out_scans)};
+  DirectoryLock locks[2];
+  int locked = 0;
+  for (const std::string& dir : out_dirs) {
+    TILTCAL_RETURN_IF_ERROR(locks[locked++].Acquire(dir, "tiltcal_decode", log));
+  }
   // A run killed while committing its pair: finish that commit first.
   TILTCAL_RETURN_IF_ERROR(CompleteInterruptedCommit(paths.out_imu));
   TILTCAL_RETURN_IF_ERROR(CompleteInterruptedCommit(paths.out_scans));
@@ -355,6 +367,7 @@ Status Decode(const DecodePaths& paths, const proto::DecodeParams& params, std::
   imu.SortAndDropRepeatedStamps(&s);
   TILTCAL_RETURN_IF_ERROR(imu.CheckStampGaps(params.max_stamp_gap_s()));
   TILTCAL_RETURN_IF_ERROR(CheckStampsAndUnits(paths, params, rig, imu, scans, &s));
+  TILTCAL_RETURN_IF_ERROR(imu.CheckPhysicalRange(params.imu_range(), s.accel_to_si, s.gyro_to_si));
   proto::Provenance imu_provenance = provenance;
   for (const std::string& note : s.imu_notes) imu_provenance.add_notes(note);
   RecordWriter imu_writer;

@@ -170,6 +170,29 @@ Status ImuSink::CheckStampGaps(double max_gap_s) const {
   return Status::Ok();
 }
 
+Status ImuSink::CheckPhysicalRange(const proto::ImuRangeParams& range, double accel_to_si,
+                                   double gyro_to_si) const {
+  for (size_t i = 0; i < samples_.size(); ++i) {
+    const Record& r = samples_[i];
+    const double accel_mps2 =
+        Eigen::Map<const Eigen::Vector3d>(r.linear_acceleration).norm() * accel_to_si;
+    const double gyro_radps =
+        Eigen::Map<const Eigen::Vector3d>(r.angular_velocity).norm() * gyro_to_si;
+    const bool accel_out = !(accel_mps2 <= range.max_linear_acceleration_mps2());
+    if (accel_out || !(gyro_radps <= range.max_angular_velocity_radps())) {
+      return Status::Error(fmt::format(
+          "{}: IMU sample {} in stamp order (stamp {} s, record time {} s) reads {} {:.6g} {}, "
+          "beyond any vehicle IMU's range (imu_range.{} = {}): a corrupt record",
+          bag_, i, FormatSeconds(r.stamp_ns), FormatSeconds(r.record_ns),
+          accel_out ? "|linear acceleration|" : "|angular velocity|",
+          accel_out ? accel_mps2 : gyro_radps, accel_out ? "m/s²" : "rad/s",
+          accel_out ? "max_linear_acceleration_mps2" : "max_angular_velocity_radps",
+          accel_out ? range.max_linear_acceleration_mps2() : range.max_angular_velocity_radps()));
+    }
+  }
+  return Status::Ok();
+}
+
 Status ImuSink::Write(const std::string& path, const proto::Provenance& provenance,
                       double accel_to_si, double gyro_to_si, RecordWriter* writer,
                       DecodeSummary* s) {

@@ -53,6 +53,13 @@ class ImuSink {
   // consecutive stamps are more than max_gap_s apart.
   Status CheckStampGaps(double max_gap_s) const;
 
+  // After SortAndDropRepeatedStamps, with the units resolved: an error naming
+  // the first sample whose |specific force| * accel_to_si or |angular
+  // velocity| * gyro_to_si exceeds the range (a corrupt record: no IMU on a
+  // vehicle reports it).
+  Status CheckPhysicalRange(const proto::ImuRangeParams& range, double accel_to_si,
+                            double gyro_to_si) const;
+
   // After SortAndDropRepeatedStamps: writes the stream with the specific
   // force multiplied by accel_to_si and the angular velocity by gyro_to_si
   // through *writer, finished under its temporary name (not committed).

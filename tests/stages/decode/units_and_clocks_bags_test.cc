@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -246,6 +247,39 @@ TEST_F(UnitsAndClocks, AccelerometerFittingNeitherUnitIsAnError) {
       << status.message();
   EXPECT_NE(status.message().find("imu_units.accel_norm_ratio_min/max"), std::string::npos);
   ExpectNoOutput(out);
+}
+
+// A sample no vehicle IMU can report (1e300 m/s², or 1000 rad/s) is the
+// corrupt record it is: an error naming the sample, no output. Before the
+// range check, 1e300 m/s² passed decode, ground and gravity and calibrate
+// blamed the rig rotation.
+TEST_F(UnitsAndClocks, ImuSampleBeyondAnyPhysicalRangeIsAnError) {
+  for (const auto& [accel_mps2, gyro_radps, quantity] :
+       {std::tuple{1e300, 0.0, "|linear acceleration| 1e+300 m/s²"},
+        std::tuple{-450.0, 0.0, "|linear acceleration| 450"},
+        std::tuple{0.0, 1000.0, "|angular velocity| 1000 rad/s"}}) {
+    testing::VehicleBagOptions corrupt;
+    corrupt.corrupt_imu_index = 700;
+    corrupt.corrupt_accel_mps2 = accel_mps2;
+    corrupt.corrupt_gyro_radps = gyro_radps;
+    const std::string bag = Bag("corrupt.bag", corrupt);
+    const std::string out = OutDir("out_corrupt");
+    DecodeSummary summary;
+    const Status status = Decode(bag, "", out, &summary);
+    ASSERT_FALSE(status.ok()) << quantity;
+    EXPECT_EQ(status.message().rfind(bag + ": IMU sample 700 in stamp order", 0), 0u)
+        << status.message();
+    EXPECT_NE(status.message().find(quantity), std::string::npos) << status.message();
+    EXPECT_NE(status.message().find("a corrupt record"), std::string::npos) << status.message();
+    ExpectNoOutput(out);
+  }
+  // The largest accepted readings decode.
+  testing::VehicleBagOptions hard;
+  hard.corrupt_imu_index = 700;
+  hard.corrupt_accel_mps2 = 390.0;
+  hard.corrupt_gyro_radps = 69.0;
+  DecodeSummary summary;
+  EXPECT_TRUE(Decode(Bag("hard.bag", hard), "", OutDir("out_hard"), &summary).ok());
 }
 
 // Specific force pointing down at rest, against the rig's g_f: an error.

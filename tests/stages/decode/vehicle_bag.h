@@ -36,6 +36,12 @@ struct VehicleBagOptions {
   // (a driver that never sets them).
   int far_future_imu_index = -1;
   bool zero_stamps = false;
+  // IMU message `corrupt_imu_index` (>= 0) publishes corrupt_accel_mps2 as
+  // its x specific force and corrupt_gyro_radps as its x angular velocity
+  // (before the scales), e.g. 1e300: a record no IMU can produce.
+  int corrupt_imu_index = -1;
+  double corrupt_accel_mps2 = 0.0;
+  double corrupt_gyro_radps = 0.0;
 };
 
 inline constexpr int64_t kVehicleBagStartNs = 1700000000000000000LL;
@@ -76,9 +82,14 @@ inline bool WriteVehicleBag(const std::string& path, const VehicleBagOptions& op
     Message m{stamp_ns + kVehicleBagImuLatencyNs, imu_connection, ""};
     int64_t published_ns = options.zero_stamps ? 0 : stamp_ns;
     if (static_cast<int>(i) == options.far_future_imu_index) published_ns = 4294967295LL * 1000000000;
+    imu::ImuReading reading = readings[i];
+    if (static_cast<int>(i) == options.corrupt_imu_index) {
+      reading.linear_acceleration_mps2.x() = options.corrupt_accel_mps2;
+      reading.angular_velocity_radps.x() = options.corrupt_gyro_radps;
+    }
     if (!ros1::SerializeImu(static_cast<uint32_t>(i), published_ns, "imu_link",
-                            readings[i].angular_velocity_radps * options.gyro_scale,
-                            readings[i].linear_acceleration_mps2 * options.accel_scale, 1e-6,
+                            reading.angular_velocity_radps * options.gyro_scale,
+                            reading.linear_acceleration_mps2 * options.accel_scale, 1e-6,
                             1e-4, &m.bytes)) {
       return false;
     }
