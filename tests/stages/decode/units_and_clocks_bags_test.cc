@@ -2,9 +2,11 @@
 // and whose LiDAR stamps on another clock (tests/stages/decode/vehicle_bag.h):
 // imu.binpb is always SI, every decision is said, every contradiction is an
 // error that leaves no output.
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <string>
+#include <thread>
 #include <tuple>
 #include <vector>
 
@@ -280,6 +282,37 @@ TEST_F(UnitsAndClocks, ImuSampleBeyondAnyPhysicalRangeIsAnError) {
   hard.corrupt_gyro_radps = 69.0;
   DecodeSummary summary;
   EXPECT_TRUE(Decode(Bag("hard.bag", hard), "", OutDir("out_hard"), &summary).ok());
+}
+
+// Two decodes of one bag into the same outputs at once: the second waits for
+// the first's lock on the output folder, so both succeed and leave one
+// consistent pair and no commit manifest (without the lock, one failed on
+// the other's manifests after the outputs were in place).
+TEST_F(UnitsAndClocks, TwoDecodesOfTheSameOutputsAtOnceBothSucceed) {
+  const std::string bag = Bag("vehicle.bag", testing::VehicleBagOptions{});
+  const std::string out = OutDir("out_twice");
+  for (int trial = 0; trial < 5; ++trial) {
+    Status statuses[2];
+    DecodeSummary summaries[2];
+    std::thread other([&] { statuses[1] = Decode(bag, "", out, &summaries[1]); });
+    statuses[0] = Decode(bag, "", out, &summaries[0]);
+    other.join();
+    for (const Status& status : statuses) EXPECT_TRUE(status.ok()) << status.message();
+    EXPECT_EQ(summaries[0].imu_written, summaries[1].imu_written);
+    std::vector<std::string> files;
+    for (const auto& entry : std::filesystem::directory_iterator(out)) {
+      files.push_back(entry.path().filename().string());
+    }
+    std::sort(files.begin(), files.end());
+    EXPECT_EQ(files, (std::vector<std::string>{"imu.binpb", "scans.binpb.lz4"})) << trial;
+    RecordReader reader;
+    ASSERT_TRUE(reader.Open(out + "/imu.binpb").ok());
+    proto::ImuSample sample;
+    int64_t samples = 0;
+    bool end = false;
+    while (reader.Read(&sample, &end).ok() && !end) ++samples;
+    EXPECT_EQ(samples, summaries[0].imu_written);
+  }
 }
 
 // Specific force pointing down at rest, against the rig's g_f: an error.
