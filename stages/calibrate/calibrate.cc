@@ -150,6 +150,10 @@ Status Initialise(const CalibrateInputs& inputs, const proto::CalibrateParams& p
                        init->hand_eye.excitation_rad, init->hand_eye.num_pairs,
                        init->position_fit_rms, Seconds(start),
                        init->rotation_from_hand_eye ? "hand-eye" : "the rig"));
+  Log(log, fmt::format("init: turning {:.3f} rad RMS per pair about the motion's axis over {:.1f} s, "
+                       "{:.2f} rad one way, {:.2f} rad the other",
+                       init->turning.rms_about_axis_rad, init->turning.span_s,
+                       init->turning.left_rad, init->turning.right_rad));
   if (init->odometry_quality_scans > 0) {
     Log(log, fmt::format("init: odometry registration quality over {} scans: inlier rms {:.1f} mm, "
                          "inliers {:.1f} %",

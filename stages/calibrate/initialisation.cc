@@ -428,19 +428,28 @@ OdometryRun RunOdometry(const std::vector<LidarScan>& scans, const CalibrationSt
 // the LiDAR's rotation axis within max_axis_alignment_deg of the IMU's, or
 // hand-eye replaces it; otherwise (planar motion: the rotation about the
 // axis is not determined) it is an error with the angle.
-Status InitialExtrinsicRotation(const OdometryRun& run,
+Status InitialExtrinsicRotation(const OdometryRun& run, const std::vector<LidarScan>& scans,
                                 const Eigen::Quaterniond& measured_imu_from_lidar,
                                 const proto::CalibrateParams& params,
                                 InitialisationReport* report, Eigen::Quaterniond* c_bl) {
   const int pair_step = std::max(1, static_cast<int>(params.hand_eye().pair_step()));
   const std::vector<RotationPair> pairs =
       MakeRotationPairs(run.imu_used, run.lidar_used, pair_step);
+  std::vector<std::pair<double, double>> pair_times_s;
+  for (size_t k = 0; k + pair_step < run.used.size(); k += pair_step) {
+    pair_times_s.emplace_back(scans[run.scan_of_pose[run.used[k]]].stamp_s,
+                              scans[run.scan_of_pose[run.used[k + pair_step]]].stamp_s);
+  }
+  report->turning = MeasureTurning(pairs, pair_times_s);
   report->hand_eye = EstimateHandEyeRotation(pairs, params.hand_eye());
   Eigen::Quaterniond c_bl_init = ChooseInitialRotation(measured_imu_from_lidar, report->hand_eye);
   report->rotation_from_hand_eye = report->hand_eye.excited;
   report->rig_axis_disagreement_deg = RotationAxisDisagreementDeg(pairs, measured_imu_from_lidar);
   const double max_deg = params.init().max_axis_alignment_deg();
   if (!report->rotation_from_hand_eye && report->rig_axis_disagreement_deg > max_deg) {
+    // Before blaming the rig: can the motion tell at all?
+    const std::string missing = MissingTurning(report->turning, params.init());
+    if (!missing.empty()) return Status::Error(missing);
     return Status::Error(fmt::format(
         "the rig's imu_from_lidar rotation maps the LiDAR's rotation axis {:.1f} deg away from "
         "the IMU's (180: one of them is upside down; at most init.max_axis_alignment_deg = {} "
@@ -561,6 +570,9 @@ Status CheckRigYaw(const OdometryRun& run, const std::vector<LidarScan>& scans,
   const AccelerationCheck& check = report->acceleration_check;
   const double max_deg = params.init().max_rig_rotation_error_deg();
   if (!check.decided || std::abs(check.yaw_error_deg) <= max_deg) return Status::Ok();
+  // Before blaming the rig: without turning, the motion's axis is noise.
+  const std::string missing = MissingTurning(report->turning, params.init());
+  if (!missing.empty()) return Status::Error(missing);
   return Status::Error(fmt::format(
       "the LiDAR's accelerations mapped into the IMU frame by the {} C_bl are turned by {:.1f} "
       "deg about the motion's rotation axis ({:.3f}, {:.3f}, {:.3f}) against the "
@@ -679,7 +691,8 @@ Status InitialiseState(const std::vector<imu::ImuReading>& imu_samples,
   // 4. Extrinsic rotation.
   Eigen::Quaterniond c_bl_init;
   TILTCAL_RETURN_IF_ERROR(
-      InitialExtrinsicRotation(run, measured_imu_from_lidar.rotation, params, report, &c_bl_init));
+      InitialExtrinsicRotation(run, scans, measured_imu_from_lidar.rotation, params, report,
+                               &c_bl_init));
   state->SetImuFromLidarRotation(c_bl_init);
 
   // 4b. Tau from consecutive odometry rotations against the gyro spline,

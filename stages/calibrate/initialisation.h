@@ -103,6 +103,8 @@ struct InitialisationReport {
   double rig_axis_disagreement_deg = 0.0;
   double rig_rotation_correction_deg = 0.0;
   AccelerationCheck acceleration_check;
+  // How much the motion turned (the hand-eye rotation pairs).
+  TurningAmount turning;
   // Principal rotation axis of the (bias-corrected) gyro, frame b, and the
   // share of sum omega omega^T along it (covariance_report.h).
   Eigen::Vector3d rotation_axis_b = Eigen::Vector3d::UnitZ();

@@ -5,6 +5,8 @@
 
 #include <Eigen/Eigenvalues>
 
+#include <fmt/format.h>
+
 #include "common/spline/so3_spline.h"
 
 namespace tiltcal::calibrate {
@@ -91,6 +93,35 @@ double RotationAxisDisagreementDeg(const std::vector<RotationPair>& pairs,
   if (!MatchedPrincipalAxes(pairs, &a_b, &a_l)) return 0.0;
   const double c = std::clamp((imu_from_lidar * a_l).normalized().dot(a_b.normalized()), -1.0, 1.0);
   return std::acos(c) * kDegPerRad;
+}
+
+TurningAmount MeasureTurning(const std::vector<RotationPair>& pairs,
+                             const std::vector<std::pair<double, double>>& pair_times_s) {
+  TurningAmount turning;
+  turning.pairs = static_cast<int>(pairs.size());
+  if (!pair_times_s.empty()) turning.span_s = pair_times_s.back().second - pair_times_s.front().first;
+  Eigen::Vector3d a_b, a_l;
+  if (!MatchedPrincipalAxes(pairs, &a_b, &a_l)) return turning;
+  double sum_sq = 0.0;
+  for (const RotationPair& p : pairs) {
+    const Eigen::AngleAxisd ab(p.imu_delta);
+    const double s = ab.angle() * ab.axis().dot(a_b);
+    sum_sq += s * s;
+    (s > 0.0 ? turning.left_rad : turning.right_rad) += std::abs(s);
+  }
+  turning.rms_about_axis_rad = std::sqrt(sum_sq / static_cast<double>(pairs.size()));
+  return turning;
+}
+
+std::string MissingTurning(const TurningAmount& turning, const proto::InitParams& params) {
+  if (turning.rms_about_axis_rad >= params.min_axis_rotation_rad()) return "";
+  return fmt::format(
+      "the motion cannot decide the extrinsic rotation: too little turning, {:.4f} rad RMS about "
+      "the motion's main axis per rotation pair (at least init.min_axis_rotation_rad = {} rad), "
+      "{} pairs over {:.1f} s of registered motion, {:.2f} rad turned one way and {:.2f} rad the "
+      "other: record 30 s or more of driving with turns both ways",
+      turning.rms_about_axis_rad, params.min_axis_rotation_rad(), turning.pairs, turning.span_s,
+      turning.left_rad, turning.right_rad);
 }
 
 AccelerationCheck CheckRigYawByAccelerations(const CalibrationState& state,

@@ -13,6 +13,8 @@
 //    and sideways (in turns); a yaw error of C_bl turns the one into the
 //    other (90 deg swaps them).
 
+#include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -36,6 +38,27 @@ bool MatchedPrincipalAxes(const std::vector<RotationPair>& pairs, Eigen::Vector3
 // 0 without rotation.
 double RotationAxisDisagreementDeg(const std::vector<RotationPair>& pairs,
                                    const Eigen::Quaterniond& imu_from_lidar);
+
+// How much the vehicle turned, from the IMU's relative rotations of the
+// rotation pairs (consecutive, non-overlapping): s_k = phi_k . a_b with
+// phi_k = Log(C_{b_i b_j}) and a_b the principal axis (MatchedPrincipalAxes).
+struct TurningAmount {
+  int pairs = 0;
+  double span_s = 0.0;             // LiDAR time from the first pair's start to the last's end
+  double rms_about_axis_rad = 0.0;  // sqrt(mean s_k^2)
+  double left_rad = 0.0;            // sum of max(s_k, 0): turning one way about a_b
+  double right_rad = 0.0;           // sum of max(-s_k, 0): the other way
+};
+
+// The turning of `pairs`; span_s from `pair_times_s` (start and end LiDAR
+// time of each pair, same order; empty: 0).
+TurningAmount MeasureTurning(const std::vector<RotationPair>& pairs,
+                             const std::vector<std::pair<double, double>>& pair_times_s);
+
+// Empty when the turning decides the motion's rotation axis (rms_about_axis_rad
+// at least params.min_axis_rotation_rad); else the line that says what the
+// motion lacks, with the measured and the needed amounts and what to record.
+std::string MissingTurning(const TurningAmount& turning, const proto::InitParams& params);
 
 struct AccelerationCheck {
   bool decided = false;  // enough horizontal acceleration to tell

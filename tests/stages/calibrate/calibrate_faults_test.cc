@@ -70,6 +70,35 @@ TEST_F(CalibrateFaultsTest, UndeclaredUpsideDownImuIsRefusedWithTheAxisAngle) {
   EXPECT_GT(angle, 170.0) << m;
 }
 
+// The first 5 s (1.5 s still, then driving off nearly straight) with the
+// rig's right rotation: the motion, not the rig, is what is missing, and the
+// error says so with the measured turning (before, it blamed the rig's
+// rotation for an axis disagreement that was noise).
+TEST_F(CalibrateFaultsTest, ShortRecordingWithARightRigIsRefusedForItsMotion) {
+  constexpr double kKeepS = 5.0;
+  std::vector<imu::ImuReading> imu;
+  for (const imu::ImuReading& r : inputs_.imu) {
+    if (r.time_s <= kKeepS) imu.push_back(r);
+  }
+  inputs_.imu = imu;
+  std::vector<LidarScan> scans;
+  for (const LidarScan& scan : inputs_.scans) {
+    if (scan.stamp_s <= kKeepS - 0.2) scans.push_back(scan);
+  }
+  inputs_.scans = scans;
+  proto::CalibrationResult result;
+  std::string log;
+  const Status status = Run(&result, &log);
+  ASSERT_FALSE(status.ok()) << log;
+  std::printf("%s\n", status.message().c_str());
+  const std::string& m = status.message();
+  EXPECT_NE(m.find("the motion cannot decide the extrinsic rotation: too little turning"),
+            std::string::npos) << m;
+  EXPECT_NE(m.find("init.min_axis_rotation_rad"), std::string::npos) << m;
+  EXPECT_NE(m.find("record 30 s or more of driving with turns both ways"), std::string::npos) << m;
+  EXPECT_EQ(m.find("rig"), std::string::npos) << "the error blames the rig: " << m;
+}
+
 // Through the executable: exit code 1, one error line, no output left.
 TEST_F(CalibrateFaultsTest, WrongRigRotationExitsWithOneAndLeavesNoOutput) {
   proto::Rig rig = inputs_.rig;
