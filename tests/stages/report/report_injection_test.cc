@@ -99,6 +99,12 @@ class ReportInjectionTest : public ::testing::Test {
     ASSERT_TRUE(ReadFileToString(paths_.out_html, &html_).ok());
   }
 
+  std::string ReadLog() const {
+    std::string log;
+    EXPECT_TRUE(ReadFileToString(dir_.File("chromium.log"), &log).ok());
+    return log;
+  }
+
   testing::TempDir dir_;
   std::vector<std::string> names_;
   ReportPaths paths_;
@@ -183,7 +189,8 @@ TEST_F(ReportInjectionTest, ChromiumShowsThePayloadsAsText) {
   std::string dom;
   ASSERT_EQ(testing::RunCommand("chromium --headless --no-sandbox --disable-gpu --no-first-run "
                                 "--user-data-dir=" + dir_.File("profile") +
-                                    " --virtual-time-budget=3000 --dump-dom file://" + page +
+                                    " --enable-logging=stderr --v=0 --virtual-time-budget=3000 "
+                                    "--dump-dom file://" + page +
                                     " 2> " + dir_.File("chromium.log"),
                                 &dom),
             0)
@@ -192,7 +199,7 @@ TEST_F(ReportInjectionTest, ChromiumShowsThePayloadsAsText) {
                              "data-scripts=\"2\" data-anchors=\"4\" data-scriptlinks=\"0\" "
                              "data-nonfilelinks=\"0\" data-linkedfiles=\"4\" data-alerts=\"0\" "
                              "data-done=\"1\""))
-      << dom.substr(dom.find("<body"), 600);
+      << dom.substr(dom.find("<body"), 600) << ReadLog();
   // Shown as text where they belong.
   EXPECT_THAT(dom, HasSubstr("<li>\"&gt;&lt;img src=x onerror=alert(1)&gt;</li>"));
   EXPECT_THAT(dom, Not(HasSubstr("<img src")));
