@@ -52,6 +52,11 @@ Status MakeExportedCalibration(const proto::CalibrationResult& calibration,
   if (!calibration.has_imu_from_lidar()) {
     return Status::Error(source + ": no imu_from_lidar (not a calibration.txtpb?)");
   }
+  const auto& q = calibration.imu_from_lidar().rotation();
+  if (!(std::isfinite(q.w()) && std::isfinite(q.x()) && std::isfinite(q.y()) &&
+        std::isfinite(q.z()))) {
+    return Status::Error(source + ": imu_from_lidar.rotation is not finite (NaN or infinite)");
+  }
   if (!HasValidRotation(calibration.imu_from_lidar())) {
     return Status::Error(source + ": imu_from_lidar.rotation is missing or of zero norm");
   }

@@ -36,8 +36,8 @@ struct ExportedCalibration {
   std::string lidar_frame;  // e.g. "lidar_link"
 };
 
-// Checks that `calibration` holds a usable extrinsic (a unit-normable
-// quaternion, finite numbers) and gathers what the formats write. The error
+// Checks that `calibration` holds a usable extrinsic (a finite quaternion of
+// non-zero norm, finite numbers) and gathers what the formats write. The error
 // names `source` and the field at fault.
 Status MakeExportedCalibration(const proto::CalibrationResult& calibration,
                                const std::string& source, const std::string& imu_frame,

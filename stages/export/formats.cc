@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "common/geometry/euler_angles.h"
+#include "stages/export/escaping.h"
 
 namespace tiltcal::exporter {
 
@@ -56,12 +57,12 @@ Eigen::Matrix4d Homogeneous(const Rigid3d& transform) {
   return m;
 }
 
-std::string HeaderLines(const ExportedCalibration& c, const std::string& prefix) {
+std::string HeaderText(const ExportedCalibration& c) {
   std::string out;
-  auto line = [&](const std::string& text) { out += prefix + text + "\n"; };
+  auto line = [&](const std::string& text) { out += text + "\n"; };
   line("tiltcal LiDAR-IMU calibration from " + c.source);
   line("verdict: " + c.verdict);
-  for (const std::string& reason : c.verdict_reasons) line("  " + reason);
+  for (const std::string& reason : c.verdict_reasons) out += CommentLines(reason, "  ");
   line(fmt::format("time offset tau = {} s: t_imu = t_lidar + tau (a LiDAR stamp plus tau is",
                    Num(c.time_offset_s)));
   line("  the same instant on the IMU clock; tau > 0: the LiDAR clock is behind the IMU's)");

@@ -50,9 +50,11 @@ std::string Num(double value);
 // Roll, pitch, yaw (rad) of `rotation`: rotation = Rz(yaw) Ry(pitch) Rx(roll)
 // (fixed axes x, y, z; URDF's rpy and tf's setRPY).
 Eigen::Vector3d RollPitchYaw(const Eigen::Quaterniond& rotation);
-// The lines every commented format starts with, each prefixed by `prefix`
-// ("# " or "  "): source, verdict and reasons, τ's sign convention, σ.
-std::string HeaderLines(const ExportedCalibration& c, const std::string& prefix);
+// The text every commented format starts with, as lines ending in '\n'
+// (each format writes it with CommentLines or XmlComment, escaping.h):
+// source, verdict and reasons (each line of a reason indented), τ's sign
+// convention, σ.
+std::string HeaderText(const ExportedCalibration& c);
 // The 4x4 homogeneous matrix of a transform: [R t; 0 0 0 1].
 Eigen::Matrix4d Homogeneous(const Rigid3d& transform);
 

@@ -2,6 +2,7 @@
 // directions, and one JSON object with everything.
 #include <fmt/format.h>
 
+#include "stages/export/escaping.h"
 #include "stages/export/formats.h"
 
 namespace tiltcal::exporter {
@@ -13,33 +14,6 @@ std::string MatrixRows(const Eigen::Matrix4d& m) {
     out += fmt::format("{} {} {} {}\n", Num(m(r, 0)), Num(m(r, 1)), Num(m(r, 2)), Num(m(r, 3)));
   }
   return out;
-}
-
-std::string JsonString(const std::string& text) {
-  std::string out = "\"";
-  for (const char c : text) {
-    switch (c) {
-      case '"':
-        out += "\\\"";
-        break;
-      case '\\':
-        out += "\\\\";
-        break;
-      case '\n':
-        out += "\\n";
-        break;
-      case '\t':
-        out += "\\t";
-        break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          out += fmt::format("\\u{:04x}", static_cast<int>(c));
-        } else {
-          out += c;
-        }
-    }
-  }
-  return out + "\"";
 }
 
 std::string JsonVector(const Eigen::VectorXd& v) {
@@ -60,14 +34,14 @@ std::string JsonTransform(const Rigid3d& t, const std::string& meaning,
   return fmt::format(
       "{{\n{i}  \"meaning\": {},\n{i}  \"matrix\": [{}],\n{i}  \"quaternion_wxyz\": {},\n"
       "{i}  \"translation_m\": {},\n{i}  \"roll_pitch_yaw_rad\": {}\n{i}}}",
-      JsonString(meaning), rows, JsonVector(Eigen::Vector4d(q.w(), q.x(), q.y(), q.z())),
+      QuotedString(meaning), rows, JsonVector(Eigen::Vector4d(q.w(), q.x(), q.y(), q.z())),
       JsonVector(t.translation), JsonVector(RollPitchYaw(q)), fmt::arg("i", indent));
 }
 
 }  // namespace
 
 std::string WriteMatrix(const ExportedCalibration& c) {
-  std::string out = HeaderLines(c, "# ");
+  std::string out = CommentLines(HeaderText(c), "# ");
   const Eigen::Quaterniond& q = c.imu_from_lidar.rotation;
   const Eigen::Quaterniond& qi = c.lidar_from_imu.rotation;
   const Eigen::Vector3d& t = c.imu_from_lidar.translation;
@@ -90,15 +64,15 @@ std::string WriteMatrix(const ExportedCalibration& c) {
 std::string WriteJson(const ExportedCalibration& c) {
   std::string reasons = "[";
   for (size_t i = 0; i < c.verdict_reasons.size(); ++i) {
-    reasons += (i > 0 ? ", " : "") + JsonString(c.verdict_reasons[i]);
+    reasons += (i > 0 ? ", " : "") + QuotedString(c.verdict_reasons[i]);
   }
   reasons += "]";
   std::string out = "{\n";
-  out += fmt::format("  \"source\": {},\n", JsonString(c.source));
-  out += fmt::format("  \"verdict\": {},\n  \"verdict_reasons\": {},\n", JsonString(c.verdict),
+  out += fmt::format("  \"source\": {},\n", QuotedString(c.source));
+  out += fmt::format("  \"verdict\": {},\n  \"verdict_reasons\": {},\n", QuotedString(c.verdict),
                      reasons);
-  out += fmt::format("  \"imu_frame\": {},\n  \"lidar_frame\": {},\n", JsonString(c.imu_frame),
-                     JsonString(c.lidar_frame));
+  out += fmt::format("  \"imu_frame\": {},\n  \"lidar_frame\": {},\n", QuotedString(c.imu_frame),
+                     QuotedString(c.lidar_frame));
   out += "  \"imu_from_lidar\": " +
          JsonTransform(c.imu_from_lidar,
                        "x_imu = R x_lidar + t: the LiDAR's pose in the IMU frame (C_bl, r_b^{lb})",

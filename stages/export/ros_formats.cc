@@ -4,18 +4,11 @@
 // R = C_bl = Rz(yaw) Ry(pitch) Rx(roll) and t = r_b^{lb}.
 #include <fmt/format.h>
 
+#include "stages/export/escaping.h"
 #include "stages/export/formats.h"
 
 namespace tiltcal::exporter {
 namespace {
-
-// XML comments may not contain "--".
-std::string XmlCommentSafe(std::string text) {
-  for (size_t i = text.find("--"); i != std::string::npos; i = text.find("--", i)) {
-    text.replace(i, 2, "- -");
-  }
-  return text;
-}
 
 constexpr char kTfDirection[] =
     "# static_transform_publisher: parent (frame_id) = IMU frame, child = LiDAR frame;\n"
@@ -28,16 +21,16 @@ constexpr char kTfDirection[] =
 std::string WriteUrdf(const ExportedCalibration& c) {
   const Eigen::Vector3d t = c.imu_from_lidar.translation;
   const Eigen::Vector3d rpy = RollPitchYaw(c.imu_from_lidar.rotation);
-  std::string out = "<!--\n" + XmlCommentSafe(HeaderLines(c, "  "));
-  out +=
-      "  The LiDAR link's pose in the IMU link: x_imu = R(rpy) x_lidar + xyz, with\n"
-      "  R(rpy) = Rz(yaw) Ry(pitch) Rx(roll) (fixed axes, rad) = C_bl and xyz = r_b^{lb} (m).\n"
-      "  URDF has no time offset: tau (above) belongs in the driver's or the estimator's\n"
-      "  time settings.\n"
-      "-->\n";
-  out += fmt::format("<joint name=\"{}_to_{}\" type=\"fixed\">\n", c.imu_frame, c.lidar_frame);
-  out += fmt::format("  <parent link=\"{}\"/>\n", c.imu_frame);
-  out += fmt::format("  <child link=\"{}\"/>\n", c.lidar_frame);
+  std::string out = XmlComment(
+      HeaderText(c) +
+      "The LiDAR link's pose in the IMU link: x_imu = R(rpy) x_lidar + xyz, with\n"
+      "R(rpy) = Rz(yaw) Ry(pitch) Rx(roll) (fixed axes, rad) = C_bl and xyz = r_b^{lb} (m).\n"
+      "URDF has no time offset: tau (above) belongs in the driver's or the estimator's\n"
+      "time settings.");
+  out += fmt::format("<joint name=\"{}\" type=\"fixed\">\n",
+                     XmlAttribute(c.imu_frame + "_to_" + c.lidar_frame));
+  out += fmt::format("  <parent link=\"{}\"/>\n", XmlAttribute(c.imu_frame));
+  out += fmt::format("  <child link=\"{}\"/>\n", XmlAttribute(c.lidar_frame));
   out += fmt::format("  <origin xyz=\"{} {} {}\" rpy=\"{} {} {}\"/>\n", Num(t.x()), Num(t.y()),
                      Num(t.z()), Num(rpy.x()), Num(rpy.y()), Num(rpy.z()));
   out += "</joint>\n";
@@ -48,15 +41,15 @@ std::string WriteTfRos1(const ExportedCalibration& c) {
   const Eigen::Vector3d t = c.imu_from_lidar.translation;
   const Eigen::Vector3d rpy = RollPitchYaw(c.imu_from_lidar.rotation);
   const Eigen::Quaterniond& q = c.imu_from_lidar.rotation;
-  std::string out = HeaderLines(c, "# ") + kTfDirection;
+  std::string out = CommentLines(HeaderText(c), "# ") + kTfDirection;
   out += "# ROS 1 argument order: x y z yaw pitch roll frame_id child_frame_id\n";
   out += fmt::format("rosrun tf2_ros static_transform_publisher {} {} {} {} {} {} {} {}\n",
                      Num(t.x()), Num(t.y()), Num(t.z()), Num(rpy.z()), Num(rpy.y()),
-                     Num(rpy.x()), c.imu_frame, c.lidar_frame);
+                     Num(rpy.x()), ShellWord(c.imu_frame), ShellWord(c.lidar_frame));
   out += "# the same with the quaternion: x y z qx qy qz qw frame_id child_frame_id\n";
   out += fmt::format("# rosrun tf2_ros static_transform_publisher {} {} {} {} {} {} {} {} {}\n",
                      Num(t.x()), Num(t.y()), Num(t.z()), Num(q.x()), Num(q.y()), Num(q.z()),
-                     Num(q.w()), c.imu_frame, c.lidar_frame);
+                     Num(q.w()), ShellWord(c.imu_frame), ShellWord(c.lidar_frame));
   return out;
 }
 
@@ -64,18 +57,18 @@ std::string WriteTfRos2(const ExportedCalibration& c) {
   const Eigen::Vector3d t = c.imu_from_lidar.translation;
   const Eigen::Vector3d rpy = RollPitchYaw(c.imu_from_lidar.rotation);
   const Eigen::Quaterniond& q = c.imu_from_lidar.rotation;
-  std::string out = HeaderLines(c, "# ") + kTfDirection;
+  std::string out = CommentLines(HeaderText(c), "# ") + kTfDirection;
   out += fmt::format(
       "ros2 run tf2_ros static_transform_publisher --x {} --y {} --z {} --roll {} --pitch {} "
       "--yaw {} --frame-id {} --child-frame-id {}\n",
-      Num(t.x()), Num(t.y()), Num(t.z()), Num(rpy.x()), Num(rpy.y()), Num(rpy.z()), c.imu_frame,
-      c.lidar_frame);
+      Num(t.x()), Num(t.y()), Num(t.z()), Num(rpy.x()), Num(rpy.y()), Num(rpy.z()),
+      ShellWord(c.imu_frame), ShellWord(c.lidar_frame));
   out += "# the same with the quaternion:\n";
   out += fmt::format(
       "# ros2 run tf2_ros static_transform_publisher --x {} --y {} --z {} --qx {} --qy {} "
       "--qz {} --qw {} --frame-id {} --child-frame-id {}\n",
       Num(t.x()), Num(t.y()), Num(t.z()), Num(q.x()), Num(q.y()), Num(q.z()), Num(q.w()),
-      c.imu_frame, c.lidar_frame);
+      ShellWord(c.imu_frame), ShellWord(c.lidar_frame));
   return out;
 }
 

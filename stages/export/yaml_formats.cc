@@ -1,6 +1,7 @@
 // YAML for FAST-LIO, LIO-SAM and Kalibr-style consumers.
 #include <fmt/format.h>
 
+#include "stages/export/escaping.h"
 #include "stages/export/formats.h"
 
 namespace tiltcal::exporter {
@@ -36,7 +37,7 @@ std::string BlockMatrix4(const Eigen::Matrix4d& m, const std::string& indent) {
 }  // namespace
 
 std::string WriteFastLio(const ExportedCalibration& c) {
-  std::string out = HeaderLines(c, "# ");
+  std::string out = CommentLines(HeaderText(c), "# ");
   out +=
       "# FAST-LIO / FAST-LIVO: the LiDAR's pose in the IMU frame,\n"
       "#   p_imu = extrinsic_R * p_lidar + extrinsic_T\n"
@@ -55,7 +56,7 @@ std::string WriteFastLio(const ExportedCalibration& c) {
 }
 
 std::string WriteLioSam(const ExportedCalibration& c) {
-  std::string out = HeaderLines(c, "# ");
+  std::string out = CommentLines(HeaderText(c), "# ");
   out +=
       "# LIO-SAM: extrinsicRot and extrinsicRPY rotate IMU-frame vectors into the\n"
       "#   LiDAR frame, v_lidar = extrinsicRot * v_imu (C_lb = C_bl^T, row-major); LIO-SAM\n"
@@ -77,7 +78,7 @@ std::string WriteLioSam(const ExportedCalibration& c) {
 }
 
 std::string WriteKalibr(const ExportedCalibration& c) {
-  std::string out = HeaderLines(c, "# ");
+  std::string out = CommentLines(HeaderText(c), "# ");
   out +=
       "# Kalibr-style: T_a_b maps coordinates in frame b to frame a, x_a = T_a_b x_b\n"
       "#   (4x4 homogeneous, row by row, m): T_imu_lidar = [C_bl r_b^{lb}; 0 1], T_lidar_imu\n"
@@ -85,7 +86,8 @@ std::string WriteKalibr(const ExportedCalibration& c) {
       "# timeshift_lidar_imu: t_imu = t_lidar + timeshift (s), the convention of Kalibr's\n"
       "#   timeshift_cam_imu; it is tau.\n";
   out += "lidar0:\n";
-  out += fmt::format("  frame_id: {}\n  parent_frame_id: {}\n", c.lidar_frame, c.imu_frame);
+  out += fmt::format("  frame_id: {}\n  parent_frame_id: {}\n", QuotedString(c.lidar_frame),
+                     QuotedString(c.imu_frame));
   out += "  T_imu_lidar:\n" + BlockMatrix4(Homogeneous(c.imu_from_lidar), "  ");
   out += "  T_lidar_imu:\n" + BlockMatrix4(Homogeneous(c.lidar_from_imu), "  ");
   out += fmt::format("  timeshift_lidar_imu: {}\n", Num(c.time_offset_s));

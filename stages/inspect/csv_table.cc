@@ -2,6 +2,7 @@
 
 #include <charconv>
 
+#include "common/io/csv_field.h"
 #include "tiltcal/proto/scan.pb.h"
 
 namespace tiltcal::inspect {
@@ -49,16 +50,6 @@ std::string CsvTable::HeaderRow() const {
 
 namespace {
 
-std::string Quote(const std::string& text) {
-  if (text.find_first_of(",\"\n") == std::string::npos) return text;
-  std::string quoted = "\"";
-  for (char c : text) {
-    if (c == '"') quoted += '"';
-    quoted += c;
-  }
-  return quoted + "\"";
-}
-
 std::string FormatScalar(const Message& message, const FieldDescriptor* field) {
   const auto* r = message.GetReflection();
   if (field->has_presence() && !r->HasField(message, field)) return "";  // unknown
@@ -71,7 +62,7 @@ std::string FormatScalar(const Message& message, const FieldDescriptor* field) {
     case FieldDescriptor::CPPTYPE_DOUBLE: return FormatDouble(r->GetDouble(message, field));
     case FieldDescriptor::CPPTYPE_BOOL: return r->GetBool(message, field) ? "1" : "0";
     case FieldDescriptor::CPPTYPE_ENUM: return r->GetEnum(message, field)->name();
-    case FieldDescriptor::CPPTYPE_STRING: return Quote(r->GetString(message, field));
+    case FieldDescriptor::CPPTYPE_STRING: return CsvField(r->GetString(message, field));
     case FieldDescriptor::CPPTYPE_MESSAGE: break;
   }
   return "";

@@ -8,6 +8,7 @@
 #include "common/geometry/rotation_statistics.h"
 #include "common/geometry/so3.h"
 #include "common/io/atomic_file.h"
+#include "common/io/csv_field.h"
 #include "common/io/eigen_proto.h"
 #include "common/io/params.h"
 #include "common/io/rig.h"
@@ -236,8 +237,9 @@ std::string FormatCsv(const Repeatability& r) {
       "rotation_error_deg,error_x_cm,error_y_cm,error_z_cm,time_offset_error_ms,verdict\n";
   auto line = [&](const Row& row) {
     char buffer[512];
-    std::snprintf(buffer, sizeof(buffer), "%s,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g",
-                  row.label.c_str(), row.translation_cm.x(), row.translation_cm.y(),
+    out += CsvField(row.label);
+    std::snprintf(buffer, sizeof(buffer), ",%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g",
+                  row.translation_cm.x(), row.translation_cm.y(),
                   row.translation_cm.z(), row.euler123_deg.x(), row.euler123_deg.y(),
                   row.euler123_deg.z(), row.time_offset_ms);
     out += buffer;
@@ -250,7 +252,7 @@ std::string FormatCsv(const Repeatability& r) {
     } else {
       out += ",,,,,";
     }
-    out += "," + row.verdict + "\n";
+    out += "," + CsvField(row.verdict) + "\n";
   };
   for (const Row& row : r.sequences) line(row);
   line(r.mean);

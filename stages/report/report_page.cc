@@ -6,6 +6,8 @@
 
 #include "common/geometry/euler_angles.h"
 #include "common/io/eigen_proto.h"
+#include "stages/export/escaping.h"
+#include "stages/report/html_escape.h"
 #include "stages/report/residual_histogram_svg.h"
 #include "stages/report/residual_time_svg.h"
 
@@ -119,15 +121,13 @@ std::string SharpnessTable(const proto::CalibrationResult& c) {
 
 std::string FilesList(const SequencePage& s) {
   std::string out = "<ul class=\"files\">\n";
-  out += fmt::format("<li>calibration: <a href=\"{0}\">{0}</a></li>\n",
-                     EscapeHtml(s.calibration_link));
+  out += "<li>calibration: " + LinkOrText(s.calibration_link) + "</li>\n";
   for (const auto& [label, link] : {std::pair<const char*, const std::string&>{
                                         "map with the rig's extrinsic", s.map_rig_link},
                                     {"map with the estimate", s.map_calibrated_link}}) {
     out += link.empty() ? fmt::format("<li>{}: not written</li>\n", label)
-                        : fmt::format("<li>{0} (PCD, pcl_viewer or CloudCompare): <a "
-                                      "class=\"pcd\" href=\"{1}\">{1}</a></li>\n",
-                                      label, EscapeHtml(link));
+                        : fmt::format("<li>{} (PCD, pcl_viewer or CloudCompare): {}</li>\n",
+                                      label, LinkOrText(link, " class=\"pcd\""));
   }
   return out + "</ul>\n";
 }
@@ -188,7 +188,7 @@ std::string ExportsBlock(const std::vector<PageExport>& exports, const std::stri
       "<details class=\"exports\"{}>\n<summary>Exports for FAST-LIO, LIO-SAM, URDF, tf, Kalibr "
       "(<code>tiltcal_export --calibration={} --format=NAME</code>; README.md, Using the "
       "result)</summary>\n",
-      open ? " open" : "", EscapeHtml(calibration_link));
+      open ? " open" : "", EscapeHtml(exporter::ShellWord(calibration_link)));
   for (const PageExport& e : exports) {
     out += fmt::format("<h4>{0}</h4>\n<pre class=\"export\" data-format=\"{0}\">{1}</pre>\n",
                        EscapeHtml(e.format), EscapeHtml(e.text));
@@ -206,9 +206,9 @@ std::string DatasetSection(const DatasetPage& d) {
   std::string out = fmt::format(
       "<section class=\"dataset\" id=\"dataset\">\n<h2>Dataset calibration: <span "
       "class=\"verdict verdict-{0}\">{0}</span></h2>\n<p>One extrinsic from the sequences "
-      "(<a href=\"{1}\">{1}</a>, tiltcal_dataset_calibration): the value to use.</p>\n"
+      "({1}, tiltcal_dataset_calibration): the value to use.</p>\n"
       "<ul class=\"reasons\">\n",
-      verdict, EscapeHtml(d.calibration_link));
+      verdict, LinkOrText(d.calibration_link));
   for (const std::string& reason : c.verdict_reasons()) {
     out += "<li>" + EscapeHtml(reason) + "</li>\n";
   }
@@ -259,21 +259,6 @@ std::string SequenceSection(const SequencePage& s) {
 }
 
 }  // namespace
-
-std::string EscapeHtml(const std::string& text) {
-  std::string out;
-  out.reserve(text.size());
-  for (const char ch : text) {
-    switch (ch) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += ch;
-    }
-  }
-  return out;
-}
 
 std::string FormatHtml(const std::string& title, const Repeatability& repeatability,
                        const std::vector<SequencePage>& sequences, const DatasetPage* dataset) {

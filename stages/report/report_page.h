@@ -49,9 +49,6 @@ std::string FormatHtml(const std::string& title, const Repeatability& repeatabil
                        const std::vector<SequencePage>& sequences,
                        const DatasetPage* dataset = nullptr);
 
-// Text with & < > " escaped for HTML.
-std::string EscapeHtml(const std::string& text);
-
 }  // namespace tiltcal::report
 
 #endif  // TILTCAL_STAGES_REPORT_REPORT_PAGE_H_

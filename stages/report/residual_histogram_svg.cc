@@ -5,6 +5,8 @@
 
 #include <fmt/format.h>
 
+#include "stages/report/html_escape.h"
+
 namespace tiltcal::report {
 namespace {
 
@@ -21,7 +23,7 @@ std::string ResidualHistogramSvg(const proto::ResidualStatistics& s) {
   const double w = s.histogram_bin_width();
   if (bins == 0 || w <= 0 || s.count() <= 0) {
     return fmt::format("<p class=\"no-histogram\">{}: no histogram in the calibration file</p>",
-                       s.type());
+                       EscapeHtml(s.type()));
   }
   const double lo = s.histogram_min();
   const double hi = lo + bins * w;
@@ -35,7 +37,7 @@ std::string ResidualHistogramSvg(const proto::ResidualStatistics& s) {
       "<title>{0}: normalised residuals against N(0,1)</title>\n"
       "<text x=\"150\" y=\"14\" text-anchor=\"middle\" font-size=\"12\">{0}: N = {1}, "
       "RMS {2:.2f}, outside ±5: {3}</text>\n",
-      s.type(), s.count(), s.rms(), s.histogram_below() + s.histogram_above());
+      EscapeHtml(s.type()), s.count(), s.rms(), s.histogram_below() + s.histogram_above());
   for (int i = 0; i < bins; ++i) {
     const double density = s.histogram_counts(i) / (static_cast<double>(s.count()) * w);
     const double y = y_of(density);

@@ -6,6 +6,8 @@
 
 #include <fmt/format.h>
 
+#include "stages/report/html_escape.h"
+
 namespace tiltcal::report {
 namespace {
 
@@ -22,7 +24,7 @@ std::string ResidualTimeSvg(const proto::ResidualStatistics& s) {
       s.time_bin_median_size() != bins || s.time_bin_p95_size() != bins) {
     return fmt::format("<p class=\"no-time-series\">{}: no residuals over time in the "
                        "calibration file</p>",
-                       s.type());
+                       EscapeHtml(s.type()));
   }
   const double t0 = s.time_start_s();
   const double t1 = t0 + bins * w;
@@ -36,7 +38,7 @@ std::string ResidualTimeSvg(const proto::ResidualStatistics& s) {
       "<title>{0}: normalised residuals over time</title>\n"
       "<text x=\"270\" y=\"14\" text-anchor=\"middle\" font-size=\"12\">{0} over time "
       "({1} bins of {2:.2g} s)</text>\n",
-      s.type(), bins, w);
+      EscapeHtml(s.type()), bins, w);
   // Runs of non-empty bins: band (p95 forward, p05 back), median, RMS.
   std::vector<std::pair<int, int>> runs;
   for (int i = 0; i < bins; ++i) {

@@ -43,10 +43,20 @@ struct Cell {
   int cluster = -1;
 };
 
-// 21 bits per axis (cells within ±2^20 of the origin).
+// 21 bits per axis: cell indices in [-2^20, 2^20).
+constexpr int64_t kKeyOffset = int64_t{1} << 20;
 int64_t Key(const Eigen::Vector3i& i) {
-  constexpr int64_t kOffset = 1 << 20;
-  return ((i.x() + kOffset) << 42) | ((i.y() + kOffset) << 21) | (i.z() + kOffset);
+  return ((i.x() + kKeyOffset) << 42) | ((i.y() + kKeyOffset) << 21) | (i.z() + kKeyOffset);
+}
+
+// The cell of `p`, or nullopt when p is not finite or its cell or a
+// neighbour of it would be outside the keys' range (|index| < 2^20 - 1;
+// with 1 m cells, beyond about 1000 km from the origin of frame a).
+std::optional<Eigen::Vector3i> CellOf(const Eigen::Vector3d& p, double cell_m) {
+  const Eigen::Array3d index = (p / cell_m).array().floor();
+  constexpr double kLimit = static_cast<double>(kKeyOffset - 1);
+  if (!index.allFinite() || (index.abs() >= kLimit).any()) return std::nullopt;
+  return index.cast<int>().matrix();
 }
 
 }  // namespace
@@ -58,8 +68,9 @@ std::optional<WallSlab> FindWall(const std::vector<Eigen::Vector3f>& points,
   std::vector<Cell> cells;
   for (const Eigen::Vector3f& q : points) {
     const Eigen::Vector3d p = q.cast<double>();
-    if (!p.allFinite()) continue;
-    const Eigen::Vector3i i = (p / params.cell_m()).array().floor().cast<int>();
+    const std::optional<Eigen::Vector3i> cell_index = CellOf(p, params.cell_m());
+    if (!cell_index) continue;  // not finite, or beyond the cell grid
+    const Eigen::Vector3i& i = *cell_index;
     const auto [it, inserted] = index_of.emplace(Key(i), cells.size());
     if (inserted) {
       Cell cell;

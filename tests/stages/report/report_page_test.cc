@@ -130,7 +130,7 @@ TEST(ReportPage, SectionsShowVerdictExtrinsicSharpnessAndEscapedReasons) {
   EXPECT_EQ(Count(html, "<svg class=\"histogram\""), 4u);
   EXPECT_EQ(Count(html, "<svg class=\"time-series\""), 4u);
   EXPECT_THAT(html, HasSubstr("Wall snapshots: maps not written"));
-  EXPECT_THAT(html, HasSubstr("<a class=\"pcd\" href=\"run1/map_rig.pcd\">"));
+  EXPECT_THAT(html, HasSubstr("<a href=\"./run1/map_rig.pcd\" class=\"pcd\">"));
   EXPECT_THAT(html, HasSubstr("map with the estimate: not written"));
   // Self-contained: nothing fetched, nothing run.
   EXPECT_THAT(html, Not(HasSubstr("<script")));
@@ -195,9 +195,9 @@ TEST_F(ReportRunTest, PageHasEverySequenceAndRelativeLinks) {
   EXPECT_THAT(html_, HasSubstr("id=\"sequence-run2\">\n<h2>run2: <span class=\"verdict "
                                "verdict-SUSPECT\">SUSPECT</span> (set aside)</h2>"));
   EXPECT_THAT(html_, HasSubstr("SUSPECT, set aside (not in the rows above): "));
-  EXPECT_THAT(html_, HasSubstr("href=\"run1/map_rig.pcd\""));
-  EXPECT_THAT(html_, HasSubstr("href=\"run1/map_calibrated.pcd\""));
-  EXPECT_THAT(html_, HasSubstr("href=\"run2/calibration.suspect.txtpb\""));
+  EXPECT_THAT(html_, HasSubstr("href=\"./run1/map_rig.pcd\""));
+  EXPECT_THAT(html_, HasSubstr("href=\"./run1/map_calibrated.pcd\""));
+  EXPECT_THAT(html_, HasSubstr("href=\"./run2/calibration.suspect.txtpb\""));
   // The dataset's section first, with its exports open; run1's exports
   // collapsed; run2 (SUSPECT) not exported.
   EXPECT_THAT(html_, HasSubstr("<section class=\"dataset\" id=\"dataset\">"));
@@ -214,7 +214,7 @@ TEST_F(ReportRunTest, PageHasEverySequenceAndRelativeLinks) {
   EXPECT_EQ(Count(html_, "<img class=\"snapshot "), 4u);
   EXPECT_EQ(Count(html_, "src="), Count(html_, "src=\"data:image/png;base64,"));
   EXPECT_THAT(html_, HasSubstr("width=\"600\" height=\"150\""));  // 4 m x 1 m at 150 px/m
-  EXPECT_THAT(html_, HasSubstr("rig's extrinsic (before): this wall's spread "));
+  EXPECT_THAT(html_, HasSubstr("rig&#39;s extrinsic (before): this wall&#39;s spread "));
 }
 
 // A map that cannot be read, or params out of their bounds: one error

@@ -53,6 +53,30 @@ TEST(WallSnapshot, FindsTheLargestVerticalPlaneNotTheGround) {
   EXPECT_EQ(slab->cells, 30);  // 10 along y x 3 up
 }
 
+// Points beyond the cell grid (|x| / cell_m above 2^20, e.g. a map point
+// at 1e30 m) or not finite are left out: the wall found is the one of the
+// scene without them (the wall is moved to the cells at x = 0, where an
+// out-of-range cell index converted to int would have landed).
+TEST(WallSnapshot, PointsBeyondTheGridAreLeftOut) {
+  auto points = SyntheticWallScene({-0.009, -0.003, 0.003, 0.009});
+  for (Eigen::Vector3f& p : points) p.x() -= 5.0f;
+  const auto plain = FindWall(points, Eigen::Vector3d::UnitZ(), Params());
+  ASSERT_TRUE(plain.has_value());
+  ASSERT_NEAR(plain->center.x(), 0.5, 1e-6);
+  for (const float far : {1e30f, -1e30f, 3e6f, -3e6f, INFINITY, NAN}) {
+    points.emplace_back(far, 0.5f, 1.5f);
+    points.emplace_back(0.5f, far, 1.5f);
+    points.emplace_back(0.5f, 0.5f, far);
+    points.emplace_back(far, far, far);
+  }
+  const auto slab = FindWall(points, Eigen::Vector3d::UnitZ(), Params());
+  ASSERT_TRUE(slab.has_value());
+  EXPECT_EQ(slab->points, plain->points);
+  EXPECT_EQ(slab->cells, plain->cells);
+  EXPECT_EQ(slab->center, plain->center);
+  EXPECT_EQ(slab->across, plain->across);
+}
+
 // A 1.8 cm thick wall at 100 px/m fills the two rows of pixels around the
 // slab's centre line (rows 29 and 30 of 60) in the top view and the two
 // columns 29 and 30 of the side view; the same wall doubled 10 cm behind
