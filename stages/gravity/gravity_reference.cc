@@ -62,9 +62,9 @@ std::string ReasonNotUsable(const proto::CalibrationResult& c,
 
 // Unit vectors u_i within theta of one direction m have |sum u_i| >= n cos
 // theta (each u_i . m >= cos theta). So a mean resultant length |sum u_i| / n
-// below cos(max_angle_from_combined_deg) means no direction, the mean
-// included, lies within that angle of every used g_a (opposite g_a have no
-// mean at all): an error with the two g_a furthest apart.
+// below cos(max_angle_from_combined_deg) means no direction lies within that
+// angle of every used g_a, also when their mean direction does not exist
+// (opposite g_a): an error with the two g_a furthest apart.
 Status CheckCommonDirection(const std::vector<FlatCalibration>& calibrations,
                             const proto::GravityReference& out,
                             const proto::FlatCalibrationsParams& params) {
@@ -143,7 +143,6 @@ Status CombineFlatCalibrations(const std::vector<FlatCalibration>& calibrations,
     return Status::Error(fmt::format(
         "no flat-ground calibration gives g_f ({} read{})", calibrations.size(), reasons));
   }
-  TILTCAL_RETURN_IF_ERROR(CheckCommonDirection(calibrations, *out, params));
   const Eigen::Vector3d g_f = norm_sum / used * direction_sum.normalized();
   double max_angle_deg = 0.0;
   std::string far;
@@ -164,6 +163,9 @@ Status CombineFlatCalibrations(const std::vector<FlatCalibration>& calibrations,
         "IMU move on the vehicle, or did a run not start on level ground?)",
         params.max_angle_from_combined_deg(), FormatVector(g_f), far));
   }
+  // Every used g_a within the angle of g_f passes this; it fails when g_f
+  // does not exist (a zero sum of directions measures every angle as 0).
+  TILTCAL_RETURN_IF_ERROR(CheckCommonDirection(calibrations, *out, params));
   *out->mutable_gravity_flat_in_imu() = ToProto(g_f);
   out->set_has_gravity_flat(true);
   out->set_gravity_flat_source(fmt::format("flat calibrations ({} of {})", used,
