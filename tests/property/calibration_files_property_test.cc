@@ -18,7 +18,9 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <iostream>
 #include <limits>
+#include <map>
 #include <random>
 #include <regex>
 #include <string>
@@ -39,7 +41,7 @@
 namespace tiltcal {
 namespace {
 
-constexpr int kCases = 60;
+constexpr int kCases = 40;
 constexpr double kDegPerRad = 180.0 / M_PI;
 // The defaults of the programs under test (stages/*/default_params.txtpb).
 constexpr double kMinGravityNorm = 9.7, kMaxGravityNorm = 9.9;
@@ -79,9 +81,15 @@ class Generator {
     return kValues[Pick(5)];
   }
 
+  // Draws in named variables: the order of a constructor's arguments is the
+  // compiler's (tests/testing/random_vector.h).
   Eigen::Quaterniond RandomRotation() {
-    Eigen::Quaterniond q(Normal(), Normal(), Normal(), Normal());
-    return q.normalized();
+    const double w = Normal(), x = Normal(), y = Normal(), z = Normal();
+    return Eigen::Quaterniond(w, x, y, z).normalized();
+  }
+  Eigen::Vector3d UniformVector(double lo, double hi) {
+    const double x = Uniform(lo, hi), y = Uniform(lo, hi), z = Uniform(lo, hi);
+    return Eigen::Vector3d(x, y, z);
   }
 
   // One dataset: a truth, up to two groups (the second far from the first),
@@ -90,16 +98,19 @@ class Generator {
     const int count = 1 + Pick(4);
     Rigid3d truth[2];
     truth[0].rotation = RandomRotation();
-    truth[0].translation = Eigen::Vector3d(Uniform(-1, 1), Uniform(-1, 1), Uniform(-1, 1));
+    truth[0].translation = UniformVector(-1, 1);
     truth[1] = truth[0];
     if (Chance(0.5)) {
-      truth[1].rotation = truth[0].rotation * Eigen::AngleAxisd(Uniform(5, 180) / kDegPerRad,
-                                                                RandomRotation().vec().normalized());
+      const double angle_deg = Uniform(5, 180);
+      const Eigen::Vector3d axis = RandomRotation().vec().normalized();
+      truth[1].rotation = truth[0].rotation * Eigen::AngleAxisd(angle_deg / kDegPerRad, axis);
     } else {
-      truth[1].translation += Uniform(0.3, 1.0) * RandomRotation().vec().normalized();
+      const double distance_m = Uniform(0.3, 1.0);
+      truth[1].translation += distance_m * RandomRotation().vec().normalized();
     }
     const bool two_groups = Chance(0.4);
-    const Eigen::Vector3d g0 = 9.81 * Eigen::Vector3d(Uniform(-0.1, 0.1), Uniform(-0.1, 0.1), -1).normalized();
+    const double gx = Uniform(-0.1, 0.1), gy = Uniform(-0.1, 0.1);
+    const Eigen::Vector3d g0 = 9.81 * Eigen::Vector3d(gx, gy, -1).normalized();
     std::vector<GeneratedSequence> sequences(count);
     for (int i = 0; i < count; ++i) {
       GeneratedSequence& s = sequences[i];
@@ -148,8 +159,9 @@ class Generator {
     r.set_verdict(Chance(0.5) ? proto::CalibrationResult::OK : proto::CalibrationResult::WEAK);
     *r.mutable_motion_rotation_axis_b() = ToProto(Eigen::Vector3d(0, 0, 1));
     const double angle = Uniform(0.0, 0.02) / kDegPerRad;
+    const double scale = Uniform(0.995, 1.005);
     *r.mutable_gravity_in_world() =
-        ToProto(Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitX()) * g0 * Uniform(0.995, 1.005));
+        ToProto(Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitX()) * g0 * scale);
     r.set_static_start(true);
     r.add_ground_residuals_used("flat");
     return r;
@@ -163,8 +175,9 @@ class Generator {
   // does not read it).
   std::string BreakGravity(proto::CalibrationResult* r, const Eigen::Vector3d& g0) {
     const double nan = std::numeric_limits<double>::quiet_NaN();
+    const double angle_deg = Uniform(1, 179);
     const Eigen::Vector3d values[] = {
-        -g0, Eigen::AngleAxisd(Uniform(1, 179) / kDegPerRad, Eigen::Vector3d::UnitX()) * g0,
+        -g0, Eigen::AngleAxisd(angle_deg / kDegPerRad, Eigen::Vector3d::UnitX()) * g0,
         g0.normalized() * 1.5, g0.normalized() * 1e300, Eigen::Vector3d(nan, 0, 9.81),
         Eigen::Vector3d::Zero(), g0.normalized() * 1e-300, g0.normalized() * 9.6};
     *r->mutable_gravity_in_world() = ToProto(values[Pick(8)]);
@@ -201,7 +214,8 @@ class Generator {
         r->clear_imu_from_lidar();
         return "no imu_from_lidar";
       case 2: {
-        const double f = Chance(0.5) ? Uniform(1.01, 3.0) : Uniform(0.1, 0.99);
+        const bool longer = Chance(0.5);
+        const double f = longer ? Uniform(1.01, 3.0) : Uniform(0.1, 0.99);
         q->set_w(q->w() * f);
         q->set_x(q->x() * f);
         q->set_y(q->y() * f);
@@ -234,14 +248,16 @@ class Generator {
         return "covariance entry non-finite";
       case 10: {
         // Asymmetric: one off-diagonal entry without its mirror.
-        const int i = Pick(6), j = (i + 1 + Pick(5)) % 6;
+        const int i = Pick(6);
+        const int j = (i + 1 + Pick(5)) % 6;
         r->set_covariance(i * 7 + j,
                           10.0 * std::sqrt(r->covariance(i * 7 + i) * r->covariance(j * 7 + j)));
         return "covariance asymmetric";
       }
       case 11: {
         // Indefinite: a correlation above 1 between two components.
-        const int i = Pick(6), j = (i + 1 + Pick(5)) % 6;
+        const int i = Pick(6);
+        const int j = (i + 1 + Pick(5)) % 6;
         const double c = 3.0 * std::sqrt(r->covariance(i * 7 + i) * r->covariance(j * 7 + j));
         r->set_covariance(i * 7 + j, c);
         r->set_covariance(j * 7 + i, c);
@@ -314,9 +330,18 @@ std::string ReadText(const std::string& path) {
   return text;
 }
 
+// Exit codes seen per program, printed at the end: the cases reach every
+// outcome (a change of the generator that stops doing so shows there).
+std::map<std::string, std::map<int, int>>& ExitCounts() {
+  static std::map<std::string, std::map<int, int>> counts;
+  return counts;
+}
+
 // The exit code of `command`; a crash (signal) or an undocumented code fails.
 int Run(const std::string& command, const std::vector<int>& documented, std::string* output) {
   const int code = testing::RunCommand(command, output);
+  const std::string program = std::filesystem::path(command.substr(0, command.find(' '))).filename();
+  ++ExitCounts()[program][code];
   EXPECT_NE(std::find(documented.begin(), documented.end(), code), documented.end())
       << "exit " << code << " of " << command << "\n" << *output;
   return code;
@@ -468,6 +493,11 @@ TEST(CalibrationFilesProperty, HostileFilesNeverGiveAnOkOrNonFiniteResult) {
       ADD_FAILURE() << "seed " << seed << ": " << what;
       return;
     }
+  }
+  for (const auto& [program, counts] : ExitCounts()) {
+    std::cout << program << " exits:";
+    for (const auto& [code, count] : counts) std::cout << " " << code << " x" << count;
+    std::cout << "\n";
   }
 }
 
