@@ -255,10 +255,11 @@ std::string Disagreement(const proto::DatasetCalibrationParams& params,
     for (size_t j = i + 1; j < used.size(); ++j) {
       const Rigid3d a = ToEigen(used[i]->imu_from_lidar());
       const Rigid3d b = ToEigen(used[j]->imu_from_lidar());
-      const double angle = Eigen::AngleAxisd(a.rotation.conjugate() * b.rotation).angle();
+      const double angle =
+          Eigen::AngleAxisd(a.rotation.conjugate() * b.rotation).angle() * kDegPerRad;
       const double distance = (a.translation - b.translation).norm();
       const std::string pair = used[i]->name() + " and " + used[j]->name();
-      if (angle * kDegPerRad > angle_deg) std::tie(angle_deg, angle_pair) = std::tie(angle, pair);
+      if (angle > angle_deg) std::tie(angle_deg, angle_pair) = std::tie(angle, pair);
       if (distance > distance_m) std::tie(distance_m, distance_pair) = std::tie(distance, pair);
     }
   }
@@ -267,8 +268,8 @@ std::string Disagreement(const proto::DatasetCalibrationParams& params,
       "{}, auto_exclude {}): {}; largest angle between two used extrinsics {:.3f} deg ({}), "
       "largest distance {:.4f} m ({})",
       used.size(), params.consistency().min_sequences(),
-      params.consistency().auto_exclude() ? "true" : "false", failing, angle_deg * kDegPerRad,
-      angle_pair, distance_m, distance_pair);
+      params.consistency().auto_exclude() ? "true" : "false", failing, angle_deg, angle_pair,
+      distance_m, distance_pair);
 }
 
 // With one usable sequence the dataset's result is that sequence's: its

@@ -1,13 +1,12 @@
 #include "stages/dataset_calibration/sequence_checks.h"
 
-#include <algorithm>
-#include <cmath>
-
 #include <fmt/format.h>
 
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
 
 #include "common/io/eigen_proto.h"
 #include "stages/calibrate/covariance_report.h"
@@ -52,15 +51,15 @@ std::string CheckCovariance(const proto::CalibrationResult& r, int n,
       return fmt::format("covariance[{}] = {} is not finite", k, r.covariance(k));
     }
   }
-  const Eigen::MatrixXd p =
-      Eigen::Map<const RowMajor7d>(r.covariance().data()).topLeftCorner(n, n);
+  const Eigen::MatrixXd p = Eigen::Map<const RowMajor7d>(r.covariance().data()).topLeftCorner(n, n);
   const double largest = p.cwiseAbs().maxCoeff();
   if (!(largest > 0.0)) return fmt::format("covariance ({}x{} block) is zero", n, n);
   const double asymmetry = (p - p.transpose()).cwiseAbs().maxCoeff() / largest;
   if (!(asymmetry <= params.max_covariance_asymmetry())) {
-    return fmt::format("covariance is not symmetric (largest |P_ij - P_ji| / max |P_ij| {:.3g} > "
-                       "input.max_covariance_asymmetry {:g})",
-                       asymmetry, params.max_covariance_asymmetry());
+    return fmt::format(
+        "covariance is not symmetric (largest |P_ij - P_ji| / max |P_ij| {:.3g} > "
+        "input.max_covariance_asymmetry {:g})",
+        asymmetry, params.max_covariance_asymmetry());
   }
   // Scaled to a largest entry of 1 so that no eigenvalue under- or overflows.
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(0.5 * (p + p.transpose()) / largest,
@@ -69,9 +68,10 @@ std::string CheckCovariance(const proto::CalibrationResult& r, int n,
   const double smallest_scaled = eig.eigenvalues().minCoeff();
   const double largest_scaled = eig.eigenvalues().maxCoeff();
   if (!(smallest_scaled > 0.0)) {
-    return fmt::format("covariance ({}x{} block) is not positive definite (eigenvalues {:.3g} to "
-                       "{:.3g})",
-                       n, n, smallest_scaled * largest, largest_scaled * largest);
+    return fmt::format(
+        "covariance ({}x{} block) is not positive definite (eigenvalues {:.3g} to "
+        "{:.3g})",
+        n, n, smallest_scaled * largest, largest_scaled * largest);
   }
   const double sigma_min = std::sqrt(smallest_scaled) * std::sqrt(largest);
   const double sigma_max = std::sqrt(largest_scaled) * std::sqrt(largest);
@@ -95,8 +95,7 @@ std::string CheckCovariance(const proto::CalibrationResult& r, int n,
 // fusion removes it, extrinsic_fusion.h), so P^{-1} - L_p, the data's
 // information, is positive semidefinite up to rounding.
 std::string CheckPriorWithinCovariance(const proto::CalibrationResult& r, int n) {
-  const Eigen::MatrixXd p =
-      Eigen::Map<const RowMajor7d>(r.covariance().data()).topLeftCorner(n, n);
+  const Eigen::MatrixXd p = Eigen::Map<const RowMajor7d>(r.covariance().data()).topLeftCorner(n, n);
   const Eigen::MatrixXd information = p.inverse();
   Eigen::MatrixXd prior = Eigen::MatrixXd::Zero(n, n);
   prior.block<3, 3>(3, 3) = calibrate::TranslationPriorInformation(
@@ -105,11 +104,13 @@ std::string CheckPriorWithinCovariance(const proto::CalibrationResult& r, int n)
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(0.5 * (data + data.transpose()),
                                                            Eigen::EigenvaluesOnly);
   const double scale = information.cwiseAbs().maxCoeff();
-  if (eig.info() != Eigen::Success || !(eig.eigenvalues().minCoeff() >= -kInformationRounding * scale)) {
-    return fmt::format("covariance holds less information than its own translation prior "
-                       "(translation_prior_sigma_m {} along ({}, {}, {}))",
-                       r.translation_prior_sigma_m(), r.translation_prior_axis_b().x(),
-                       r.translation_prior_axis_b().y(), r.translation_prior_axis_b().z());
+  if (eig.info() != Eigen::Success ||
+      !(eig.eigenvalues().minCoeff() >= -kInformationRounding * scale)) {
+    return fmt::format(
+        "covariance holds less information than its own translation prior "
+        "(translation_prior_sigma_m {} along ({}, {}, {}))",
+        r.translation_prior_sigma_m(), r.translation_prior_axis_b().x(),
+        r.translation_prior_axis_b().y(), r.translation_prior_axis_b().z());
   }
   return "";
 }
@@ -118,16 +119,17 @@ std::string CheckPriorWithinCovariance(const proto::CalibrationResult& r, int n)
 
 Status ValidateSequenceInputParams(const proto::SequenceInputParams& params) {
   if (!(params.min_sigma() < params.max_sigma())) {
-    return Status::Error(fmt::format("field input.min_sigma = {:g} is not below input.max_sigma = {:g}",
-                                     params.min_sigma(), params.max_sigma()));
+    return Status::Error(
+        fmt::format("field input.min_sigma = {:g} is not below input.max_sigma = {:g}",
+                    params.min_sigma(), params.max_sigma()));
   }
   return Status::Ok();
 }
 
 std::string ReasonRefused(const proto::CalibrationResult& r, int n,
                           const proto::SequenceInputParams& params) {
-  std::string reason = CheckTransform(r.has_imu_from_lidar(), r.imu_from_lidar(),
-                                      "imu_from_lidar", params.max_quaternion_norm_error());
+  std::string reason = CheckTransform(r.has_imu_from_lidar(), r.imu_from_lidar(), "imu_from_lidar",
+                                      params.max_quaternion_norm_error());
   if (reason.empty()) {
     reason = CheckTransform(r.has_rig_imu_from_lidar(), r.rig_imu_from_lidar(),
                             "rig_imu_from_lidar", params.max_quaternion_norm_error());
@@ -143,9 +145,10 @@ std::string ReasonRefused(const proto::CalibrationResult& r, int n,
   const double prior_sigma_m = r.translation_prior_sigma_m();
   if (prior_sigma_m != 0.0 &&
       !(prior_sigma_m >= params.min_sigma() && prior_sigma_m <= params.max_sigma())) {
-    return fmt::format("translation_prior_sigma_m = {} is neither 0 (no prior) nor within "
-                       "input.min_sigma {:g} to input.max_sigma {:g}",
-                       prior_sigma_m, params.min_sigma(), params.max_sigma());
+    return fmt::format(
+        "translation_prior_sigma_m = {} is neither 0 (no prior) nor within "
+        "input.min_sigma {:g} to input.max_sigma {:g}",
+        prior_sigma_m, params.min_sigma(), params.max_sigma());
   }
   reason = CheckVector(r.translation_prior_axis_b(), "translation_prior_axis_b");
   if (reason.empty()) reason = CheckVector(r.motion_rotation_axis_b(), "motion_rotation_axis_b");

@@ -15,6 +15,10 @@
 //     SUSPECT; tiltcal_report and tiltcal_export print no nan or inf.
 // Each case is generated from its own seed (std::mt19937), so a failure names
 // the seed that reproduces it.
+#include <google/protobuf/text_format.h>
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -25,11 +29,6 @@
 #include <regex>
 #include <string>
 #include <vector>
-
-#include <google/protobuf/text_format.h>
-#include <gtest/gtest.h>
-
-#include <Eigen/Geometry>
 
 #include "common/io/atomic_file.h"
 #include "common/io/eigen_proto.h"
@@ -49,8 +48,8 @@ constexpr double kMaxGravityAngleDeg = 0.3;
 
 // What the generator made of a file.
 enum class Kind {
-  kGood,      // whole, drawn from its group's covariance
-  kHostile,   // broken one way or another: must never be used
+  kGood,        // whole, drawn from its group's covariance
+  kHostile,     // broken one way or another: must never be used
   kUnreadable,  // not a calibration in text format: the run is an error
 };
 
@@ -68,7 +67,9 @@ class Generator {
  public:
   explicit Generator(unsigned seed) : rng_(seed) {}
 
-  double Uniform(double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng_); }
+  double Uniform(double lo, double hi) {
+    return std::uniform_real_distribution<double>(lo, hi)(rng_);
+  }
   int Pick(int n) { return std::uniform_int_distribution<int>(0, n - 1)(rng_); }
   bool Chance(double p) { return Uniform(0.0, 1.0) < p; }
   double Normal() { return std::normal_distribution<double>()(rng_); }
@@ -177,9 +178,14 @@ class Generator {
     const double nan = std::numeric_limits<double>::quiet_NaN();
     const double angle_deg = Uniform(1, 179);
     const Eigen::Vector3d values[] = {
-        -g0, Eigen::AngleAxisd(angle_deg / kDegPerRad, Eigen::Vector3d::UnitX()) * g0,
-        g0.normalized() * 1.5, g0.normalized() * 1e300, Eigen::Vector3d(nan, 0, 9.81),
-        Eigen::Vector3d::Zero(), g0.normalized() * 1e-300, g0.normalized() * 9.6};
+        -g0,
+        Eigen::AngleAxisd(angle_deg / kDegPerRad, Eigen::Vector3d::UnitX()) * g0,
+        g0.normalized() * 1.5,
+        g0.normalized() * 1e300,
+        Eigen::Vector3d(nan, 0, 9.81),
+        Eigen::Vector3d::Zero(),
+        g0.normalized() * 1e-300,
+        g0.normalized() * 9.6};
     *r->mutable_gravity_in_world() = ToProto(values[Pick(8)]);
     return " gravity hostile";
   }
@@ -223,8 +229,8 @@ class Generator {
         return "non-unit quaternion";
       }
       case 3:
-        r->mutable_imu_from_lidar()->mutable_translation()->set_y(
-            Chance(0.5) ? std::nan("") : -HUGE_VAL);
+        r->mutable_imu_from_lidar()->mutable_translation()->set_y(Chance(0.5) ? std::nan("")
+                                                                              : -HUGE_VAL);
         return "translation non-finite";
       case 4:
         r->set_time_offset_s(Chance(0.5) ? std::nan("") : HUGE_VAL);
@@ -340,17 +346,19 @@ std::map<std::string, std::map<int, int>>& ExitCounts() {
 // The exit code of `command`; a crash (signal) or an undocumented code fails.
 int Run(const std::string& command, const std::vector<int>& documented, std::string* output) {
   const int code = testing::RunCommand(command, output);
-  const std::string program = std::filesystem::path(command.substr(0, command.find(' '))).filename();
+  const std::string program =
+      std::filesystem::path(command.substr(0, command.find(' '))).filename();
   ++ExitCounts()[program][code];
   EXPECT_NE(std::find(documented.begin(), documented.end(), code), documented.end())
-      << "exit " << code << " of " << command << "\n" << *output;
+      << "exit " << code << " of " << command << "\n"
+      << *output;
   return code;
 }
 
 void CheckDatasetCalibration(const std::vector<GeneratedSequence>& sequences,
                              const std::string& root, std::string* dataset_out) {
-  std::string command = testing::ToolPath("tiltcal_dataset_calibration") + " --out=" + root +
-                        "/calibration.txtpb";
+  std::string command =
+      testing::ToolPath("tiltcal_dataset_calibration") + " --out=" + root + "/calibration.txtpb";
   for (const GeneratedSequence& s : sequences) command += " " + s.dir + "/calibration.txtpb";
   std::string output;
   const int code = Run(command, {0, 1, 3}, &output);
@@ -380,7 +388,8 @@ void CheckDatasetCalibration(const std::vector<GeneratedSequence>& sequences,
     if (!out.sequences(i).used()) continue;
     ++used;
     EXPECT_EQ(sequences[i].kind, Kind::kGood)
-        << sequences[i].name << " used although " << sequences[i].mutation << "\n" << output;
+        << sequences[i].name << " used although " << sequences[i].mutation << "\n"
+        << output;
     used_groups.push_back(sequences[i].group);
   }
   EXPECT_GE(used, 1) << output;
@@ -391,7 +400,8 @@ void CheckDatasetCalibration(const std::vector<GeneratedSequence>& sequences,
     // Never OK with used sequences that disagree.
     EXPECT_TRUE(std::all_of(used_groups.begin(), used_groups.end(),
                             [&](int g) { return g == used_groups.front(); }))
-        << "exit 0 fusing sequences of two groups\n" << output;
+        << "exit 0 fusing sequences of two groups\n"
+        << output;
   }
   *dataset_out = root + "/calibration.txtpb";
 }
@@ -445,16 +455,17 @@ void CheckReport(const std::vector<GeneratedSequence>& sequences, const std::str
 }
 
 void CheckExport(const std::string& calibration, Generator* generator) {
-  static const char* kFormats[] = {"fast_lio", "lio_sam", "urdf", "tf_ros1",
+  static const char* kFormats[] = {"fast_lio", "lio_sam", "urdf",   "tf_ros1",
                                    "tf_ros2",  "kalibr",  "matrix", "json"};
   const std::string format = kFormats[generator->Pick(8)];
   std::string output;
-  const int code = Run(testing::ToolPath("tiltcal_export") + " --format=" + format +
-                           " --calibration=" + calibration,
-                       {0, 1, 2}, &output);
+  const int code = Run(
+      testing::ToolPath("tiltcal_export") + " --format=" + format + " --calibration=" + calibration,
+      {0, 1, 2}, &output);
   if (code != 0) return;
   EXPECT_FALSE(HasNonFiniteWord(WithoutReasons(output, {calibration})))
-      << format << " of " << calibration << "\n" << output;
+      << format << " of " << calibration << "\n"
+      << output;
   proto::CalibrationResult input;
   if (ReadTextProto(calibration, &input).ok()) {
     EXPECT_NE(input.verdict(), proto::CalibrationResult::SUSPECT)

@@ -78,8 +78,9 @@ TEST(Params, NanIsRejected) {
 // protobuf's parser alone refuses "x: 5  x: 0" but keeps 5 of "x: 0  x: 5"
 // (a proto3 scalar at its default is not "present"): both are refused.
 TEST(Params, AFieldGivenTwiceIsRefusedInEitherOrder) {
-  for (const char* twice : {"min_range_m: 0\nmin_range_m: 0.5\n", "min_range_m: 0.5\nmin_range_m: 0\n",
-                            "min_range_m: 0\nmin_range_m: 0\n", "min_range_m: 0.5; min_range_m: 0.5\n"}) {
+  for (const char* twice :
+       {"min_range_m: 0\nmin_range_m: 0.5\n", "min_range_m: 0.5\nmin_range_m: 0\n",
+        "min_range_m: 0\nmin_range_m: 0\n", "min_range_m: 0.5; min_range_m: 0.5\n"}) {
     proto::DecodeParams params;
     const Status status =
         LoadFromText(std::string("chunk_cache_size: 4\nmax_stamp_gap_s: 60\n") + twice, &params);
@@ -96,10 +97,9 @@ TEST(Params, ANestedFieldOrMessageGivenTwiceIsRefusedWithItsPath) {
   std::string text;
   ASSERT_TRUE(ReadFileToString(defaults, &text).ok());
   proto::GroundParams params;
-  // A scalar at its default (false) then true, inside a nested message.
-  Status status = ParseTextProto(
-      text + "\n", "ground.txtpb", &params);
+  Status status = ParseTextProto(text, "ground.txtpb", &params);
   ASSERT_TRUE(status.ok()) << status.message();
+  // A scalar at its default (0) then 1.5, inside a nested message.
   const std::string nested_scalar = "frame {\n  use_rig_up_direction: true\n  "
                                     "sensor_height_guess_m: 0.0\n  sensor_height_guess_m: 1.5\n}\n";
   std::string edited = text;
@@ -120,7 +120,8 @@ TEST(Params, ANestedFieldOrMessageGivenTwiceIsRefusedWithItsPath) {
       << status.message();
   // Repeated fields and lists may be given more than once.
   proto::GroundParams repeated;
-  status = ParseTextProto("zone_model { rings: 2 rings: [4, 4] rings: 4 }", "ground.txtpb", &repeated);
+  status = ParseTextProto("zone_model { rings: 2 rings: [4, 4] rings: 4 }", "ground.txtpb",
+                          &repeated);
   ASSERT_TRUE(status.ok()) << status.message();
   EXPECT_EQ(repeated.zone_model().rings_size(), 4);
 }

@@ -123,14 +123,16 @@ TEST(DatasetCalibration, AnInconsistentSequenceIsLeftOutAndNamed) {
 
   // Without auto_exclude it stays in and pulls the joint value.
   proto::CalibrationResult kept;
-  ASSERT_TRUE(CalibrateDataset(sequences, Params("consistency { auto_exclude: false }"), &kept).ok());
+  ASSERT_TRUE(
+      CalibrateDataset(sequences, Params("consistency { auto_exclude: false }"), &kept).ok());
   EXPECT_TRUE(kept.sequences(3).used());
   EXPECT_FALSE(kept.sequences(3).consistent());
   EXPECT_GT(RotationErrorDeg(kept), 0.15);
   // ... and the joint value is not to be used without reading why.
   EXPECT_EQ(kept.verdict(), proto::CalibrationResult::SUSPECT);
   ASSERT_GT(kept.verdict_reasons_size(), 0);
-  EXPECT_NE(kept.verdict_reasons(0).find("run4 chi2"), std::string::npos) << kept.verdict_reasons(0);
+  EXPECT_NE(kept.verdict_reasons(0).find("run4 chi2"), std::string::npos)
+      << kept.verdict_reasons(0);
 }
 
 TEST(DatasetCalibration, UserExclusionSuspectInputsAndTooFewSequences) {
@@ -265,7 +267,8 @@ TEST(DatasetCalibration, TwoDisagreeingSequencesAreSuspect) {
   SequenceCalibration run1 = Sequence("run1", &rng);
   SequenceCalibration run2 = Sequence("run2", &rng);
   Rigid3d turned = ToEigen(run2.result.imu_from_lidar());
-  turned.rotation = turned.rotation * Eigen::AngleAxisd(30.0 / kDegPerRad, Eigen::Vector3d::UnitZ());
+  turned.rotation =
+      turned.rotation * Eigen::AngleAxisd(30.0 / kDegPerRad, Eigen::Vector3d::UnitZ());
   *run2.result.mutable_imu_from_lidar() = ToProto(turned);
   DatasetTool tool;
   const std::vector<std::string> paths = {tool.Write("run1", run1.result),
@@ -284,6 +287,26 @@ TEST(DatasetCalibration, TwoDisagreeingSequencesAreSuspect) {
   EXPECT_NEAR(std::stod(reason.substr(reason.find(angle) + angle.size())), 30.0, 0.01) << reason;
   EXPECT_TRUE(out.sequences(0).used());
   EXPECT_TRUE(out.sequences(1).used());
+}
+
+// The reason names the two used extrinsics furthest apart, whichever they are.
+TEST(DatasetCalibration, TheDisagreementNamesTheWidestPair) {
+  std::mt19937 rng(17);
+  std::vector<SequenceCalibration> sequences = {Sequence("a", &rng), Sequence("b", &rng),
+                                                Sequence("c", &rng)};
+  Rigid3d turned = ToEigen(sequences[0].result.imu_from_lidar());
+  turned.rotation = turned.rotation * Eigen::AngleAxisd(5.0 / kDegPerRad, Eigen::Vector3d::UnitY());
+  *sequences[0].result.mutable_imu_from_lidar() = ToProto(turned);
+  proto::CalibrationResult out;
+  ASSERT_TRUE(
+      CalibrateDataset(sequences, Params("consistency { auto_exclude: false }"), &out).ok());
+  EXPECT_EQ(out.verdict(), proto::CalibrationResult::SUSPECT);
+  ASSERT_GT(out.verdict_reasons_size(), 0);
+  const std::string& reason = out.verdict_reasons(0);
+  const std::string angle = "largest angle between two used extrinsics ";
+  ASSERT_NE(reason.find(angle), std::string::npos) << reason;
+  EXPECT_NEAR(std::stod(reason.substr(reason.find(angle) + angle.size())), 5.0, 0.05) << reason;
+  EXPECT_NE(reason.find(" deg (a and "), std::string::npos) << reason;
 }
 
 // A calibration file that is broken, each way, beside two good ones.
@@ -342,7 +365,9 @@ const std::vector<BrokenFile>& BrokenFiles() {
          *r->mutable_translation_prior_axis_b() = ToProto(Eigen::Vector3d(0, 0, 1));
        }},
       {"verdict unset", "verdict 0 is not OK, WEAK or SUSPECT",
-       [](proto::CalibrationResult* r) { r->set_verdict(proto::CalibrationResult::VERDICT_UNSET); }},
+       [](proto::CalibrationResult* r) {
+         r->set_verdict(proto::CalibrationResult::VERDICT_UNSET);
+       }},
   };
   return files;
 }
@@ -379,7 +404,9 @@ TEST(DatasetCalibration, BrokenSequenceFilesAreRefusedAndNamed) {
     EXPECT_NEAR(ToEigen(out.imu_from_lidar().translation()).x(),
                 ToEigen(good.imu_from_lidar().translation()).x(), 1e-12);
     bool named = false;
-    for (const std::string& r : out.verdict_reasons()) named |= r.find("left out c: " + c_path) == 0;
+    for (const std::string& r : out.verdict_reasons()) {
+      named |= r.find("left out c: " + c_path) == 0;
+    }
     EXPECT_TRUE(named) << output;
 
     // Beside one good sequence: that sequence is the dataset's result.

@@ -174,8 +174,10 @@ TEST(GravityReference, ToolRefusesOppositeNonFiniteAndWrongNormGravities) {
       {"norm 1.5", {0, 0, 9.81}, {0, 0, 1.5},
        {"b.txtpb: gravity_in_world (0, 0, 1.5) has norm 1.5 m/s^2, outside "
         "flat_calibrations.min_gravity_norm_mps2 9.7 to max_gravity_norm_mps2 9.9"}},
-      {"norm 9.6", {0, 0, 9.6}, {0, 0, 9.81}, {"a.txtpb: gravity_in_world (0, 0, 9.6) has norm 9.6"}},
-      {"nan", {0, 0, 9.81}, {nan, 0, 9.81}, {"b.txtpb: gravity_in_world (nan, 0, 9.81) is not finite"}},
+      {"norm 9.6", {0, 0, 9.6}, {0, 0, 9.81},
+       {"a.txtpb: gravity_in_world (0, 0, 9.6) has norm 9.6"}},
+      {"nan", {0, 0, 9.81}, {nan, 0, 9.81},
+       {"b.txtpb: gravity_in_world (nan, 0, 9.81) is not finite"}},
   };
   const std::string tool = testing::ToolPath("tiltcal_gravity_reference");
   for (const Case& c : cases) {
