@@ -45,8 +45,10 @@ truncate_half "$GOOD/seq.bag" "$BAD/truncated.bag"
 truncate_half "$GOOD/imu.binpb" "$BAD/truncated_imu.binpb"
 truncate_half "$GOOD/scans.binpb.lz4" "$BAD/truncated_scans.binpb.lz4"
 truncate_half "$GOOD/ground.binpb" "$BAD/truncated_ground.binpb"
-sed -E 's/^(  translation \{)/\1 x: nan/' "$GOOD/rig.txtpb" > "$BAD/nan_rig.txtpb"
-sed -E 's/^(  rotation \{)/\1 w: 1e300/' "$GOOD/rig.txtpb" > "$BAD/huge_rig.txtpb"
+sed -E '/^  translation \{/,/^  \}/ s/^(    x:).*/\1 nan/' "$GOOD/rig.txtpb" > "$BAD/nan_rig.txtpb"
+sed -E '/^  rotation \{/,/^  \}/ s/^(    w:).*/\1 1e300/' "$GOOD/rig.txtpb" > "$BAD/huge_rig.txtpb"
+grep -q "^    x: nan$" "$BAD/nan_rig.txtpb" && grep -q "^    w: 1e300$" "$BAD/huge_rig.txtpb" ||
+  { echo "the rig's translation x or rotation w not found" >&2; exit 1; }
 sed -E 's/^imu_height_m:.*/imu_height_m: -1/' "$GOOD/rig.txtpb" > "$BAD/negative_height_rig.txtpb"
 grep -q "^imu_height_m: -1$" "$BAD/negative_height_rig.txtpb" || { echo "no imu_height_m in the rig" >&2; exit 1; }
 echo "imu_from_lidar { rotation { w: nan } }" > "$BAD/nan_calibration.txtpb"
