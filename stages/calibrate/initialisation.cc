@@ -423,11 +423,12 @@ OdometryRun RunOdometry(const std::vector<LidarScan>& scans, const CalibrationSt
   return run;
 }
 
-// Step 4: C_bl from the rig, or hand-eye when excited; without excitation
-// the rig's C_bl aligned to the motion's rotation axis. The rig's C_bl maps
-// the LiDAR's rotation axis within max_axis_alignment_deg of the IMU's, or
-// hand-eye replaces it; otherwise (planar motion: the rotation about the
-// axis is not determined) it is an error with the angle.
+// Step 4: an error when the motion turned too little to decide the rotation
+// (MissingTurning); else C_bl from the rig, or hand-eye when excited; without
+// excitation the rig's C_bl aligned to the motion's rotation axis. The rig's
+// C_bl maps the LiDAR's rotation axis within max_axis_alignment_deg of the
+// IMU's, or hand-eye replaces it; otherwise (planar motion: the rotation
+// about the axis is not determined) it is an error with the angle.
 Status InitialExtrinsicRotation(const OdometryRun& run, const std::vector<LidarScan>& scans,
                                 const Eigen::Quaterniond& measured_imu_from_lidar,
                                 const proto::CalibrateParams& params,
@@ -441,15 +442,16 @@ Status InitialExtrinsicRotation(const OdometryRun& run, const std::vector<LidarS
                               scans[run.scan_of_pose[run.used[k + pair_step]]].stamp_s);
   }
   report->turning = MeasureTurning(pairs, pair_times_s);
+  // Without turning, the motion's axis is noise: neither hand-eye, nor the
+  // axis alignment, nor a check of the rig can use it.
+  const std::string missing = MissingTurning(report->turning, params.init());
+  if (!missing.empty()) return Status::Error(missing);
   report->hand_eye = EstimateHandEyeRotation(pairs, params.hand_eye());
   Eigen::Quaterniond c_bl_init = ChooseInitialRotation(measured_imu_from_lidar, report->hand_eye);
   report->rotation_from_hand_eye = report->hand_eye.excited;
   report->rig_axis_disagreement_deg = RotationAxisDisagreementDeg(pairs, measured_imu_from_lidar);
   const double max_deg = params.init().max_axis_alignment_deg();
   if (!report->rotation_from_hand_eye && report->rig_axis_disagreement_deg > max_deg) {
-    // Before blaming the rig: can the motion tell at all?
-    const std::string missing = MissingTurning(report->turning, params.init());
-    if (!missing.empty()) return Status::Error(missing);
     return Status::Error(fmt::format(
         "the rig's imu_from_lidar rotation maps the LiDAR's rotation axis {:.1f} deg away from "
         "the IMU's (180: one of them is upside down; at most init.max_axis_alignment_deg = {} "
@@ -570,9 +572,6 @@ Status CheckRigYaw(const OdometryRun& run, const std::vector<LidarScan>& scans,
   const AccelerationCheck& check = report->acceleration_check;
   const double max_deg = params.init().max_rig_rotation_error_deg();
   if (!check.decided || std::abs(check.yaw_error_deg) <= max_deg) return Status::Ok();
-  // Before blaming the rig: without turning, the motion's axis is noise.
-  const std::string missing = MissingTurning(report->turning, params.init());
-  if (!missing.empty()) return Status::Error(missing);
   return Status::Error(fmt::format(
       "the LiDAR's accelerations mapped into the IMU frame by the {} C_bl are turned by {:.1f} "
       "deg about the motion's rotation axis ({:.3f}, {:.3f}, {:.3f}) against the "

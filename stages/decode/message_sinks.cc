@@ -175,9 +175,9 @@ Status ImuSink::CheckPhysicalRange(const proto::ImuRangeParams& range, double ac
   for (size_t i = 0; i < samples_.size(); ++i) {
     const Record& r = samples_[i];
     const double accel_mps2 =
-        Eigen::Map<const Eigen::Vector3d>(r.linear_acceleration).norm() * accel_to_si;
+        Eigen::Map<const Eigen::Vector3d>(r.linear_acceleration).stableNorm() * accel_to_si;
     const double gyro_radps =
-        Eigen::Map<const Eigen::Vector3d>(r.angular_velocity).norm() * gyro_to_si;
+        Eigen::Map<const Eigen::Vector3d>(r.angular_velocity).stableNorm() * gyro_to_si;
     const bool accel_out = !(accel_mps2 <= range.max_linear_acceleration_mps2());
     if (accel_out || !(gyro_radps <= range.max_angular_velocity_radps())) {
       return Status::Error(fmt::format(

@@ -21,7 +21,10 @@ Status LoadFromText(const std::string& text, google::protobuf::Message* params) 
 TEST(Params, ValidFileLoads) {
   proto::DecodeParams params;
   const Status status =
-      LoadFromText("min_range_m: 0.5\nchunk_cache_size: 4\nmax_stamp_gap_s: 60\n", &params);
+      LoadFromText("min_range_m: 0.5\nchunk_cache_size: 4\nmax_stamp_gap_s: 60\n"
+                   "imu_range { max_linear_acceleration_mps2: 400 "
+                   "max_angular_velocity_radps: 70 }\n",
+                   &params);
   ASSERT_TRUE(status.ok()) << status.message();
   EXPECT_DOUBLE_EQ(params.min_range_m(), 0.5);
 }
@@ -147,7 +150,9 @@ namespace {
 TEST(Params, MissingPathMeansTheDefaultText) {
   proto::DecodeParams params;
   const Status status =
-      LoadParamsOrDefaults("", "min_range_m: 0.25\nchunk_cache_size: 4\nmax_stamp_gap_s: 60\n",
+      LoadParamsOrDefaults("", "min_range_m: 0.25\nchunk_cache_size: 4\nmax_stamp_gap_s: 60\n"
+                           "imu_range { max_linear_acceleration_mps2: 400 "
+                           "max_angular_velocity_radps: 70 }\n",
                            &params);
   ASSERT_TRUE(status.ok()) << status.message();
   EXPECT_DOUBLE_EQ(params.min_range_m(), 0.25);
