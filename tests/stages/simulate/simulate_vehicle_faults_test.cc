@@ -57,7 +57,7 @@ struct Bag {
   std::vector<ImuSample> imu;
   std::vector<CloudHeader> clouds;
 };
-struct Run {
+struct SimRun {
   proto::SimulationTruth truth;
   Bag bag;
   std::string bag_path;
@@ -93,13 +93,13 @@ Bag ReadBag(const std::string& path, const proto::SimulateParams& params) {
   return bag;
 }
 
-Run Simulate(const proto::SimulateParams& params, const TempDir& dir, const std::string& name) {
+SimRun Simulate(const proto::SimulateParams& params, const TempDir& dir, const std::string& name) {
   SimulatePaths paths;
   paths.out_bag = dir.File(name + ".bag");
   paths.out_truth = dir.File(name + "_truth.txtpb");
   const Status status = simulate::Run(paths, params, /*log=*/nullptr);
   EXPECT_TRUE(status.ok()) << status.message();
-  Run run;
+  SimRun run;
   EXPECT_TRUE(ReadTextProto(paths.out_truth, &run.truth).ok());
   run.bag = ReadBag(paths.out_bag, params);
   run.bag_path = paths.out_bag;
@@ -152,7 +152,7 @@ TEST(SimulateVehicleFaultsTest, EveryScenarioKeepsItsBytesWithFaultsOff) {
       if (!faults.empty() && c.file != "short_test_vlp16.txtpb") continue;
       SCOPED_TRACE(c.file + " " + faults);
       const proto::SimulateParams params = ScenarioWith(c.file, cut + faults);
-      const Run run = Simulate(params, dir, "off");
+      const SimRun run = Simulate(params, dir, "off");
       std::string bytes;
       ASSERT_TRUE(ReadFileToString(run.bag_path, &bytes).ok());
       EXPECT_EQ(bytes.size(), c.size);
@@ -180,8 +180,8 @@ TEST(SimulateVehicleFaultsTest, ImuScaleAndMisalignment) {
       "misalignment_deg { x: -1 y: 0.6 z: 0.4 } } }";
   const proto::SimulateParams clean_params = ShortWith(motion);
   const proto::SimulateParams params = ShortWith(motion + faults);
-  const Run clean = Simulate(clean_params, dir, "clean");
-  const Run faulty = Simulate(params, dir, "faulty");
+  const SimRun clean = Simulate(clean_params, dir, "clean");
+  const SimRun faulty = Simulate(params, dir, "faulty");
   const double d = M_PI / 180;
   Eigen::Matrix3d k_gyro, k_accel;
   k_gyro << 1.02, 0, 0, 0.5 * d, 1 - 0.015, 0, -0.8 * d, 1.0 * d, 1.01;
@@ -240,11 +240,11 @@ TEST(SimulateVehicleFaultsTest, ImuIntrinsicsDrawnWithinBounds) {
   const std::string gyro = "gyro_intrinsics { scale_max_ppm: 5000 misalignment_max_deg: 0.5 } ";
   const std::string accel = "accel_intrinsics { scale_max_ppm: 3000 misalignment_max_deg: 0.2 } ";
   const proto::SimulateParams params = ShortWith("duration_s: 1 faults { " + gyro + accel + "}");
-  const Run clean = Simulate(ShortWith("duration_s: 1"), dir, "clean");
-  const Run run = Simulate(params, dir, "drawn");
-  const Run other_seed =
+  const SimRun clean = Simulate(ShortWith("duration_s: 1"), dir, "clean");
+  const SimRun run = Simulate(params, dir, "drawn");
+  const SimRun other_seed =
       Simulate(ShortWith("duration_s: 1 seed: 8 faults { " + gyro + accel + "}"), dir, "seed8");
-  const Run gyro_only = Simulate(ShortWith("duration_s: 1 faults { " + gyro + "}"), dir, "gyro");
+  const SimRun gyro_only = Simulate(ShortWith("duration_s: 1 faults { " + gyro + "}"), dir, "gyro");
   for (const auto& [t, max_ppm, max_deg] :
        {std::tuple{&run.truth.gyro_intrinsics(), 5000.0, 0.5},
         std::tuple{&run.truth.accel_intrinsics(), 3000.0, 0.2}}) {
@@ -314,7 +314,7 @@ double PeakFrequency(const std::vector<double>& x, double rate, double lo, doubl
 TEST(SimulateVehicleFaultsTest, ImuVibration) {
   TempDir dir;
   const proto::SimulateParams clean_params = ShortWith("");
-  const Run clean = Simulate(clean_params, dir, "clean");
+  const SimRun clean = Simulate(clean_params, dir, "clean");
   const double rate = clean_params.imu().rate_hz();
   struct Case {
     double frequency_hz, seen_hz;
@@ -327,7 +327,7 @@ TEST(SimulateVehicleFaultsTest, ImuVibration) {
     const proto::SimulateParams params = ShortWith(
         "faults { imu_vibration { frequency_hz: " + std::to_string(c.frequency_hz) +
         " accel_amplitude_mps2: 0.5 gyro_amplitude_radps: 0.05 when: " + c.when + " } }");
-    const Run run = Simulate(params, dir, "vibration");
+    const SimRun run = Simulate(params, dir, "vibration");
     ASSERT_EQ(run.bag.imu.size(), clean.bag.imu.size());
     const Eigen::Vector3d phase_w = ToEigen(run.truth.imu_vibration_gyro_phase_rad());
     const Eigen::Vector3d phase_f = ToEigen(run.truth.imu_vibration_accel_phase_rad());
@@ -366,12 +366,12 @@ TEST(SimulateVehicleFaultsTest, ImuVibration) {
 // do not move.
 TEST(SimulateVehicleFaultsTest, LidarClockDrift) {
   TempDir dir;
-  const Run clean = Simulate(ShortWith(""), dir, "clean");
+  const SimRun clean = Simulate(ShortWith(""), dir, "clean");
   for (const double ppm : {200.0, -500.0}) {
     SCOPED_TRACE(ppm);
     const proto::SimulateParams params =
         ShortWith("faults { lidar_clock_drift_ppm: " + std::to_string(ppm) + " }");
-    const Run run = Simulate(params, dir, "drift");
+    const SimRun run = Simulate(params, dir, "drift");
     const proto::SimulationTruth& truth = run.truth;
     ASSERT_EQ(run.bag.clouds.size(), static_cast<size_t>(truth.scans_size()));
     ASSERT_GE(truth.scans_size(), 30);
@@ -400,8 +400,8 @@ TEST(SimulateVehicleFaultsTest, LidarClockDrift) {
 // dropped ones and lists the scans in the bag; the IMU is untouched.
 TEST(SimulateVehicleFaultsTest, DroppedScans) {
   TempDir dir;
-  const Run clean = Simulate(ShortWith("duration_s: 12"), dir, "clean");
-  const Run run = Simulate(ShortWith("duration_s: 12 faults { lidar_drop_fraction: 0.3 }"), dir,
+  const SimRun clean = Simulate(ShortWith("duration_s: 12"), dir, "clean");
+  const SimRun run = Simulate(ShortWith("duration_s: 12 faults { lidar_drop_fraction: 0.3 }"), dir,
                            "dropped");
   const size_t total = clean.bag.clouds.size();
   ASSERT_GT(total, 100u);
@@ -494,7 +494,7 @@ TEST(SimulateVehicleFaultsTest, RollingGround) {
   EXPECT_LE(*std::max_element(height.begin(), height.end()), amplitude + 1e-4);
   EXPECT_GT(Rms(height), 0.25 * amplitude);
   TempDir dir;
-  const Run run = Simulate(ShortWith("duration_s: 0.5 faults { rolling_ground_amplitude_m: 0.15 "
+  const SimRun run = Simulate(ShortWith("duration_s: 0.5 faults { rolling_ground_amplitude_m: 0.15 "
                                      "rolling_ground_wavelength_m: 6 }"),
                            dir, "rolling");
   Scenario scenario;
@@ -608,7 +608,7 @@ TEST(SimulateVehicleFaultsTest, FaultyVehicleScenario) {
   TempDir dir;
   const proto::SimulateParams params =
       ScenarioWith("faulty_vehicle_vlp16_40s.txtpb", "duration_s: 5 num_threads: 2");
-  const Run run = Simulate(params, dir, "faulty");
+  const SimRun run = Simulate(params, dir, "faulty");
   const proto::SimulationTruth& truth = run.truth;
   EXPECT_NE(MatrixOf(truth.gyro_intrinsics()), Eigen::Matrix3d::Identity());
   EXPECT_NE(MatrixOf(truth.accel_intrinsics()), Eigen::Matrix3d::Identity());
