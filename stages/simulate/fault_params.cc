@@ -22,7 +22,8 @@ Status SimFaultParamsAreValid(const proto::SimFaultParams& faults, double durati
           g, gap.start_s(), duration_s));
     }
   }
-  TILTCAL_RETURN_IF_ERROR(SimTriadErrorsAreValid(faults.gyro_intrinsics(), "faults.gyro_intrinsics"));
+  TILTCAL_RETURN_IF_ERROR(
+      SimTriadErrorsAreValid(faults.gyro_intrinsics(), "faults.gyro_intrinsics"));
   TILTCAL_RETURN_IF_ERROR(
       SimTriadErrorsAreValid(faults.accel_intrinsics(), "faults.accel_intrinsics"));
   const proto::SimImuVibration& vibration = faults.imu_vibration();

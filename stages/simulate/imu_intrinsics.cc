@@ -28,7 +28,9 @@ TriadErrors Draw(const proto::SimTriadErrors& p, Rng* rng) {
   TriadErrors e;
   const Eigen::Vector3d scale_ppm = ToEigen(p.scale_ppm());
   const Eigen::Vector3d misalignment_deg = ToEigen(p.misalignment_deg());
-  for (int a = 0; a < 3; ++a) e.scale[a] = GivenPlusDraw(scale_ppm[a], p.scale_max_ppm(), rng) * 1e-6;
+  for (int a = 0; a < 3; ++a) {
+    e.scale[a] = GivenPlusDraw(scale_ppm[a], p.scale_max_ppm(), rng) * 1e-6;
+  }
   for (int a = 0; a < 3; ++a) {
     e.misalignment_rad[a] =
         GivenPlusDraw(misalignment_deg[a], p.misalignment_max_deg(), rng) * kDegToRad;
@@ -50,7 +52,8 @@ Eigen::Matrix3d TriadErrors::MeasuredFromTrue() const {
 Status SimTriadErrorsAreValid(const proto::SimTriadErrors& p, const char* field) {
   const Eigen::Vector3d scale_ppm = ToEigen(p.scale_ppm());
   const Eigen::Vector3d misalignment_deg = ToEigen(p.misalignment_deg());
-  if (!scale_ppm.allFinite() || scale_ppm.cwiseAbs().maxCoeff() + p.scale_max_ppm() > kMaxScalePpm) {
+  if (!scale_ppm.allFinite() ||
+      scale_ppm.cwiseAbs().maxCoeff() + p.scale_max_ppm() > kMaxScalePpm) {
     return Status::Error(fmt::format(
         "field {}.scale_ppm: |scale_ppm| + scale_max_ppm must be at most {} ppm per axis", field,
         kMaxScalePpm));

@@ -24,7 +24,7 @@ namespace tiltcal::simulate {
 // towards +x and by m_zy towards +y. So frame b is defined by the triad
 // itself (x axis and x-y plane), each triad separately.
 struct TriadErrors {
-  Eigen::Vector3d scale = Eigen::Vector3d::Zero();        // s_x, s_y, s_z (fractions)
+  Eigen::Vector3d scale = Eigen::Vector3d::Zero();             // s_x, s_y, s_z (fractions)
   Eigen::Vector3d misalignment_rad = Eigen::Vector3d::Zero();  // m_yx, m_zx, m_zy
   // K = I + S + M.
   Eigen::Matrix3d MeasuredFromTrue() const;

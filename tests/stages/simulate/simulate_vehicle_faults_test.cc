@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -274,10 +276,11 @@ TEST(SimulateVehicleFaultsTest, ImuIntrinsicsDrawnWithinBounds) {
   for (size_t i = 0; i < run.bag.imu.size(); ++i) {
     Eigen::Vector3d omega, force;
     TrueImu(scenario, params.imu().rate_hz(), static_cast<int>(i), &omega, &force);
-    ASSERT_LT((run.bag.imu[i].gyro - clean.bag.imu[i].gyro -
-               (k_gyro - Eigen::Matrix3d::Identity()) * omega).norm(), 1e-9);
-    ASSERT_LT((run.bag.imu[i].accel - clean.bag.imu[i].accel -
-               (k_accel - Eigen::Matrix3d::Identity()) * force).norm(), 1e-9);
+    const Eigen::Matrix3d identity = Eigen::Matrix3d::Identity();
+    const Eigen::Vector3d gyro_change = run.bag.imu[i].gyro - clean.bag.imu[i].gyro;
+    const Eigen::Vector3d accel_change = run.bag.imu[i].accel - clean.bag.imu[i].accel;
+    ASSERT_LT((gyro_change - (k_gyro - identity) * omega).norm(), 1e-9);
+    ASSERT_LT((accel_change - (k_accel - identity) * force).norm(), 1e-9);
   }
 }
 
@@ -338,8 +341,7 @@ TEST(SimulateVehicleFaultsTest, ImuVibration) {
     std::vector<double> accel_x, diff_x;  // faulty accel x; (faulty − clean) accel x, moving
     for (size_t i = 0; i < run.bag.imu.size(); ++i) {
       const double t = NominalImuStampNs(0, rate, static_cast<int>(i)) * 1e-9;
-      const double w =
-          moving_only ? scenario.trajectory->Evaluate(t).moving_rate : 1.0;
+      const double w = moving_only ? scenario.trajectory->Evaluate(t).moving_rate : 1.0;
       const Eigen::Vector3d dw = run.bag.imu[i].gyro - clean.bag.imu[i].gyro;
       const Eigen::Vector3d df = run.bag.imu[i].accel - clean.bag.imu[i].accel;
       for (int a = 0; a < 3; ++a) {
@@ -349,7 +351,9 @@ TEST(SimulateVehicleFaultsTest, ImuVibration) {
       if (moving_only && t < params.trajectory().static_start_s()) {
         ASSERT_EQ(dw.norm() + df.norm(), 0.0);
       }
-      if (!moving_only || t >= params.trajectory().static_start_s() + params.trajectory().ramp_s()) {
+      const double moving_from_s =
+          params.trajectory().static_start_s() + params.trajectory().ramp_s();
+      if (!moving_only || t >= moving_from_s) {
         accel_x.push_back(run.bag.imu[i].accel.x());
         diff_x.push_back(df.x());
       }
