@@ -2,9 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <string>
-
-#include <fmt/format.h>
 
 #include "stages/simulate/random.h"
 
@@ -27,23 +24,6 @@ bool InGap(const proto::SimFaultParams& faults, double t_s) {
 
 int64_t NominalImuStampNs(int64_t start_ns, double rate_hz, int i) {
   return start_ns + std::llround(static_cast<double>(i) * 1e9 / rate_hz);
-}
-
-Status SimFaultParamsAreValid(const proto::SimFaultParams& faults, double duration_s) {
-  for (int g = 0; g < faults.imu_gaps_size(); ++g) {
-    const proto::SimImuGap& gap = faults.imu_gaps(g);
-    if (gap.duration_s() <= 0) {
-      return Status::Error(fmt::format("field faults.imu_gaps[{}].duration_s = {} must be > 0", g,
-                                       gap.duration_s()));
-    }
-    if (gap.start_s() >= duration_s) {
-      return Status::Error(fmt::format(
-          "field faults.imu_gaps[{}].start_s = {} is not before the end of the sequence "
-          "(duration_s = {})",
-          g, gap.start_s(), duration_s));
-    }
-  }
-  return Status::Ok();
 }
 
 ImuSchedule MakeImuSchedule(int num_samples, double rate_hz, int64_t start_ns,

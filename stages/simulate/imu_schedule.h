@@ -4,7 +4,6 @@
 #include <cstdint>
 #include <vector>
 
-#include "common/status.h"
 #include "tiltcal/proto/simulate_params.pb.h"
 
 namespace tiltcal::simulate {
@@ -21,11 +20,6 @@ struct ImuSchedule {
 
 // Nominal time of sample i, ns (IMU clock).
 int64_t NominalImuStampNs(int64_t start_ns, double rate_hz, int i);
-
-// Checks what the schema bounds of `faults` cannot: every gap has a positive
-// duration and starts before `duration_s` (the scenario's). The error names
-// the field.
-Status SimFaultParamsAreValid(const proto::SimFaultParams& faults, double duration_s);
 
 // The stamps and the samples kept for `num_samples` samples at `rate_hz`
 // from `start_ns`. The jitter and the random drops each draw from their own

@@ -14,7 +14,14 @@ inline constexpr uint64_t kImuNoiseStream = 0;       // IMU white noise and bias
 inline constexpr uint64_t kWorldStream = 1;          // random boxes and pillars
 inline constexpr uint64_t kImuStampJitterStream = 2;  // SimFaultParams.imu_stamp_jitter_s
 inline constexpr uint64_t kImuDropStream = 3;         // SimFaultParams.imu_drop_fraction
+inline constexpr uint64_t kImuIntrinsicsStream = 4;   // SimFaultParams.*_intrinsics bounds
+inline constexpr uint64_t kImuVibrationStream = 5;    // SimFaultParams.imu_vibration phases
+inline constexpr uint64_t kLidarDropStream = 6;       // SimFaultParams.lidar_drop_fraction
+inline constexpr uint64_t kRollingGroundStream = 7;   // SimFaultParams.rolling_ground_* phases
+inline constexpr uint64_t kPedestrianStream = 8;      // SimFaultParams.pedestrians paths
 inline constexpr uint64_t kSweepStreamBase = 1000;    // + k: range noise of sweep k
+// + k: SimFaultParams.ground_roughness_m of sweep k
+inline constexpr uint64_t kGroundRoughnessStreamBase = uint64_t{1} << 32;
 
 class Rng {
  public:

@@ -24,6 +24,7 @@ float Intensity(Surface surface, double cos_incidence, uint16_t* reflectivity) {
     case Surface::kWall: base = 60.0; break;
     case Surface::kBox: base = 100.0; break;
     case Surface::kPillar: base = 140.0; break;
+    case Surface::kPerson: base = 80.0; break;
     default: break;
   }
   *reflectivity = static_cast<uint16_t>(base);
@@ -59,11 +60,13 @@ namespace {
 class LaserCaster {
  public:
   LaserCaster(const ScanConfig& config, const PlanarTrajectory& trajectory, const World& world,
-              uint64_t seed, int k)
+              const Pedestrians* pedestrians, uint64_t seed, int k)
       : config_(config),
         trajectory_(trajectory),
         world_(world),
+        pedestrians_(pedestrians != nullptr && !pedestrians->empty() ? pedestrians : nullptr),
         rng_(seed, kSweepStreamBase + static_cast<uint64_t>(k)),
+        roughness_rng_(seed, kGroundRoughnessStreamBase + static_cast<uint64_t>(k)),
         cos_el_(config.model.num_lasers()),
         sin_el_(config.model.num_lasers()) {
     for (int i = 0; i < config.model.num_lasers(); ++i) {
@@ -81,28 +84,41 @@ class LaserCaster {
     *r_wl = r_wb + c_wb * config_.imu_from_lidar_translation;
   }
 
-  // Casts laser i at horizontal angle alpha from the pose; fills *p (valid
-  // when a surface is hit within the range limits after the noise).
-  void Cast(const Eigen::Matrix3d& c_wl, const Eigen::Vector3d& r_wl, int i, double alpha,
-            ScanPoint* p) {
-    CastDirection(c_wl, r_wl, cos_el_[i], sin_el_[i], alpha, config_.model.ring[i], p);
+  // Casts laser i at horizontal angle alpha from the pose of time t; fills
+  // *p (valid when a surface is hit within the range limits after the noise).
+  void Cast(const Eigen::Matrix3d& c_wl, const Eigen::Vector3d& r_wl, double t, int i,
+            double alpha, ScanPoint* p) {
+    CastDirection(c_wl, r_wl, t, cos_el_[i], sin_el_[i], alpha, config_.model.ring[i], p);
   }
 
   // Casts a ray at elevation (cos_el, sin_el) and horizontal angle alpha,
-  // frame l, reported as `ring`.
-  void CastDirection(const Eigen::Matrix3d& c_wl, const Eigen::Vector3d& r_wl, double cos_el,
-                     double sin_el, double alpha, int ring, ScanPoint* p) {
+  // frame l, at time t (for the pedestrians), reported as `ring`.
+  void CastDirection(const Eigen::Matrix3d& c_wl, const Eigen::Vector3d& r_wl, double t,
+                     double cos_el, double sin_el, double alpha, int ring, ScanPoint* p) {
     const Eigen::Vector3d d_l(cos_el * std::cos(alpha), cos_el * std::sin(alpha), sin_el);
     const Eigen::Vector3d d_w = c_wl * d_l;
     RayHit hit;
     p->ring = static_cast<uint16_t>(ring);
     // Cast a little beyond the limits: noise may bring the range back inside.
     const double margin = 6.0 * config_.range_noise_m;
-    if (!world_.Cast(r_wl, d_w, std::max(0.0, config_.min_range_m - margin),
-                     config_.max_range_m + margin, &hit)) {
-      return;
+    const double min_range = std::max(0.0, config_.min_range_m - margin);
+    const double max_range = config_.max_range_m + margin;
+    bool hit_any = world_.Cast(r_wl, d_w, min_range, max_range, &hit);
+    if (pedestrians_ != nullptr &&
+        pedestrians_->Cast(world_, r_wl, d_w, t, min_range, hit_any ? hit.range : max_range,
+                           &hit)) {
+      hit_any = true;
     }
-    const double range = hit.range + config_.range_noise_m * rng_.Gaussian();
+    if (!hit_any) return;
+    double surface_range = hit.range;
+    if (config_.ground_roughness_m > 0.0 && hit.surface == Surface::kGround) {
+      // Height δ ~ N(0, σ²) along the plane normal n: n · d < 0 for a ground
+      // hit, so the ray meets the raised surface at s + δ / (n · d).
+      const double delta = config_.ground_roughness_m * roughness_rng_.Gaussian();
+      surface_range += delta / world_.ground_normal().dot(d_w);
+      if (surface_range <= 0.0) return;
+    }
+    const double range = surface_range + config_.range_noise_m * rng_.Gaussian();
     if (range < config_.min_range_m || range > config_.max_range_m) return;
     const Eigen::Vector3d q = range * d_l;
     p->x = static_cast<float>(q.x());
@@ -130,7 +146,9 @@ class LaserCaster {
   const ScanConfig& config_;
   const PlanarTrajectory& trajectory_;
   const World& world_;
+  const Pedestrians* pedestrians_;  // nullptr: none
   Rng rng_;
+  Rng roughness_rng_;
   std::vector<double> cos_el_, sin_el_;
 };
 
@@ -160,7 +178,7 @@ void SimulateVelodyneSweep(const ScanConfig& config, int64_t start_ns, LaserCast
       }
       const double alpha = -kTwoPi * config.scan_rate_hz * offset;
       ScanPoint p;
-      caster->Cast(c_wl, r_wl, i, alpha, &p);
+      caster->Cast(c_wl, r_wl, start_s + offset, i, alpha, &p);
       if (!p.valid) continue;
       p.time_s = static_cast<float>(start_minus_stamp_s + offset);
       ++scan->num_valid;
@@ -187,11 +205,12 @@ void SimulateOusterSweep(const ScanConfig& config, int64_t start_ns, LaserCaster
   Eigen::Vector3d r_wl;
   for (int c = 0; c < columns; ++c) {
     const int64_t t_ns = std::llround(c * column_period_ns);
-    caster->LidarPose((start_ns + t_ns) * 1e-9, &c_wl, &r_wl);
+    const double t = (start_ns + t_ns) * 1e-9;
+    caster->LidarPose(t, &c_wl, &r_wl);
     const double alpha = -kTwoPi * c / columns;
     for (int i = 0; i < lasers; ++i) {
       ScanPoint& p = scan->points[static_cast<size_t>(i) * columns + c];
-      caster->Cast(c_wl, r_wl, i, alpha, &p);
+      caster->Cast(c_wl, r_wl, t, i, alpha, &p);
       p.time_ns = static_cast<uint32_t>(t_ns);
       if (!p.valid) {
         p.x = p.y = p.z = std::numeric_limits<float>::quiet_NaN();
@@ -233,7 +252,8 @@ void SimulateLivoxSweep(const ScanConfig& config, int64_t start_ns, LaserCaster*
                       (1.0 - std::cos(kTwoPi * pattern.f2_hz * t + phase));
     }
     ScanPoint& p = scan->points[static_cast<size_t>(j)];
-    caster->CastDirection(c_wl, r_wl, std::cos(elevation), std::sin(elevation), azimuth, line, &p);
+    caster->CastDirection(c_wl, r_wl, t, std::cos(elevation), std::sin(elevation), azimuth, line,
+                          &p);
     p.time_ns = static_cast<uint32_t>(offset_ns);
     if (!p.valid) {
       p.x = p.y = p.z = 0.0f;
@@ -250,8 +270,9 @@ void SimulateLivoxSweep(const ScanConfig& config, int64_t start_ns, LaserCaster*
 }  // namespace
 
 SimulatedScan SimulateSweep(const ScanConfig& config, const PlanarTrajectory& trajectory,
-                            const World& world, uint64_t seed, int k) {
-  LaserCaster caster(config, trajectory, world, seed, k);
+                            const World& world, uint64_t seed, int k,
+                            const Pedestrians* pedestrians) {
+  LaserCaster caster(config, trajectory, world, pedestrians, seed, k);
   SimulatedScan scan;
   const int64_t start_ns = SweepStartNs(config, k);
   if (config.model.kind == LidarModel::Kind::kVelodyne) {

@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 
 #include "stages/simulate/lidar_model.h"
+#include "stages/simulate/pedestrians.h"
 #include "stages/simulate/trajectory.h"
 #include "stages/simulate/world.h"
 
@@ -52,6 +53,10 @@ struct ScanConfig {
   // Livox: fraction of points replaced by noise (a random range along the
   // ray, tag 0x01: high confidence of noise by spatial position).
   double livox_noise_fraction = 0.0;
+  // σ of the ground returns' height noise along the plane normal, m
+  // (SimFaultParams.ground_roughness_m: grass), from the sweep's own
+  // roughness stream (random.h).
+  double ground_roughness_m = 0.0;
   Eigen::Matrix3d imu_from_lidar_rotation = Eigen::Matrix3d::Identity();  // C_bl
   Eigen::Vector3d imu_from_lidar_translation = Eigen::Vector3d::Zero();   // r_b^{lb}
 };
@@ -67,8 +72,10 @@ double SweepSpanS(const ScanConfig& config);
 // that time (C_wl = C_wb C_bl, r_w^{lw} = r_w^{bw} + C_wb r_b^{lb}), with
 // Gaussian range noise from `seed` (one random stream per sweep, so sweeps
 // can be simulated in any order or in parallel with identical results).
+// `pedestrians` (none when nullptr) are cast at each firing's time.
 SimulatedScan SimulateSweep(const ScanConfig& config, const PlanarTrajectory& trajectory,
-                            const World& world, uint64_t seed, int k);
+                            const World& world, uint64_t seed, int k,
+                            const Pedestrians* pedestrians = nullptr);
 
 }  // namespace tiltcal::simulate
 

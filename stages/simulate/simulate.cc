@@ -19,7 +19,10 @@
 #include "common/io/eigen_proto.h"
 #include "common/io/provenance.h"
 #include "common/io/text_proto.h"
+#include "stages/simulate/fault_params.h"
+#include "stages/simulate/imu_intrinsics.h"
 #include "stages/simulate/imu_schedule.h"
+#include "stages/simulate/imu_vibration.h"
 #include "stages/simulate/point_cloud_layout.h"
 #include "stages/simulate/random.h"
 #include "tiltcal/proto/rig.pb.h"
@@ -153,6 +156,7 @@ Status MakeScanConfig(const proto::SimulateParams& params, ScanConfig* sc) {
   sc->max_range_m = lp.max_range_m();
   sc->range_noise_m = lp.range_noise_m();
   sc->livox_noise_fraction = lp.livox_noise_fraction();
+  sc->ground_roughness_m = params.faults().ground_roughness_m();
   const bool livox = sc->model.kind == LidarModel::Kind::kLivox;
   if (livox && lp.append_surface_label()) {
     return Status::Error("field lidar.append_surface_label: a Livox CustomMsg has no label field");
@@ -169,12 +173,22 @@ Status MakeScanConfig(const proto::SimulateParams& params, ScanConfig* sc) {
 }
 
 // The room with its walls, the boxes and pillars of the params and the
-// random obstacles.
+// random obstacles; the rolling ground of the faults, its phases in
+// *scenario.
 std::unique_ptr<World> MakeWorld(const proto::SimulateParams& params,
-                                 const PlanarTrajectory& trajectory) {
+                                 const PlanarTrajectory& trajectory, Scenario* scenario) {
   const auto& wp = params.world();
   auto world =
       std::make_unique<World>(trajectory.NormalInWorld(), wp.room_half_size_m(), wp.wall_height_m());
+  const auto& faults = params.faults();
+  if (faults.rolling_ground_amplitude_m() > 0) {
+    Rng rng(params.seed(), kRollingGroundStream);
+    scenario->rolling_phase_u_rad = rng.Uniform(0.0, 2.0 * M_PI);
+    scenario->rolling_phase_v_rad = rng.Uniform(0.0, 2.0 * M_PI);
+    world->SetRollingGround(trajectory.world_from_plane(), faults.rolling_ground_amplitude_m(),
+                            faults.rolling_ground_wavelength_m(), scenario->rolling_phase_u_rad,
+                            scenario->rolling_phase_v_rad);
+  }
   for (const auto& b : wp.boxes()) {
     const double z = world->GroundZ(b.center_x_m(), b.center_y_m());
     world->AddBox({b.center_x_m() - 0.5 * b.size_x_m(), b.center_x_m() + 0.5 * b.size_x_m(),
@@ -236,10 +250,15 @@ Status SetTiming(const proto::SimulateParams& params, Scenario* scenario) {
   const int64_t tau_ns = std::llround(params.rig().time_offset_s() * 1e9);
   const int64_t start = params.start_stamp_ns();
   scenario->time_offset_ns = tau_ns;
-  scenario->imu_clock_shift_ns = start + SweepStartNs(sc, 0) - tau_ns < 0 ? tau_ns : 0;
+  scenario->lidar_clock_drift_ppm = params.faults().lidar_clock_drift_ppm();
+  // The LiDAR clock with the IMU clock starting at `start`.
+  scenario->imu_start_stamp_ns = start;
+  scenario->imu_clock_shift_ns =
+      scenario->LidarStampNs(SweepStartNs(sc, 0)) < 0 ? tau_ns : 0;
   scenario->imu_start_stamp_ns = start + scenario->imu_clock_shift_ns;
-  // The latest stamp: the last IMU sample, or a LiDAR stamp |τ| later for τ < 0.
-  if (scenario->imu_start_stamp_ns + duration_ns + std::max<int64_t>(0, -tau_ns) >
+  // The latest stamp: the last IMU sample, or the LiDAR clock then (later
+  // for τ < 0 or a fast LiDAR clock).
+  if (std::max(scenario->imu_start_stamp_ns + duration_ns, scenario->LidarStampNs(duration_ns)) >
       kMaxRosTimeNs) {
     return Status::Error("field start_stamp_ns = " + std::to_string(start) +
                          " gives stamps beyond the ROS time range with this duration and "
@@ -248,9 +267,36 @@ Status SetTiming(const proto::SimulateParams& params, Scenario* scenario) {
   return Status::Ok();
 }
 
+// Which sweeps SimFaultParams.lidar_drop_fraction leaves out (one draw per
+// sweep from its own stream; the first and the last always stay).
+void DropScans(const proto::SimulateParams& params, Scenario* scenario) {
+  const double fraction = params.faults().lidar_drop_fraction();
+  const int n = scenario->num_scans;
+  scenario->scan_kept.assign(static_cast<size_t>(n), true);
+  scenario->num_scans_dropped = 0;
+  if (fraction <= 0) return;
+  Rng rng(params.seed(), kLidarDropStream);
+  for (int k = 0; k < n; ++k) {
+    const bool dropped = rng.Uniform() < fraction;
+    if (dropped && k > 0 && k < n - 1) {
+      scenario->scan_kept[static_cast<size_t>(k)] = false;
+      ++scenario->num_scans_dropped;
+    }
+  }
+}
+
 }  // namespace
 
+int64_t Scenario::LidarStampNs(int64_t true_rel_ns) const {
+  const int64_t drift_ns =
+      lidar_clock_drift_ppm == 0.0
+          ? 0
+          : std::llround(static_cast<double>(true_rel_ns) * lidar_clock_drift_ppm * 1e-6);
+  return imu_start_stamp_ns + true_rel_ns + drift_ns - time_offset_ns;
+}
+
 Status BuildScenario(const proto::SimulateParams& params, Scenario* scenario) {
+  TILTCAL_RETURN_IF_ERROR(SimFaultParamsAreValid(params.faults(), params.duration_s()));
   const TrajectoryConfig tc = MakeTrajectoryConfig(params);
   if ((tc.vibration_roll_rad > 0 || tc.vibration_pitch_rad > 0) &&
       tc.vibration_frequency_hz <= 0) {
@@ -261,10 +307,16 @@ Status BuildScenario(const proto::SimulateParams& params, Scenario* scenario) {
   TILTCAL_RETURN_IF_ERROR(CheckTrackFitsRoom(params, trajectory));
   TILTCAL_RETURN_IF_ERROR(MakeScanConfig(params, &scenario->scan));
   TILTCAL_RETURN_IF_ERROR(CheckLidarAboveGround(trajectory, scenario->scan));
-  scenario->world = MakeWorld(params, trajectory);
+  scenario->world = MakeWorld(params, trajectory, scenario);
   scenario->gravity_w = Eigen::Vector3d(0.0, 0.0, -params.gravity_norm_mps2());
-  TILTCAL_RETURN_IF_ERROR(SimFaultParamsAreValid(params.faults(), params.duration_s()));
-  return SetTiming(params, scenario);
+  if (params.faults().pedestrians().count() > 0) {
+    scenario->pedestrians = Pedestrians(params.faults().pedestrians(),
+                                        params.world().room_half_size_m(), params.duration_s(),
+                                        params.seed());
+  }
+  TILTCAL_RETURN_IF_ERROR(SetTiming(params, scenario));
+  DropScans(params, scenario);
+  return Status::Ok();
 }
 
 namespace {
@@ -316,7 +368,12 @@ class ImuSimulator {
         gyro_bias_(ToEigen(params_.gyro_bias_radps())),
         accel_bias_(ToEigen(params_.accel_bias_mps2())),
         last_gyro_bias_(gyro_bias_),
-        last_accel_bias_(accel_bias_) {}
+        last_accel_bias_(accel_bias_),
+        vibration_(params.faults().imu_vibration(), params.seed()) {
+    DrawImuIntrinsics(params.faults(), params.seed(), &gyro_errors_, &accel_errors_);
+    gyro_from_true_ = gyro_errors_.MeasuredFromTrue();
+    accel_from_true_ = accel_errors_.MeasuredFromTrue();
+  }
 
   // Simulates the samples stamped up to `stamp_ns` (all of them for
   // INT64_MAX) not yet simulated, and writes those the schedule keeps.
@@ -332,6 +389,9 @@ class ImuSimulator {
   // The biases of the last sample.
   const Eigen::Vector3d& last_gyro_bias() const { return last_gyro_bias_; }
   const Eigen::Vector3d& last_accel_bias() const { return last_accel_bias_; }
+  const TriadErrors& gyro_errors() const { return gyro_errors_; }
+  const TriadErrors& accel_errors() const { return accel_errors_; }
+  const ImuVibration& vibration() const { return vibration_; }
 
  private:
   Eigen::Vector3d Gaussian3() {
@@ -341,12 +401,19 @@ class ImuSimulator {
 
   Status SimulateSample(int i, uint32_t connection, ros1::BagWriter* writer) {
     const int64_t rel_ns = NominalImuStampNs(0, rate_, i);
-    const ImuState s = scenario_.trajectory->Evaluate(rel_ns * 1e-9);
+    const double t = rel_ns * 1e-9;
+    const ImuState s = scenario_.trajectory->Evaluate(t);
     max_yaw_rate_ = std::max(max_yaw_rate_, std::abs(s.yaw_rate_radps));
-    const Eigen::Vector3d omega = s.angular_velocity_b + gyro_bias_ + gyro_sigma_ * Gaussian3();
-    const Eigen::Vector3d force = s.world_from_imu.transpose() *
-                                      (s.acceleration_w - scenario_.gravity_w) +
-                                  accel_bias_ + accel_sigma_ * Gaussian3();
+    // What the triads feel (frame b): the motion plus the vibration; then
+    // what they read: K · that (imu_intrinsics.h), plus bias and noise.
+    Eigen::Vector3d omega_felt = s.angular_velocity_b;
+    Eigen::Vector3d force_felt =
+        s.world_from_imu.transpose() * (s.acceleration_w - scenario_.gravity_w);
+    vibration_.Add(t, s.moving_rate, &omega_felt, &force_felt);
+    if (!gyro_errors_.IsIdentity()) omega_felt = gyro_from_true_ * omega_felt;
+    if (!accel_errors_.IsIdentity()) force_felt = accel_from_true_ * force_felt;
+    const Eigen::Vector3d omega = omega_felt + gyro_bias_ + gyro_sigma_ * Gaussian3();
+    const Eigen::Vector3d force = force_felt + accel_bias_ + accel_sigma_ * Gaussian3();
     last_gyro_bias_ = gyro_bias_;
     last_accel_bias_ = accel_bias_;
     gyro_bias_ += gyro_walk_ * Gaussian3();
@@ -373,6 +440,9 @@ class ImuSimulator {
   const double gyro_published_per_si_, accel_published_per_si_;
   Eigen::Vector3d gyro_bias_, accel_bias_;
   Eigen::Vector3d last_gyro_bias_, last_accel_bias_;
+  const ImuVibration vibration_;
+  TriadErrors gyro_errors_, accel_errors_;
+  Eigen::Matrix3d gyro_from_true_, accel_from_true_;  // K_g, K_a
   int next_ = 0;
   double max_yaw_rate_ = 0.0;
   std::string message_;
@@ -420,6 +490,34 @@ void FillTruthScan(const Scenario& scenario, const TruthFrames& f, const Simulat
   ts->set_num_ground_points(scan.num_ground);
 }
 
+// The values the faults drew (only for the faults the scenario has, so a
+// clean scenario's truth keeps its fields).
+void FillFaultTruth(const proto::SimFaultParams& faults, const Scenario& scenario,
+                    const ImuSimulator& imu, proto::SimulationTruth* truth) {
+  if (faults.has_gyro_intrinsics()) *truth->mutable_gyro_intrinsics() = ToTruth(imu.gyro_errors());
+  if (faults.has_accel_intrinsics()) {
+    *truth->mutable_accel_intrinsics() = ToTruth(imu.accel_errors());
+  }
+  if (imu.vibration().enabled()) {
+    *truth->mutable_imu_vibration_gyro_phase_rad() = ToProto(imu.vibration().gyro_phase_rad());
+    *truth->mutable_imu_vibration_accel_phase_rad() = ToProto(imu.vibration().accel_phase_rad());
+  }
+  truth->set_num_scans_dropped(static_cast<uint32_t>(scenario.num_scans_dropped));
+  truth->set_rolling_ground_phase_u_rad(scenario.rolling_phase_u_rad);
+  truth->set_rolling_ground_phase_v_rad(scenario.rolling_phase_v_rad);
+  for (const Pedestrian& person : scenario.pedestrians.people()) {
+    proto::TruthPedestrian* t = truth->add_pedestrians();
+    t->set_radius_m(person.radius_m);
+    t->set_height_m(person.height_m);
+    t->set_speed_mps(person.speed_mps);
+    for (size_t j = 0; j < person.waypoints.size(); ++j) {
+      t->add_waypoint_x_m(person.waypoints[j].x());
+      t->add_waypoint_y_m(person.waypoints[j].y());
+      t->add_arrival_s(person.arrival_s[j]);
+    }
+  }
+}
+
 // The sequence-level truth, after every scan is in.
 void FillSequenceTruth(const proto::SimulateParams& params, const Scenario& scenario,
                        const TruthFrames& f, const ImuSimulator& imu,
@@ -455,6 +553,7 @@ void FillSequenceTruth(const proto::SimulateParams& params, const Scenario& scen
   truth->set_imu_clock_shift_ns(scenario.imu_clock_shift_ns);
   if (params.has_faults()) *truth->mutable_faults() = params.faults();
   truth->set_num_imu_samples_dropped(static_cast<uint32_t>(imu.num_dropped()));
+  FillFaultTruth(params.faults(), scenario, imu, truth);
 }
 
 // The rig a user would have measured: the true extrinsic with the errors of
@@ -504,6 +603,7 @@ class ScanWriter {
       summary->raycast_seconds += std::chrono::duration<double>(Clock::now() - t0).count();
       for (int j = 0; j < count; ++j) {
         const int k = first + j;
+        if (!scenario_.scan_kept[static_cast<size_t>(k)]) continue;
         const int64_t stamp = StampNs(scans_[j]);
         if (!ok_[j]) return Status::Error("scan " + std::to_string(k) + ": stamp is not a ROS time");
         TILTCAL_RETURN_IF_ERROR(imu->WriteUpTo(stamp, imu_conn, writer));
@@ -522,9 +622,9 @@ class ScanWriter {
   }
 
  private:
-  // The bag stamp of a sweep (LiDAR clock = IMU clock − τ).
+  // The bag stamp of a sweep (LiDAR clock: IMU clock − τ, with the drift).
   int64_t StampNs(const SimulatedScan& scan) const {
-    return scenario_.imu_start_stamp_ns + scan.stamp_true_ns - scenario_.time_offset_ns;
+    return scenario_.LidarStampNs(scan.stamp_true_ns);
   }
 
   // Simulates and serializes sweeps first .. first + count - 1.
@@ -535,8 +635,9 @@ class ScanWriter {
     auto work = [&](unsigned tid) {
       for (int j = static_cast<int>(tid); j < count; j += static_cast<int>(threads_)) {
         const int k = first + j;
-        scans_[j] =
-            SimulateSweep(scenario_.scan, *scenario_.trajectory, *scenario_.world, params_.seed(), k);
+        if (!scenario_.scan_kept[static_cast<size_t>(k)]) continue;  // left out, not simulated
+        scans_[j] = SimulateSweep(scenario_.scan, *scenario_.trajectory, *scenario_.world,
+                                  params_.seed(), k, &scenario_.pedestrians);
         ok_[j] = livox ? SerializeLivoxScan(scans_[j], static_cast<uint32_t>(k),
                                             StampNs(scans_[j]), lp.frame_id(), &messages_[j])
                        : SerializeScan(scans_[j], ouster, lp.append_surface_label(),
@@ -617,7 +718,7 @@ Status Run(const SimulatePaths& paths, const proto::SimulateParams& params, std:
   }
 
   summary.num_imu_samples = scenario.num_imu_samples;
-  summary.num_scans = scenario.num_scans;
+  summary.num_scans = scenario.num_scans - scenario.num_scans_dropped;
   summary.bag_bytes = writer.bytes_written();
   summary.total_seconds = std::chrono::duration<double>(Clock::now() - wall_start).count();
   PrintSummary(log, summary);

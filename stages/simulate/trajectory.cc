@@ -116,6 +116,7 @@ ImuState PlanarTrajectory::Evaluate(double t) const {
   const double psi = std::atan2(dp.y(), dp.x());
   const double dpsi = (dp.x() * ddp.y() - dp.y() * ddp.x()) / dp.squaredNorm() * dtheta;
   state.yaw_rate_radps = dpsi;
+  state.moving_rate = dsigma;
 
   // Vibration φ = A_r σ' sin(2πf t), ϑ = A_p σ' sin(2π 1.37 f t + 1).
   const double w1 = kTwoPi * config_.vibration_frequency_hz;

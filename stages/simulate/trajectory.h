@@ -46,6 +46,7 @@ struct ImuState {
   Eigen::Vector3d acceleration_w;  // m/s², r̈_w
   Eigen::Vector3d angular_velocity_b;  // ω_b, rad/s, resolved in b
   double yaw_rate_radps = 0.0;     // ψ̇ about the plane normal
+  double moving_rate = 0.0;        // σ'(t): 0 while static, 1 once moving
 };
 
 class PlanarTrajectory {

@@ -16,6 +16,89 @@ double World::GroundZ(double x, double y) const {
   return -(normal_.x() * x + normal_.y() * y) / normal_.z();
 }
 
+void World::SetRollingGround(const Eigen::Matrix3d& world_from_plane, double amplitude_m,
+                             double wavelength_m, double phase_u_rad, double phase_v_rad) {
+  plane_from_world_ = world_from_plane.transpose();
+  rolling_amplitude_m_ = amplitude_m;
+  rolling_wavenumber_ = 2.0 * M_PI / wavelength_m;
+  rolling_phase_u_ = phase_u_rad;
+  rolling_phase_v_ = phase_v_rad;
+}
+
+double World::RollingHeight(double u, double v, Eigen::Vector2d* gradient) const {
+  const double au = rolling_wavenumber_ * u + rolling_phase_u_;
+  const double av = rolling_wavenumber_ * v + rolling_phase_v_;
+  const double su = std::sin(au), sv = std::sin(av);
+  if (gradient != nullptr) {
+    *gradient = rolling_amplitude_m_ * rolling_wavenumber_ *
+                Eigen::Vector2d(std::cos(au) * sv, su * std::cos(av));
+  }
+  return rolling_amplitude_m_ * su * sv;
+}
+
+double World::GroundHeight(const Eigen::Vector3d& x_w) const {
+  if (rolling_amplitude_m_ <= 0.0) return 0.0;
+  const Eigen::Vector3d q = plane_from_world_ * x_w;
+  return RollingHeight(q.x(), q.y(), nullptr);
+}
+
+bool World::CastRollingGround(const Eigen::Vector3d& o, const Eigen::Vector3d& d,
+                              double min_range, double best, double* range,
+                              Eigen::Vector3d* normal) const {
+  // Along the ray, in plane coordinates: q(s) = q_o + s q_d; the ray is
+  // above the surface while g(s) = q_z(s) − h(q_x(s), q_y(s)) > 0.
+  const Eigen::Vector3d q_o = plane_from_world_ * o, q_d = plane_from_world_ * d;
+  if (q_d.z() >= 0.0) return false;
+  auto g = [&](double s) {
+    return q_o.z() + s * q_d.z() - RollingHeight(q_o.x() + s * q_d.x(), q_o.y() + s * q_d.y(),
+                                                 nullptr);
+  };
+  const double amplitude = rolling_amplitude_m_;
+  // The surface lies within |q_z| <= A: march from where the ray enters that
+  // slab to where it leaves it (or to `best`).
+  double s0 = std::max(0.0, (amplitude - q_o.z()) / q_d.z());
+  const double s_end = std::min(best, (-amplitude - q_o.z()) / q_d.z());
+  double g0 = g(s0);
+  if (g0 <= 0.0) return false;  // the origin is below the surface
+  const double horizontal = std::max(q_d.head<2>().norm(), 1e-12);
+  const double step = 2.0 * M_PI / rolling_wavenumber_ / 32.0 / horizontal;
+  while (s0 < s_end) {
+    const double s1 = std::min(s0 + step, s_end);
+    const double g1 = g(s1);
+    if (g1 <= 0.0) {
+      // Illinois false position on [s0, s1], g0 > 0 >= g1.
+      double a = s0, b = s1, ga = g0, gb = g1;
+      int side = 0;
+      double s = b;
+      for (int iteration = 0; iteration < 100 && b - a > 1e-9; ++iteration) {
+        s = (a * gb - b * ga) / (gb - ga);
+        const double gs = g(s);
+        if (gs > 0.0) {
+          a = s;
+          ga = gs;
+          if (side == 1) gb *= 0.5;
+          side = 1;
+        } else {
+          b = s;
+          gb = gs;
+          if (side == -1) ga *= 0.5;
+          side = -1;
+        }
+      }
+      if (s < min_range) return false;
+      Eigen::Vector2d gradient;
+      RollingHeight(q_o.x() + s * q_d.x(), q_o.y() + s * q_d.y(), &gradient);
+      *range = s;
+      *normal = plane_from_world_.transpose() *
+                Eigen::Vector3d(-gradient.x(), -gradient.y(), 1.0).normalized();
+      return true;
+    }
+    s0 = s1;
+    g0 = g1;
+  }
+  return false;
+}
+
 void World::AddBox(const Box& box) {
   boxes_.push_back(box);
   const double hx = 0.5 * (box.max_x - box.min_x), hy = 0.5 * (box.max_y - box.min_y);
@@ -75,15 +158,38 @@ double BoxEntry(const Box& box, const Eigen::Vector3d& o, const Eigen::Vector3d&
 
 }  // namespace
 
+bool CastPillar(const Pillar& pillar, const Eigen::Vector3d& o, const Eigen::Vector3d& d,
+                double min_range, double best, double* range, Eigen::Vector3d* normal) {
+  double exit = 0.0;
+  const double s = CircleEntry(o.x(), o.y(), d.x(), d.y(), pillar.center_x, pillar.center_y,
+                               pillar.radius, &exit);
+  if (!(s < best) || s < min_range) return false;
+  const Eigen::Vector3d p = o + s * d;
+  if (p.z() > pillar.top_z) return false;
+  *range = s;
+  *normal =
+      Eigen::Vector3d(p.x() - pillar.center_x, p.y() - pillar.center_y, 0.0) / pillar.radius;
+  return true;
+}
+
 bool World::Cast(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double min_range,
                  double max_range, RayHit* hit) const {
   double best = max_range;
   Surface surface = Surface::kNone;
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();
 
-  // Ground plane n · x = 0 (the sensor is above it, n · o > 0).
+  // Ground plane n · x = 0 (the sensor is above it, n · o > 0), or the
+  // rolling ground about it.
   const double denom = normal_.dot(d);
-  if (denom < 0.0) {
+  if (rolling_amplitude_m_ > 0.0) {
+    double s;
+    Eigen::Vector3d n;
+    if (CastRollingGround(o, d, min_range, best, &s, &n)) {
+      best = s;
+      surface = Surface::kGround;
+      normal = n;
+    }
+  } else if (denom < 0.0) {
     const double s = -normal_.dot(o) / denom;
     if (s >= min_range && s <= best) {
       best = s;
@@ -130,16 +236,12 @@ bool World::Cast(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double min_
 
   // Pillars: vertical cylinders, side surface only.
   for (const Pillar& pillar : pillars_) {
-    double exit = 0.0;
-    const double s = CircleEntry(o.x(), o.y(), d.x(), d.y(), pillar.center_x, pillar.center_y,
-                                 pillar.radius, &exit);
-    if (!(s < best) || s < min_range) continue;
-    const Eigen::Vector3d p = o + s * d;
-    if (p.z() > pillar.top_z) continue;
+    double s;
+    Eigen::Vector3d n;
+    if (!CastPillar(pillar, o, d, min_range, best, &s, &n)) continue;
     best = s;
     surface = Surface::kPillar;
-    normal = Eigen::Vector3d(p.x() - pillar.center_x, p.y() - pillar.center_y, 0.0) /
-             pillar.radius;
+    normal = n;
   }
 
   if (surface == Surface::kNone) return false;
