@@ -22,6 +22,7 @@
 #include "stages/simulate/imu_schedule.h"
 #include "stages/simulate/point_cloud_layout.h"
 #include "stages/simulate/random.h"
+#include "stages/simulate/tf_static_writer.h"
 #include "tiltcal/proto/rig.pb.h"
 
 namespace tiltcal::simulate {
@@ -264,6 +265,7 @@ Status BuildScenario(const proto::SimulateParams& params, Scenario* scenario) {
   scenario->world = MakeWorld(params, trajectory);
   scenario->gravity_w = Eigen::Vector3d(0.0, 0.0, -params.gravity_norm_mps2());
   TILTCAL_RETURN_IF_ERROR(SimFaultParamsAreValid(params.faults(), params.duration_s()));
+  TILTCAL_RETURN_IF_ERROR(TfStaticParamsAreValid(params));
   return SetTiming(params, scenario);
 }
 
@@ -597,6 +599,7 @@ Status Run(const SimulatePaths& paths, const proto::SimulateParams& params, std:
                                                  imu_type.md5sum, imu_type.definition);
   const uint32_t lidar_conn = writer.AddConnection(params.lidar().topic(), cloud_type.type,
                                                    cloud_type.md5sum, cloud_type.definition);
+  TILTCAL_RETURN_IF_ERROR(WriteTfStatic(params, scenario, &writer));
 
   SimulateSummary summary;
   ImuSimulator imu(params, scenario);
