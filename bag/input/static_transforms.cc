@@ -117,8 +117,9 @@ void Summarise(StaticTransforms* s) {
   const std::string imu = geometry::NormalizeFrameId(s->imu_frame_id);
   const std::string lidar = geometry::NormalizeFrameId(s->lidar_frame_id);
   if (imu.empty() || lidar.empty()) {
-    s->summary = fmt::format("the {} messages have no frame_id: tf_static cannot place them",
-                             imu.empty() ? "IMU" : "LiDAR");
+    s->summary = fmt::format(
+        "the {} frame is unknown (no message, or an empty frame_id): tf_static cannot place it",
+        imu.empty() ? "IMU" : "LiDAR");
     return;
   }
   if (imu == lidar) {
@@ -141,12 +142,13 @@ void Summarise(StaticTransforms* s) {
     return;
   }
   const geometry::FrameChain& c = s->imu_from_lidar;
-  const Eigen::Quaterniond& q = c.target_from_source_rotation;
+  Eigen::Quaterniond q = c.target_from_source_rotation;
+  if (q.w() < 0) q.coeffs() = -q.coeffs();  // as written to the provenance
   const Eigen::Vector3d euler_deg =
       geometry::Euler123FromRotation(q.toRotationMatrix()) * (180.0 / M_PI);
   const Eigen::Vector3d& r = c.target_from_source_translation;
   s->summary = fmt::format(
-      "tf_static gives imu_from_lidar along {}: rotation (w x y z) {:.6f} {:.6f} {:.6f} {:.6f} "
+      "imu_from_lidar along {}: rotation (w x y z) {:.6f} {:.6f} {:.6f} {:.6f} "
       "(Euler 1-2-3 {:.3f} {:.3f} {:.3f} deg), translation {:.4f} {:.4f} {:.4f} m",
       ChainText(c.frames), q.w(), q.x(), q.y(), q.z(), euler_deg.x(), euler_deg.y(),
       euler_deg.z(), r.x(), r.y(), r.z());

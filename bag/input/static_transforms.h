@@ -40,8 +40,9 @@ struct StaticTransforms {
   bool found = false;  // a chain joins the two frames (and they differ)
   geometry::FrameChain imu_from_lidar;  // target: IMU frame, source: LiDAR frame
   std::vector<std::string> warnings;    // transforms skipped or replaced by other values
-  // One sentence: "tf_static gives imu_from_lidar imu_link <- base_link <-
-  // velodyne: ..." or "no tf_static transform joins 'imu' and 'velodyne'".
+  // One sentence: "imu_from_lidar along imu_link <- base_link <- velodyne:
+  // rotation ..., translation ... m" or "no tf_static transform joins 'imu'
+  // and 'velodyne' (...)".
   std::string summary;
 };
 
