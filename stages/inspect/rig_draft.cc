@@ -67,8 +67,10 @@ std::string ExtrinsicLines(const bag::StaticTransforms& tf) {
   if (!tf.found) {
     return "# imu_from_lidar: not in the bag (" + Printable(tf.summary) +
            ").\n"
-           "# The calibration will estimate it from the motion. If you know it (the\n"
-           "# vehicle's URDF, a drawing, a tape measure), state it here, p_imu = R p_lidar + t:\n"
+           "# The calibration will estimate it from the motion, starting from the value\n"
+           "# stated here, which the rig requires: put in your best one (the vehicle's URDF,\n"
+           "# a drawing, a tape measure; p_imu = R p_lidar + t, quaternion w x y z, metres)\n"
+           "# and remove the '#':\n"
            "# imu_from_lidar { rotation { w: 1 x: 0 y: 0 z: 0 } translation { x: 0 y: 0 z: 0 } }\n";
   }
   const geometry::FrameChain& c = tf.imu_from_lidar;

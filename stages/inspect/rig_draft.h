@@ -5,9 +5,11 @@
 // has only the recording. It states the IMU and LiDAR topics (with their
 // frame ids in comments), the IMU units the check detects, the
 // IMU-from-LiDAR of the bag's /tf_static as imu_from_lidar (or, without one,
-// a comment that the calibration will estimate it), and imu_height_m as a
-// commented line with how to measure it. The text parses as a Rig (proto
-// rig.proto); tiltcal_decode accepts it once imu_height_m is filled in.
+// a comment that the calibration will estimate it and a commented template
+// for the starting value the rig requires), and imu_height_m as a commented
+// line with how to measure it. The text parses as a Rig (proto rig.proto);
+// tiltcal_decode accepts it once imu_height_m is filled in (and, without
+// /tf_static, imu_from_lidar).
 
 #include <ostream>
 #include <string>
