@@ -3,7 +3,8 @@
 
 // The in-memory form of the sensor messages decode reads, whatever the bag
 // format: std_msgs/Header, sensor_msgs/Imu, sensor_msgs/PointCloud2 and
-// PointField, and the Livox CustomMsg. ROS 1 (bag/ros1/messages.h, the ROS 1 wire format) and ROS 2
+// PointField, the Livox CustomMsg and tf2_msgs/TFMessage. ROS 1
+// (bag/ros1/messages.h, the ROS 1 wire format) and ROS 2
 // (bag/ros2/messages.h, CDR) decode into these same structs, so the decode
 // stage's sinks do not know which format a message came from.
 
@@ -108,6 +109,24 @@ struct LivoxCustomMessage {
   uint8_t rsvd[3] = {};
   std::vector<LivoxPoint> points;
 };
+
+// geometry_msgs/TransformStamped: the pose of frame `child_frame_id` in
+// frame `header.frame_id` (the parent): p_parent = R(rotation) p_child +
+// translation, translation in metres resolved in the parent.
+struct TransformStamped {
+  Header header;
+  std::string child_frame_id;
+  double translation[3] = {};        // x, y, z
+  double rotation[4] = {0, 0, 0, 1};  // x, y, z, w (as on the wire)
+};
+
+// tf2_msgs/TFMessage (ROS 1 also tf/tfMessage, the same layout): the
+// messages of /tf and /tf_static.
+struct TfMessage {
+  std::vector<TransformStamped> transforms;
+};
+// The topic of the static transforms, as tf2 names it.
+inline constexpr char kTfStaticTopic[] = "/tf_static";
 
 }  // namespace tiltcal::bag
 

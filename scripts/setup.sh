@@ -11,7 +11,7 @@ PACKAGES=(
   libpcl-dev libnanoflann-dev libprotobuf-dev protobuf-compiler
   liblz4-dev lz4 libbz2-dev libfmt-dev libsqlite3-dev libzstd-dev zlib1g-dev libpng-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  python3-rosbag python3-sensor-msgs python3-numpy python3-matplotlib python3-yaml
+  python3-rosbag python3-sensor-msgs python3-tf2 python3-numpy python3-matplotlib python3-yaml
   chromium
   clang libclang-rt-14-dev
 )

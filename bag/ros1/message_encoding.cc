@@ -176,6 +176,61 @@ const MessageType& LivoxCustomMsgMessageType() {
   return kType;
 }
 
+// tf2_msgs/TFMessage and geometry_msgs/TransformStamped, Transform, as in
+// ros/geometry2 and ros/common_msgs (noetic); the MD5 is genpy's.
+const char kTfMessageDefinitionTop[] = R"msgdef(geometry_msgs/TransformStamped[] transforms
+
+================================================================================
+MSG: geometry_msgs/TransformStamped
+# This expresses a transform from coordinate frame header.frame_id
+# to the coordinate frame child_frame_id
+#
+# This message is mostly used by the 
+# <a href="http://wiki.ros.org/tf">tf</a> package. 
+# See its documentation for more information.
+
+Header header
+string child_frame_id # the frame id of the child frame
+Transform transform
+
+)msgdef";
+const char kTfMessageDefinitionDependencies[] = R"msgdef(================================================================================
+MSG: geometry_msgs/Transform
+# This represents the transform between two coordinate frames in free space.
+
+Vector3 translation
+Quaternion rotation
+
+================================================================================
+MSG: geometry_msgs/Vector3
+# This represents a vector in free space. 
+# It is only meant to represent a direction. Therefore, it does not
+# make sense to apply a translation to it (e.g., when applying a 
+# generic rigid transformation to a Vector3, tf2 will only apply the
+# rotation). If you want your data to be translatable too, use the
+# geometry_msgs/Point message instead.
+
+float64 x
+float64 y
+float64 z
+================================================================================
+MSG: geometry_msgs/Quaternion
+# This represents an orientation in free space in quaternion form.
+
+float64 x
+float64 y
+float64 z
+float64 w
+)msgdef";
+
+const MessageType& TfMessageType() {
+  static const std::string kDefinition = std::string(kTfMessageDefinitionTop) +
+                                         kHeaderDefinition + kTfMessageDefinitionDependencies;
+  static const MessageType kType{kTfMessageType, "94810edda583a504dfda3829e70d7eec",
+                                 kDefinition.c_str()};
+  return kType;
+}
+
 namespace {
 
 void AppendString(std::string* out, const std::string& s) {
@@ -275,6 +330,19 @@ bool SerializeLivoxCustomMsg(uint32_t seq, int64_t timebase_ns, const std::strin
     out->push_back(static_cast<char>(p.line));
   }
   return true;
+}
+
+void SerializeTfMessage(const TfMessage& msg, std::string* out) {
+  out->clear();
+  AppendU32Le(out, static_cast<uint32_t>(msg.transforms.size()));
+  for (const TransformStamped& t : msg.transforms) {
+    AppendU32Le(out, t.header.seq);
+    AppendRosTime(out, t.header.stamp);
+    AppendString(out, t.header.frame_id);
+    AppendString(out, t.child_frame_id);
+    for (double v : t.translation) AppendLe(out, v);
+    for (double v : t.rotation) AppendLe(out, v);
+  }
 }
 
 }  // namespace tiltcal::ros1

@@ -11,7 +11,8 @@
 
 namespace tiltcal::ros1 {
 
-// Encoding of sensor_msgs/Imu and sensor_msgs/PointCloud2 into the ROS1 wire
+// Encoding of sensor_msgs/Imu, sensor_msgs/PointCloud2, the Livox CustomMsg
+// and tf2_msgs/TFMessage into the ROS1 wire
 // format (little-endian, no padding; string = u32 length + bytes; T[] = u32
 // count + elements; T[N] = N elements), and the connection data a bag
 // records for them. The decoding side is messages.h.
@@ -25,6 +26,8 @@ const MessageType& ImuMessageType();
 const MessageType& PointCloud2MessageType();
 // livox_ros_driver/CustomMsg (its CustomPoint as dependency).
 const MessageType& LivoxCustomMsgMessageType();
+// tf2_msgs/TFMessage (geometry_msgs/TransformStamped and its dependencies).
+const MessageType& TfMessageType();
 
 // std_msgs/Header: seq, stamp (u32 sec, u32 nsec), frame_id.
 // Returns false when stamp_ns is not representable as ROS time.
@@ -48,6 +51,9 @@ bool SerializePointCloud2(uint32_t seq, int64_t stamp_ns, const std::string& fra
 bool SerializeLivoxCustomMsg(uint32_t seq, int64_t timebase_ns, const std::string& frame_id,
                              uint8_t lidar_id, const std::vector<LivoxPoint>& points,
                              std::string* out);
+
+// tf2_msgs/TFMessage with the transforms as given.
+void SerializeTfMessage(const TfMessage& msg, std::string* out);
 
 }  // namespace tiltcal::ros1
 

@@ -152,4 +152,24 @@ Status DecodeLivoxCustomMsg(const uint8_t* data, size_t size, LivoxCustomMessage
   return r.ExpectEnd(kLivoxCustomMsgType);
 }
 
+Status DecodeTfMessage(const uint8_t* data, size_t size, TfMessage* msg) {
+  // A TransformStamped takes at least 12 (header) + 4 + 56 bytes.
+  constexpr size_t kMinTransformBytes = 72;
+  WireReader r(data, size);
+  uint32_t count = 0;
+  TILTCAL_RETURN_IF_ERROR(r.U32("transforms", &count));
+  if (count > size / kMinTransformBytes) {
+    return Status::Error("message runs past its record: " + std::to_string(count) +
+                         " transforms cannot fit in " + std::to_string(size) + " bytes");
+  }
+  msg->transforms.resize(count);
+  for (TransformStamped& t : msg->transforms) {
+    TILTCAL_RETURN_IF_ERROR(r.Header(&t.header));
+    TILTCAL_RETURN_IF_ERROR(r.String("transforms.child_frame_id", &t.child_frame_id));
+    TILTCAL_RETURN_IF_ERROR(r.F64s("transforms.transform.translation", t.translation, 3));
+    TILTCAL_RETURN_IF_ERROR(r.F64s("transforms.transform.rotation", t.rotation, 4));
+  }
+  return r.ExpectEnd(kTfMessageType);
+}
+
 }  // namespace tiltcal::ros1

@@ -24,12 +24,17 @@ inline constexpr char kPointCloud2Type[] = "sensor_msgs/PointCloud2";
 // Livox CustomMsg of livox_ros_driver and of livox_ros_driver2 built for ROS 1.
 inline constexpr char kLivoxCustomMsgType[] = "livox_ros_driver/CustomMsg";
 inline constexpr char kLivox2CustomMsgType[] = "livox_ros_driver2/CustomMsg";
+// The messages of /tf_static (tf2) and of the older tf package: one layout.
+inline constexpr char kTfMessageType[] = "tf2_msgs/TFMessage";
+inline constexpr char kTfLegacyMessageType[] = "tf/tfMessage";
 
 // The message structs are shared with ROS 2 (bag/sensor_messages.h).
 using bag::Header;
 using bag::LivoxCustomMessage;
 using bag::LivoxPoint;
 using bag::ImuMessage;
+using bag::TfMessage;
+using bag::TransformStamped;
 using bag::PointCloud2View;
 using bag::PointField;
 using bag::PointFieldType;
@@ -55,6 +60,12 @@ Status DecodePointCloud2(const uint8_t* data, size_t size, PointCloud2View* clou
 // u8 reflectivity tag line). point_num differing from the array's length is
 // an error. `msg->points` may be reused between calls.
 Status DecodeLivoxCustomMsg(const uint8_t* data, size_t size, LivoxCustomMessage* msg);
+
+// tf2_msgs/TFMessage (md5 94810edda583a504dfda3829e70d7eec): u32 count,
+// then per geometry_msgs/TransformStamped: header, string child_frame_id,
+// f64 translation x y z, f64 rotation x y z w. `msg->transforms` may be
+// reused between calls.
+Status DecodeTfMessage(const uint8_t* data, size_t size, TfMessage* msg);
 
 }  // namespace tiltcal::ros1
 

@@ -96,4 +96,24 @@ Status DecodeLivoxCustomMsg(const uint8_t* data, size_t size, bag::LivoxCustomMe
   return r.ExpectEnd(kLivox2CustomMsgType);
 }
 
+Status DecodeTfMessage(const uint8_t* data, size_t size, bag::TfMessage* msg) {
+  CdrReader r;
+  TILTCAL_RETURN_IF_ERROR(r.Open(data, size));
+  uint32_t count = 0;
+  TILTCAL_RETURN_IF_ERROR(r.U32("transforms", &count));
+  // A TransformStamped takes at least 8 (stamp) + 4 + 4 + 56 bytes.
+  if (count > size / 72) {
+    return Status::Error("message runs past its end: " + std::to_string(count) +
+                         " transforms cannot fit in " + std::to_string(size) + " bytes");
+  }
+  msg->transforms.resize(count);
+  for (bag::TransformStamped& t : msg->transforms) {
+    TILTCAL_RETURN_IF_ERROR(ReadHeader(&r, &t.header));
+    TILTCAL_RETURN_IF_ERROR(r.String("transforms.child_frame_id", &t.child_frame_id));
+    TILTCAL_RETURN_IF_ERROR(r.F64s("transforms.transform.translation", t.translation, 3));
+    TILTCAL_RETURN_IF_ERROR(r.F64s("transforms.transform.rotation", t.rotation, 4));
+  }
+  return r.ExpectEnd(kTfMessageType);
+}
+
 }  // namespace tiltcal::ros2

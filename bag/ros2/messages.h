@@ -24,6 +24,8 @@ inline constexpr char kPointCloud2Type[] = "sensor_msgs/msg/PointCloud2";
 inline constexpr char kLivox2CustomMsgType[] = "livox_ros_driver2/msg/CustomMsg";
 inline constexpr char kLivoxInterfacesCustomMsgType[] = "livox_interfaces/msg/CustomMsg";
 
+inline constexpr char kTfMessageType[] = "tf2_msgs/msg/TFMessage";
+
 // The serialization of the messages in rosbag2 and MCAP ("cdr").
 inline constexpr char kCdrEncoding[] = "cdr";
 
@@ -34,6 +36,11 @@ Status DecodePointCloud2(const uint8_t* data, size_t size, bag::PointCloud2View*
 // 8-byte aligned and every CustomPoint starts 4-byte aligned). point_num
 // differing from the array's length is an error. `msg->points` may be reused.
 Status DecodeLivoxCustomMsg(const uint8_t* data, size_t size, bag::LivoxCustomMessage* msg);
+
+// tf2_msgs/msg/TFMessage: a sequence of geometry_msgs/msg/TransformStamped
+// (header, string child_frame_id, f64 translation x y z, f64 rotation
+// x y z w; the doubles 8-byte aligned). `msg->transforms` may be reused.
+Status DecodeTfMessage(const uint8_t* data, size_t size, bag::TfMessage* msg);
 
 }  // namespace tiltcal::ros2
 

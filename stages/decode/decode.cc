@@ -12,6 +12,8 @@
 
 #include <fmt/format.h>
 
+#include "bag/input/bag_input.h"
+#include "bag/input/static_transforms.h"
 #include "bag/message_reader.h"
 #include "common/checked_conversion.h"
 #include "common/cli/command_line.h"
@@ -21,7 +23,6 @@
 #include "common/io/record_stream.h"
 #include "common/io/rig.h"
 #include "stages/decode/async_record_writer.h"
-#include "stages/decode/bag_input.h"
 #include "stages/decode/clock_domains.h"
 #include "stages/decode/decode_params.h"
 #include "stages/decode/imu_units_resolution.h"
@@ -151,6 +152,10 @@ void PrintSummary(std::ostream* log, const DecodePaths& paths,
                           ? fmt::format(" (LiDAR stamps shifted by {:.3f} s, lidar_stamp_shift_s)",
                                         shift_s)
                           : "");
+  *log << "  tf_static: " << s.tf_static.summary << "\n";
+  for (const std::string& warning : s.tf_static.warnings) {
+    *log << "  WARNING: tf_static: " << warning << "\n";
+  }
   for (const std::string& note : s.imu_notes) {
     const bool warning =
         std::find(s.imu_warnings.begin(), s.imu_warnings.end(), note) != s.imu_warnings.end();
@@ -208,10 +213,10 @@ Status CheckPaths(const DecodePaths& paths) {
 // the only topic of the type).
 Status OpenBag(const DecodePaths& paths, const proto::DecodeParams& params, const proto::Rig& rig,
                std::unique_ptr<bag::MessageReader>* input, DecodeSummary* s) {
-  decode::Ros1ChunkSettings ros1_chunks;
+  bag::Ros1ChunkSettings ros1_chunks;
   ros1_chunks.cache_size = std::max<uint32_t>(params.chunk_cache_size(), 1);
   ros1_chunks.read_ahead = params.read_ahead_chunks();
-  TILTCAL_RETURN_IF_ERROR(decode::OpenBagInput(paths.bag, ros1_chunks, input));
+  TILTCAL_RETURN_IF_ERROR(bag::OpenBagInput(paths.bag, ros1_chunks, input));
   const bag::MessageReader* reader = input->get();
   s->bag_bytes = reader->size_bytes();
   s->bag_format = reader->format_name();
@@ -223,7 +228,7 @@ Status OpenBag(const DecodePaths& paths, const proto::DecodeParams& params, cons
     return Status::Error(paths.bag + ": the bag holds no messages" +
                          (s->salvage_note.empty() ? "" : " (" + s->salvage_note + ")"));
   }
-  const decode::SensorTypes types = decode::SensorTypesOf(*reader);
+  const bag::SensorTypes types = bag::SensorTypesOf(*reader);
   std::string imu_type;
   TILTCAL_RETURN_IF_ERROR(ChooseTopic(*reader, {types.imu}, params.imu_topic(), rig.imu_topic(),
                                       "imu_topic", &s->imu_topic, &imu_type));
@@ -331,6 +336,10 @@ Status Decode(const DecodePaths& paths, const proto::DecodeParams& params, std::
   bag::MessageReader& reader = *input;
   bag::MessageSelection options;
   TILTCAL_RETURN_IF_ERROR(MakeReadOptions(reader, params, s, &options));
+  // The extrinsic of the vehicle's URDF, when /tf_static joins the sensors'
+  // frames: before the outputs are opened, so that both provenances hold it.
+  TILTCAL_RETURN_IF_ERROR(
+      bag::ReadStaticTransforms(reader, s.imu_topic, s.lidar_topic, &s.tf_static));
 
   // The bag as named, and every file read when they differ from it.
   std::vector<InputPath> input_paths = {{"bag", paths.bag}};
@@ -338,8 +347,9 @@ Status Decode(const DecodePaths& paths, const proto::DecodeParams& params, std::
     for (const std::string& file : s.bag_files) input_paths.push_back({"bag file", file});
   }
   if (!paths.rig.empty()) input_paths.push_back({"rig", paths.rig});
-  const proto::Provenance provenance =
+  proto::Provenance provenance =
       MakeProvenance("tiltcal_decode", params, input_paths, paths.command_line);
+  *provenance.mutable_tf_static() = bag::ToProto(s.tf_static);
 
   // Scans are serialized, framed and written on a second thread, 4 scans in
   // flight.

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "bag/input/static_transforms.h"
 #include "common/status.h"
 #include "tiltcal/proto/decode_params.pb.h"
 
@@ -58,6 +59,9 @@ struct DecodeSummary {
   std::vector<std::string> bag_files;  // every file read, in file-name order
   int64_t duplicates_dropped = 0;      // the same message in two files, given once
   uint64_t chunks_decompressed = 0;
+  // What /tf_static says about the extrinsic (also in both outputs'
+  // provenance, Provenance.tf_static).
+  bag::StaticTransforms tf_static;
   double wall_s = 0.0;
 };
 

@@ -113,9 +113,19 @@ void AddClockNotes(const proto::CheckParams& params, CheckFindings* f) {
   }
 }
 
+// The extrinsic of /tf_static, when there is one: a starting value the user
+// can take into the rig.
+void AddTfStaticNote(CheckFindings* f) {
+  if (!f->tf_static.found) return;
+  f->notes.push_back(
+      "the bag's /tf_static gives an IMU-from-LiDAR extrinsic: `tiltcal_inspect rig --bag=...` "
+      "drafts a rig.txtpb with it as imu_from_lidar (the calibration's starting value)");
+}
+
 }  // namespace
 
 void AddCalibrationNotes(const proto::CheckParams& params, CheckFindings* f) {
+  AddTfStaticNote(f);
   AddImuNotes(params, f);
   AddLidarNotes(params, f);
   AddClockNotes(params, f);

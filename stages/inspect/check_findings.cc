@@ -186,6 +186,8 @@ CheckFindings AnalyseSurvey(const BagSurvey& survey, const proto::Rig* rig,
                             const proto::CheckParams& params) {
   CheckFindings f;
   f.bag = survey.path;
+  f.format = survey.format;
+  f.tf_static = survey.tf_static;
   f.file_size = survey.file_size;
   f.indexed = survey.indexed;
   f.imu_topic = survey.imu_topic;

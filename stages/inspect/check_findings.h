@@ -57,6 +57,7 @@ struct ClockFindings {
 // 1); `notes` say what the data mean for the calibration.
 struct CheckFindings {
   std::string bag;
+  std::string format;  // "ROS 1 bag", "MCAP", ...
   uint64_t file_size = 0;
   bool indexed = true;
   std::string imu_topic, lidar_topic;
@@ -65,6 +66,7 @@ struct CheckFindings {
   ImuFindings imu;
   LidarFindings lidar;
   ClockFindings clock;
+  bag::StaticTransforms tf_static;  // what /tf_static says about the extrinsic
   std::vector<std::string> problems;
   std::vector<std::string> notes;
 };

@@ -131,9 +131,11 @@ void WriteExcitation(const CheckFindings& f, std::ostream& out) {
 }  // namespace
 
 void WriteCheckReport(const CheckFindings& f, std::ostream& out) {
-  out << fmt::format("bag      {} ({:.1f} MB, {})\n", f.bag,
+  out << fmt::format("bag      {} ({}, {:.1f} MB, {})\n", f.bag, f.format,
                      1e-6 * static_cast<double>(f.file_size),
                      f.indexed ? "indexed" : "no index: read record by record");
+  out << "tf_static " << f.tf_static.summary << "\n";
+  for (const std::string& warning : f.tf_static.warnings) out << "  WARNING: " << warning << "\n";
   WriteImu(f, out);
   WriteLidar(f, out);
   WriteClock(f, out);

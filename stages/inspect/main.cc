@@ -11,6 +11,7 @@
 #include "stages/inspect/ground_summary.h"
 #include "stages/inspect/inspect.h"
 #include "stages/inspect/pcd_export.h"
+#include "stages/inspect/rig_draft.h"
 
 namespace {
 
@@ -31,6 +32,15 @@ Status RunCheckCommand(const CommandLine& cli) {
   TILTCAL_RETURN_IF_ERROR(tiltcal::LoadParamsOrDefaults(
       cli.Get("params"), tiltcal::inspect::DefaultParamsText(), &params));
   return tiltcal::inspect::RunCheck({cli.Get("bag"), cli.Get("rig")}, params, std::cout);
+}
+
+// `rig --bag=... [--out=rig.txtpb] [--params=...]`: a rig drafted from a bag.
+Status RunRigCommand(const CommandLine& cli) {
+  tiltcal::proto::CheckParams params;
+  TILTCAL_RETURN_IF_ERROR(tiltcal::LoadParamsOrDefaults(
+      cli.Get("params"), tiltcal::inspect::DefaultParamsText(), &params));
+  return tiltcal::inspect::RunRigDraft({cli.Get("bag"), cli.Get("out")}, params, std::cout,
+                                       std::cerr);
 }
 
 Status RunCommand(const CommandLine& cli, const std::string& command, const std::string& path) {
@@ -57,10 +67,11 @@ Status RunCommand(const CommandLine& cli, const std::string& command, const std:
 
 int main(int argc, char** argv) {
   CommandLine cli("tiltcal_inspect", "looks into any file of the pipeline");
-  cli.SetPositional("info|cat|csv|pcd FILE  or  check",
+  cli.SetPositional("info|cat|csv|pcd FILE  or  check  or  rig",
                     "info: what the file is; cat: its records as text; csv: a table; "
                     "pcd: one scan as a PCD file; check: the pre-flight check of a bag "
-                    "(--bag, --rig, --params)",
+                    "(--bag, --rig, --params); rig: a rig.txtpb drafted from a bag (--bag, "
+                    "--out, --params)",
                     1, 2);
   cli.AddFlag("from", "cat: first record to print", tiltcal::cli::kOptional, "0");
   cli.AddFlag("count", "cat: number of records to print (-1: all)", tiltcal::cli::kOptional,
@@ -70,14 +81,18 @@ int main(int argc, char** argv) {
   cli.AddFlag("record", "csv --points / pcd: index of the scan", tiltcal::cli::kOptional, "0");
   cli.AddFlag("field", "csv of a text file: the repeated field to tabulate");
   cli.AddFlag("ground", "pcd: ground.binpb whose point masks label the points");
-  cli.AddFlag("out", "pcd: the PCD file to write");
-  cli.AddFlag("bag", "check: the ROS1 bag to look at");
+  cli.AddFlag("out", "pcd: the PCD file to write; rig: the rig to write (default: stdout)");
+  cli.AddFlag("bag",
+              "check, rig: the bag to look at (.bag, .mcap, .db3, a rosbag2 folder or a folder "
+              "of bag files)");
   cli.AddFlag("rig", "check, optional: rig.txtpb (topics, extrinsic for up, imu_height_m)");
   cli.AddFlag("params",
-              "check, optional: check params, text format (default: "
+              "check, rig, optional: check params, text format (default: "
               "stages/inspect/default_params.txtpb, compiled in)");
   cli.AddExample("tiltcal_inspect check --bag=datasets/husky/run1.bag "
                  "--rig=datasets/husky/rig.txtpb");
+  cli.AddExample("tiltcal_inspect rig --bag=datasets/husky/run1.bag "
+                 "--out=datasets/husky/rig.txtpb");
   cli.AddExample("tiltcal_inspect info out/run1/scans.binpb.lz4");
   cli.AddExample("tiltcal_inspect csv out/run1/ground.binpb > ground.csv");
   cli.AddExample("tiltcal_inspect csv out/run1/scans.binpb.lz4 --points --record=10");
@@ -87,12 +102,12 @@ int main(int argc, char** argv) {
   if (const auto exit_code = cli.Parse(argc, argv)) return *exit_code;
   const std::string& command = cli.positional()[0];
   if (command != "info" && command != "cat" && command != "csv" && command != "pcd" &&
-      command != "check") {
+      command != "check" && command != "rig") {
     std::cerr << "tiltcal_inspect: unknown command '" << command
-              << "' (info, cat, csv, pcd, check; see tiltcal_inspect --help)\n";
+              << "' (info, cat, csv, pcd, check, rig; see tiltcal_inspect --help)\n";
     return tiltcal::cli::kExitUsage;
   }
-  const bool check = command == "check";
+  const bool check = command == "check" || command == "rig";  // both take --bag
   if (cli.positional().size() != (check ? 1u : 2u) || (check && cli.Get("bag").empty())) {
     std::cerr << "tiltcal_inspect: " << command
               << (check ? " takes --bag=FILE and no FILE argument" : " needs one FILE")
@@ -100,7 +115,9 @@ int main(int argc, char** argv) {
     return tiltcal::cli::kExitUsage;
   }
   std::ios::sync_with_stdio(false);
-  Status status = check ? RunCheckCommand(cli) : RunCommand(cli, command, cli.positional()[1]);
+  Status status = command == "check" ? RunCheckCommand(cli)
+                  : command == "rig" ? RunRigCommand(cli)
+                                     : RunCommand(cli, command, cli.positional()[1]);
   if (status.ok()) status = FlushStdout();
   return cli.Finish(status);
 }

@@ -30,6 +30,9 @@ struct CloudLayout {
   std::string ring_type;
 };
 CloudLayout DescribeCloudLayout(const ros1::PointCloud2View& cloud);
+// A Livox CustomMsg: x, y, z, the time `timebase + offset_time` (ns) and
+// the ring `line`.
+CloudLayout DescribeLivoxLayout();
 
 // Every stride-th point of a cloud with finite coordinates (metres, LiDAR
 // frame) and, when the cloud has a time field, finite time offsets from the
@@ -43,6 +46,9 @@ struct CloudSample {
 // Errors name the layout problem (no x/y/z, a field outside the point, data
 // shorter than its rows).
 Status SampleCloud(const ros1::PointCloud2View& cloud, uint32_t stride, CloudSample* sample);
+// The same for a Livox CustomMsg: time offsets timebase + offset_time − the
+// header stamp.
+void SampleLivox(const bag::LivoxCustomMessage& msg, uint32_t stride, CloudSample* sample);
 
 }  // namespace tiltcal::inspect
 

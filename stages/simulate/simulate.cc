@@ -25,6 +25,7 @@
 #include "stages/simulate/imu_vibration.h"
 #include "stages/simulate/point_cloud_layout.h"
 #include "stages/simulate/random.h"
+#include "stages/simulate/tf_static_writer.h"
 #include "tiltcal/proto/rig.pb.h"
 
 namespace tiltcal::simulate {
@@ -314,6 +315,7 @@ Status BuildScenario(const proto::SimulateParams& params, Scenario* scenario) {
                                         params.world().room_half_size_m(), params.duration_s(),
                                         params.seed());
   }
+  TILTCAL_RETURN_IF_ERROR(TfStaticParamsAreValid(params));
   TILTCAL_RETURN_IF_ERROR(SetTiming(params, scenario));
   DropScans(params, scenario);
   return Status::Ok();
@@ -698,6 +700,7 @@ Status Run(const SimulatePaths& paths, const proto::SimulateParams& params, std:
                                                  imu_type.md5sum, imu_type.definition);
   const uint32_t lidar_conn = writer.AddConnection(params.lidar().topic(), cloud_type.type,
                                                    cloud_type.md5sum, cloud_type.definition);
+  TILTCAL_RETURN_IF_ERROR(WriteTfStatic(params, scenario, &writer));
 
   SimulateSummary summary;
   ImuSimulator imu(params, scenario);

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Reads the sensor_msgs/Imu, sensor_msgs/PointCloud2 and Livox CustomMsg messages of a ROS1
+"""Reads the sensor_msgs/Imu, sensor_msgs/PointCloud2, Livox CustomMsg and tf2_msgs/TFMessage messages of a ROS1
 bag with the real ROS library (Debian python3-rosbag) and prints them as the
 JSON lines write_ros2_bags.mjs --messages= takes, in record order: the same
 values as ROS 2 messages (std_msgs/Header without seq, stamp as
@@ -73,6 +73,17 @@ def main():
                                     p.tag, p.line) for p in msg.points)).decode("ascii"),
                 }
                 kind = livox_type
+            elif msg._type == "tf2_msgs/TFMessage":
+                ros2 = {"transforms": [{
+                    "header": header(t.header),
+                    "child_frame_id": t.child_frame_id,
+                    "transform": {"translation": vector(t.transform.translation),
+                                  "rotation": {"x": t.transform.rotation.x,
+                                               "y": t.transform.rotation.y,
+                                               "z": t.transform.rotation.z,
+                                               "w": t.transform.rotation.w}},
+                } for t in msg.transforms]}
+                kind = "tf2_msgs/msg/TFMessage"
             else:
                 continue
             # repr() of a float round-trips; json.dumps uses it.

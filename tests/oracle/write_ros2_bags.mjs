@@ -26,7 +26,8 @@
 // (/ouster/points) and Hesai (/hesai/pandar) layouts, 5 std_msgs/msg/String on
 // /chatter, interleaved in record time. --messages reads one JSON object per
 // line instead: {"topic", "type" ("sensor_msgs/msg/Imu" | "sensor_msgs/msg/PointCloud2" |
-// "livox_ros_driver2/msg/CustomMsg" | "livox_interfaces/msg/CustomMsg"), "record_ns"
+// "livox_ros_driver2/msg/CustomMsg" | "livox_interfaces/msg/CustomMsg" |
+// "tf2_msgs/msg/TFMessage" (CDR only)), "record_ns"
 // (string), "msg": the message with stamps as {sec, nanosec}, the cloud's data
 // in base64 as "data_b64", a CustomMsg's timebase as a string and its points
 // in base64 as "points_b64" (19 bytes each, the ROS 1 wire form)}.
@@ -82,6 +83,14 @@ const DEFINITIONS = {
     "MSG: livox_ros_driver2/CustomPoint\nuint32 offset_time\nfloat32 x\nfloat32 y\nfloat32 z\n" +
     "uint8 reflectivity\nuint8 tag\nuint8 line",
 };
+DEFINITIONS["tf2_msgs/msg/TFMessage"] =
+  "geometry_msgs/TransformStamped[] transforms" + SEP +
+  "MSG: geometry_msgs/TransformStamped\nstd_msgs/Header header\nstring child_frame_id\n" +
+  "geometry_msgs/Transform transform" + SEP + HEADER_DEFS + SEP +
+  "MSG: geometry_msgs/Transform\ngeometry_msgs/Vector3 translation\n" +
+  "geometry_msgs/Quaternion rotation" + SEP +
+  "MSG: geometry_msgs/Vector3\nfloat64 x\nfloat64 y\nfloat64 z" + SEP +
+  "MSG: geometry_msgs/Quaternion\nfloat64 x 0\nfloat64 y 0\nfloat64 z 0\nfloat64 w 1";
 // livox_interfaces (livox_ros2_driver) has the same fields.
 DEFINITIONS["livox_interfaces/msg/CustomMsg"] = DEFINITIONS["livox_ros_driver2/msg/CustomMsg"]
   .replaceAll("livox_ros_driver2/", "livox_interfaces/");

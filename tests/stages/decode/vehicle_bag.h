@@ -6,7 +6,9 @@
 // still for 2 s and then turns (up to 0.6 rad/s about z) from a level, z-up
 // start, and /points at 10 Hz (64 points on a ring, Velodyne layout with a
 // per-point `time`). Its IMU values can be published in other units or with
-// the other sign, and its LiDAR stamps on another clock, as drivers do.
+// the other sign, and its LiDAR stamps on another clock, as drivers do; it
+// can carry static transforms on /tf_static. IMU frame "imu_link", LiDAR
+// frame "lidar".
 
 #include <algorithm>
 #include <cmath>
@@ -42,6 +44,9 @@ struct VehicleBagOptions {
   int corrupt_imu_index = -1;
   double corrupt_accel_mps2 = 0.0;
   double corrupt_gyro_radps = 0.0;
+  // Messages on /tf_static (tf2_msgs/TFMessage), recorded 1 ms apart from
+  // the bag's start, before the first IMU message.
+  std::vector<bag::TfMessage> tf_static;
 };
 
 inline constexpr int64_t kVehicleBagStartNs = 1700000000000000000LL;
@@ -76,6 +81,17 @@ inline bool WriteVehicleBag(const std::string& path, const VehicleBagOptions& op
     std::string bytes;
   };
   std::vector<Message> messages;
+  if (!options.tf_static.empty()) {
+    const ros1::MessageType& tf_type = ros1::TfMessageType();
+    const uint32_t tf_connection =
+        writer.AddConnection(bag::kTfStaticTopic, tf_type.type, tf_type.md5sum, tf_type.definition);
+    for (size_t i = 0; i < options.tf_static.size(); ++i) {
+      Message m{kVehicleBagStartNs - 100000000 + static_cast<int64_t>(i) * 1000000, tf_connection,
+                ""};
+      ros1::SerializeTfMessage(options.tf_static[i], &m.bytes);
+      messages.push_back(std::move(m));
+    }
+  }
   const std::vector<imu::ImuReading> readings = VehicleBagImu(options.duration_s);
   for (size_t i = 0; i < readings.size(); ++i) {
     const int64_t stamp_ns = kVehicleBagStartNs + std::llround(readings[i].time_s * 1e9);

@@ -324,7 +324,8 @@ TEST(CheckBag, BagWithoutLidarTopicCannotBeCalibrated) {
   ASSERT_FALSE(run.status.ok());
   EXPECT_EQ(run.status.message(),
             dir.File("imu_only.bag") +
-                ": cannot be calibrated: LiDAR: no sensor_msgs/PointCloud2 topic in the bag "
+                ": cannot be calibrated: LiDAR: no sensor_msgs/PointCloud2 or "
+                "livox_ros_driver/CustomMsg or livox_ros_driver2/CustomMsg topic in the bag "
                 "(topics: /imu/data)");
   EXPECT_TRUE(Contains(run.report, "LiDAR    (none)\n")) << run.report;
   EXPECT_EQ(run.findings.imu.stamps.count, kImuSamples);  // the IMU part is still reported
@@ -410,7 +411,8 @@ TEST_F(CheckCommandLine, ExitCodes) {
   RewriteBag(sim.bag(), dir.File("imu_only.bag"), edits);
   EXPECT_EQ(Run("check --bag=" + dir.File("imu_only.bag") + " >/dev/null", &output), 1);
   EXPECT_EQ(output, "tiltcal_inspect: " + dir.File("imu_only.bag") +
-                        ": cannot be calibrated: LiDAR: no sensor_msgs/PointCloud2 topic in the "
+                        ": cannot be calibrated: LiDAR: no sensor_msgs/PointCloud2 or "
+                        "livox_ros_driver/CustomMsg or livox_ros_driver2/CustomMsg topic in the "
                         "bag (topics: /imu/data)\n");
 }
 

@@ -1,6 +1,6 @@
-#include "stages/decode/ros1_message_reader.h"
+#include "bag/input/ros1_message_reader.h"
 
-namespace tiltcal::decode {
+namespace tiltcal::bag {
 
 namespace {
 constexpr char kChunkPosition[] = "chunk at byte";
@@ -15,16 +15,16 @@ Status Ros1MessageReader::Open(const std::string& path) {
   return Status::Ok();
 }
 
-Status Ros1MessageReader::ReadMessages(const bag::MessageSelection& selection,
-                                       const std::function<Status(const bag::Message&)>& fn) {
+Status Ros1MessageReader::ReadMessages(const MessageSelection& selection,
+                                       const std::function<Status(const Message&)>& fn) {
   ros1::ReadOptions options;
   options.topics = selection.topics;
   options.start_ns = selection.start_ns;
   options.end_ns = selection.end_ns;
   options.chunk_cache_size = chunk_cache_size_;
   options.read_ahead_chunks = read_ahead_chunks_;
-  bag::Message m;
-  m.encoding = bag::Encoding::kRos1;
+  Message m;
+  m.encoding = Encoding::kRos1;
   m.file = nullptr;  // the one file: the path decode names first
   m.position_name = kChunkPosition;
   return reader_.ReadMessages(options, [&](const ros1::MessageView& v) {
@@ -38,4 +38,4 @@ Status Ros1MessageReader::ReadMessages(const bag::MessageSelection& selection,
   });
 }
 
-}  // namespace tiltcal::decode
+}  // namespace tiltcal::bag

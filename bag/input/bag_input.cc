@@ -1,4 +1,4 @@
-#include "stages/decode/bag_input.h"
+#include "bag/input/bag_input.h"
 
 #include <algorithm>
 #include <cstring>
@@ -11,9 +11,9 @@
 #include "bag/ros1/messages.h"
 #include "bag/ros2/messages.h"
 #include "bag/ros2/sqlite_bag_reader.h"
-#include "stages/decode/ros1_message_reader.h"
+#include "bag/input/ros1_message_reader.h"
 
-namespace tiltcal::decode {
+namespace tiltcal::bag {
 
 namespace fs = std::filesystem;
 
@@ -66,7 +66,7 @@ std::vector<std::string> BagFilesIn(const fs::path& folder) {
 
 template <typename Reader>
 Status OpenWith(std::unique_ptr<Reader> r, const std::string& path,
-                std::unique_ptr<bag::MessageReader>* reader) {
+                std::unique_ptr<MessageReader>* reader) {
   TILTCAL_RETURN_IF_ERROR(r->Open(path));
   *reader = std::move(r);
   return Status::Ok();
@@ -75,13 +75,13 @@ Status OpenWith(std::unique_ptr<Reader> r, const std::string& path,
 // Opens every file of `files` (each by its first bytes) and merges them;
 // a single file is opened alone.
 Status OpenFiles(const std::string& path, const std::vector<std::string>& files,
-                 const Ros1ChunkSettings& ros1_chunks, std::unique_ptr<bag::MessageReader>* reader) {
+                 const Ros1ChunkSettings& ros1_chunks, std::unique_ptr<MessageReader>* reader) {
   if (files.size() == 1) return OpenBagFile(files[0], ros1_chunks, reader);
-  std::vector<std::unique_ptr<bag::MessageReader>> readers(files.size());
+  std::vector<std::unique_ptr<MessageReader>> readers(files.size());
   for (size_t i = 0; i < files.size(); ++i) {
     TILTCAL_RETURN_IF_ERROR(OpenBagFile(files[i], ros1_chunks, &readers[i]));
   }
-  auto merged = std::make_unique<bag::MergedMessageReader>();
+  auto merged = std::make_unique<MergedMessageReader>();
   TILTCAL_RETURN_IF_ERROR(merged->Open(path, std::move(readers)));
   *reader = std::move(merged);
   return Status::Ok();
@@ -95,15 +95,18 @@ std::vector<std::string> SensorTypes::Lidar() const {
   return types;
 }
 
-SensorTypes SensorTypesOf(const bag::MessageReader& reader) {
-  const SensorTypes ros1_types = {ros1::kImuType, ros1::kPointCloud2Type,
-                                  {ros1::kLivoxCustomMsgType, ros1::kLivox2CustomMsgType}};
+SensorTypes SensorTypesOf(const MessageReader& reader) {
+  const SensorTypes ros1_types = {ros1::kImuType,
+                                  ros1::kPointCloud2Type,
+                                  {ros1::kLivoxCustomMsgType, ros1::kLivox2CustomMsgType},
+                                  {ros1::kTfMessageType, ros1::kTfLegacyMessageType}};
   const SensorTypes ros2_types = {
       ros2::kImuType,
       ros2::kPointCloud2Type,
-      {ros2::kLivox2CustomMsgType, ros2::kLivoxInterfacesCustomMsgType}};
+      {ros2::kLivox2CustomMsgType, ros2::kLivoxInterfacesCustomMsgType},
+      {ros2::kTfMessageType}};
   // A ROS 1 bag, or an MCAP with the ROS 1 type names, is read as ROS 1.
-  for (const bag::TopicInfo& t : reader.topics()) {
+  for (const TopicInfo& t : reader.topics()) {
     for (const std::string& type : ros1_types.Lidar()) {
       if (t.type == ros1::kImuType || t.type == type) return ros1_types;
     }
@@ -113,7 +116,7 @@ SensorTypes SensorTypesOf(const bag::MessageReader& reader) {
 }
 
 Status OpenBagInput(const std::string& path, const Ros1ChunkSettings& ros1_chunks,
-                    std::unique_ptr<bag::MessageReader>* reader) {
+                    std::unique_ptr<MessageReader>* reader) {
   std::error_code ec;
   const fs::path p(path);
   if (!fs::is_directory(p, ec)) return OpenBagFile(path, ros1_chunks, reader);
@@ -147,7 +150,7 @@ Status OpenBagInput(const std::string& path, const Ros1ChunkSettings& ros1_chunk
 }
 
 Status OpenBagFile(const std::string& path, const Ros1ChunkSettings& ros1_chunks,
-                   std::unique_ptr<bag::MessageReader>* reader) {
+                   std::unique_ptr<MessageReader>* reader) {
   // A file is recognised by its first bytes, whatever its name; anything
   // that is neither MCAP nor sqlite3 goes to the ROS 1 reader, whose errors
   // say what is wrong with it.
@@ -163,4 +166,4 @@ Status OpenBagFile(const std::string& path, const Ros1ChunkSettings& ros1_chunks
                                                      ros1_chunks.read_ahead), path, reader);
 }
 
-}  // namespace tiltcal::decode
+}  // namespace tiltcal::bag

@@ -1,7 +1,7 @@
-#ifndef TILTCAL_STAGES_DECODE_BAG_INPUT_H_
-#define TILTCAL_STAGES_DECODE_BAG_INPUT_H_
+#ifndef TILTCAL_BAG_INPUT_BAG_INPUT_H_
+#define TILTCAL_BAG_INPUT_BAG_INPUT_H_
 
-// Decode's input, chosen by its shape:
+// The input of tiltcal_decode and tiltcal_inspect, chosen by its shape:
 //   a file starting with the MCAP magic      MCAP (bag/mcap/), ROS 2 cdr or ROS 1
 //   a file starting with "SQLite format 3"   one rosbag2 sqlite3 .db3 (bag/ros2/)
 //   any other file                           ROS 1 bag (bag/ros1/), as before
@@ -22,17 +22,18 @@
 #include "bag/message_reader.h"
 #include "common/status.h"
 
-namespace tiltcal::decode {
+namespace tiltcal::bag {
 
 // The type names decode reads, in the naming of the input's format.
 struct SensorTypes {
   const char* imu;
   const char* point_cloud2;
   std::vector<std::string> livox;  // the Livox CustomMsg types of the format
+  std::vector<std::string> tf;     // the TFMessage types of /tf_static
   // The LiDAR types: point_cloud2, then the Livox types.
   std::vector<std::string> Lidar() const;
 };
-SensorTypes SensorTypesOf(const bag::MessageReader& reader);
+SensorTypes SensorTypesOf(const MessageReader& reader);
 
 // How the ROS 1 reader holds its chunks (decode params chunk_cache_size and
 // read_ahead_chunks).
@@ -43,12 +44,12 @@ struct Ros1ChunkSettings {
 
 // Opens `path` with the reader of its shape.
 Status OpenBagInput(const std::string& path, const Ros1ChunkSettings& ros1_chunks,
-                    std::unique_ptr<bag::MessageReader>* reader);
+                    std::unique_ptr<MessageReader>* reader);
 
 // Opens the one file `path` by its first bytes (MCAP, sqlite3, else ROS 1).
 Status OpenBagFile(const std::string& path, const Ros1ChunkSettings& ros1_chunks,
-                   std::unique_ptr<bag::MessageReader>* reader);
+                   std::unique_ptr<MessageReader>* reader);
 
-}  // namespace tiltcal::decode
+}  // namespace tiltcal::bag
 
-#endif  // TILTCAL_STAGES_DECODE_BAG_INPUT_H_
+#endif  // TILTCAL_BAG_INPUT_BAG_INPUT_H_

@@ -1,8 +1,8 @@
-#ifndef TILTCAL_STAGES_DECODE_ROS1_MESSAGE_READER_H_
-#define TILTCAL_STAGES_DECODE_ROS1_MESSAGE_READER_H_
+#ifndef TILTCAL_BAG_INPUT_ROS1_MESSAGE_READER_H_
+#define TILTCAL_BAG_INPUT_ROS1_MESSAGE_READER_H_
 
 // The ROS 1 bag reader (bag/ros1/bag_reader.h) behind the format-neutral
-// bag::MessageReader, so decode reads every format through one interface.
+// MessageReader, so every format is read through one interface.
 // Messages keep the reader's order and positions ("chunk at byte N").
 
 #include <string>
@@ -11,9 +11,9 @@
 #include "bag/message_reader.h"
 #include "bag/ros1/bag_reader.h"
 
-namespace tiltcal::decode {
+namespace tiltcal::bag {
 
-class Ros1MessageReader : public bag::MessageReader {
+class Ros1MessageReader : public MessageReader {
  public:
   // `chunk_cache_size`: decompressed chunks kept in memory;
   // `read_ahead_chunks`: chunks decompressed ahead on a second thread.
@@ -29,20 +29,20 @@ class Ros1MessageReader : public bag::MessageReader {
   int64_t num_salvaged_messages() const override { return reader_.num_salvaged_messages(); }
   std::string salvage_note() const override { return reader_.salvage_note(); }
   uint64_t chunks_decompressed() const override { return reader_.stats().chunks_decompressed; }
-  const std::vector<bag::TopicInfo>& topics() const override { return topics_; }
+  const std::vector<TopicInfo>& topics() const override { return topics_; }
   bool TimeRange(int64_t* start_ns, int64_t* end_ns) const override {
     return reader_.TimeRange(start_ns, end_ns);
   }
-  Status ReadMessages(const bag::MessageSelection& selection,
-                      const std::function<Status(const bag::Message&)>& fn) override;
+  Status ReadMessages(const MessageSelection& selection,
+                      const std::function<Status(const Message&)>& fn) override;
 
  private:
   size_t chunk_cache_size_;
   size_t read_ahead_chunks_;
   ros1::BagReader reader_;
-  std::vector<bag::TopicInfo> topics_;
+  std::vector<TopicInfo> topics_;
 };
 
-}  // namespace tiltcal::decode
+}  // namespace tiltcal::bag
 
-#endif  // TILTCAL_STAGES_DECODE_ROS1_MESSAGE_READER_H_
+#endif  // TILTCAL_BAG_INPUT_ROS1_MESSAGE_READER_H_
