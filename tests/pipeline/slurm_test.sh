@@ -26,6 +26,7 @@ cleanup() {
   rm -rf "$WORK"
 }
 trap cleanup EXIT
+trap 'exit 143' TERM INT HUP
 
 # Two flat 20 s sequences, as in end_to_end_test.sh, kept pristine in $WORK/dataset.
 mkdir -p "$WORK/dataset"
