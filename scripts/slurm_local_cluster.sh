@@ -76,12 +76,12 @@ start_daemon() {
   echo $! > "$pid_file"
 }
 
-# Fails naming LOG when the daemon of PID_FILE is gone.
+# Fails, showing the end of its log and output, when the daemon NAME is gone.
 check_alive() {
-  local name=$1 pid_file=$2 log=$3
-  kill -0 "$(cat "$pid_file")" 2> /dev/null || {
-    tail -5 "$log" >&2
-    die "$name exited at start (log: $log)"
+  local name=$1
+  kill -0 "$(cat "$DIR/$name.pid")" 2> /dev/null || {
+    tail -n 5 "$DIR/$name.log" "$DIR/$name.out" >&2 2> /dev/null || true
+    die "$name exited at start (logs: $DIR/$name.log, $DIR/$name.out)"
   }
 }
 
@@ -107,7 +107,7 @@ start() {
   munged --key-file="$DIR/munge/munge.key" --socket="$socket" \
     --pid-file="$DIR/munged.pid" --log-file="$DIR/munged.log" \
     --seed-file="$DIR/munge/munged.seed" --force 2>> "$DIR/munged.log" ||
-    { tail -5 "$DIR/munged.log" >&2; die "munged did not start (log: $DIR/munged.log)"; }
+    { tail -n 5 "$DIR/munged.log" >&2 2> /dev/null || true; die "munged did not start (log: $DIR/munged.log)"; }
 
   local host cpus memory_mb ctld_port slurmd_port
   host=$(hostname -s)
@@ -129,8 +129,8 @@ CredType=cred/munge
 AuthInfo=socket=$socket
 StateSaveLocation=$DIR/state
 SlurmdSpoolDir=$DIR/spool
-SlurmctldPidFile=$DIR/slurmctld.pid.conf
-SlurmdPidFile=$DIR/slurmd.pid.conf
+SlurmctldPidFile=$DIR/state/slurmctld.pid
+SlurmdPidFile=$DIR/spool/slurmd.pid
 SlurmctldLogFile=$DIR/slurmctld.log
 SlurmdLogFile=$DIR/slurmd.log
 ProctrackType=proctrack/linuxproc
@@ -158,14 +158,14 @@ EOF
   # Up when sinfo shows the node idle (about 2 s; 60 s at most).
   local state=""
   for _ in $(seq 120); do
-    check_alive slurmctld "$DIR/slurmctld.pid" "$DIR/slurmctld.log"
-    check_alive slurmd "$DIR/slurmd.pid" "$DIR/slurmd.log"
+    check_alive slurmctld
+    check_alive slurmd
     state=$(sinfo -h -n "$host" -o %T 2> /dev/null || true)
     [ "$state" = idle ] && break
     sleep 0.5
   done
   [ "$state" = idle ] || {
-    tail -5 "$DIR/slurmctld.log" "$DIR/slurmd.log" >&2
+    tail -n 5 "$DIR/slurmctld.log" "$DIR/slurmd.log" >&2 2> /dev/null || true
     die "the node $host is not idle after 60 s (state: ${state:-none}; logs in $DIR)"
   }
   echo "slurm_local_cluster: node $host idle ($cpus CPUs, $memory_mb MB); export SLURM_CONF=$SLURM_CONF" >&2
