@@ -9,8 +9,10 @@
 
 namespace tiltcal {
 
-// Parses a protobuf text-format file. Unknown fields are errors; the message
-// names the file, line and column. A directory, another non-regular file or an
+// Parses a protobuf text-format file. Unknown fields, and a non-repeated
+// field given twice in one message (also when its first value is the
+// default), are errors; the message names the file, line and column and,
+// for a duplicate, the field by its dotted path. A directory, another non-regular file or an
 // empty file is an error, not an empty message.
 Status ReadTextProto(const std::string& path, google::protobuf::Message* message);
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <tuple>
 
 #include <fmt/format.h>
 
@@ -13,6 +14,7 @@
 #include "common/io/provenance.h"
 #include "common/io/text_proto.h"
 #include "stages/calibrate/covariance_report.h"
+#include "stages/dataset_calibration/sequence_checks.h"
 
 namespace tiltcal::dataset {
 namespace {
@@ -25,19 +27,27 @@ int Dimension(const proto::DatasetCalibrationParams& params) {
   return params.time_offset_shared() ? 7 : 6;
 }
 
-// Why a sequence cannot be fused ("" when it can).
+// Why a sequence cannot be fused ("" when it can): left out by the user,
+// refused (sequence_checks.h; the reason names the file), or SUSPECT.
 std::string ReasonNotUsable(const SequenceCalibration& s,
                             const proto::DatasetCalibrationParams& params) {
   const auto& excluded = params.exclude_sequences();
   if (std::find(excluded.begin(), excluded.end(), s.name) != excluded.end()) {
     return "left out by exclude_sequences";
   }
-  if (s.result.covariance_size() != 49) return "no covariance";
-  for (double v : s.result.covariance()) {
-    if (!std::isfinite(v)) return "non-finite covariance";
+  if (s.result.covariance_size() == 0) return "no covariance";
+  const std::string refused = ReasonRefused(s.result, Dimension(params), params.input());
+  if (!refused.empty()) return s.path + ": " + refused;
+  switch (s.result.verdict()) {
+    case proto::CalibrationResult::OK:
+    case proto::CalibrationResult::WEAK:
+      return "";
+    case proto::CalibrationResult::SUSPECT:
+      return "verdict SUSPECT";
+    default:
+      return fmt::format("{}: verdict {} is not OK, WEAK or SUSPECT", s.path,
+                         static_cast<int>(s.result.verdict()));
   }
-  if (s.result.verdict() == proto::CalibrationResult::SUSPECT) return "verdict SUSPECT";
-  return "";
 }
 
 // Information of the translation prior of one solve, n x n (zero: none);
@@ -87,6 +97,7 @@ std::string DescribeComponent(int component, double z) {
 struct Fusion {
   std::vector<ExtrinsicEstimate> estimates;  // per sequence (empty rest: unusable)
   std::vector<bool> used;
+  int usable = 0;  // used before the consistency exclusion
   geometry::FusedExtrinsic fused;
 };
 
@@ -102,14 +113,15 @@ void FuseUsed(const std::vector<SequenceCalibration>& sequences, int n, Fusion* 
 }
 
 // With auto_exclude: leaves out the most inconsistent used sequence and fuses
-// again while one is beyond the limit and more than min_sequences remain.
+// again while one is beyond the limit and more than min_sequences (and more
+// than two: of two that disagree, neither is the better) remain.
 void ExcludeInconsistent(const std::vector<SequenceCalibration>& sequences,
                          const proto::DatasetCalibrationParams& params, int n, Fusion* f,
                          std::vector<std::string>* reasons) {
   const auto& consistency = params.consistency();
   while (consistency.auto_exclude()) {
     const auto used_count = std::count(f->used.begin(), f->used.end(), true);
-    if (used_count <= static_cast<long>(consistency.min_sequences())) return;
+    if (used_count <= std::max<long>(consistency.min_sequences(), 2)) return;
     int worst = -1;
     double worst_ratio = 1.0;
     std::string why;
@@ -212,30 +224,120 @@ void FillResult(const std::vector<SequenceCalibration>& sequences,
   out->set_translation_from_rig_m((extrinsic.translation - rig.translation).norm());
 }
 
-void DecideVerdict(const proto::DatasetCalibrationParams& params, proto::CalibrationResult* out) {
+proto::CalibrationResult::Verdict Worse(proto::CalibrationResult::Verdict a,
+                                        proto::CalibrationResult::Verdict b) {
+  const auto rank = [](proto::CalibrationResult::Verdict v) {
+    return v == proto::CalibrationResult::SUSPECT ? 2 : v == proto::CalibrationResult::WEAK ? 1 : 0;
+  };
+  return rank(a) >= rank(b) ? a : b;
+}
+
+// The used sequences that fail the consistency test (none could be left
+// out): their chi2 against the limit and the largest angle and distance
+// between two used extrinsics; "" when every used sequence is consistent.
+std::string Disagreement(const proto::DatasetCalibrationParams& params,
+                         const proto::CalibrationResult& out) {
+  std::vector<const proto::DatasetSequence*> used;
+  std::string failing;
+  for (const proto::DatasetSequence& s : out.sequences()) {
+    if (!s.used()) continue;
+    used.push_back(&s);
+    if (!s.consistent()) {
+      failing += fmt::format("{}{} chi2 {:.1f} > {:.1f} ({})", failing.empty() ? "" : ", ",
+                             s.name(), s.consistency_chi2(), s.consistency_limit(),
+                             s.disagreement());
+    }
+  }
+  if (failing.empty()) return "";
+  double angle_deg = -1.0, distance_m = -1.0;
+  std::string angle_pair, distance_pair;
+  for (size_t i = 0; i < used.size(); ++i) {
+    for (size_t j = i + 1; j < used.size(); ++j) {
+      const Rigid3d a = ToEigen(used[i]->imu_from_lidar());
+      const Rigid3d b = ToEigen(used[j]->imu_from_lidar());
+      const double angle =
+          Eigen::AngleAxisd(a.rotation.conjugate() * b.rotation).angle() * kDegPerRad;
+      const double distance = (a.translation - b.translation).norm();
+      const std::string pair = used[i]->name() + " and " + used[j]->name();
+      if (angle > angle_deg) std::tie(angle_deg, angle_pair) = std::tie(angle, pair);
+      if (distance > distance_m) std::tie(distance_m, distance_pair) = std::tie(distance, pair);
+    }
+  }
+  return fmt::format(
+      "the used sequences disagree and none can be left out ({} used, consistency.min_sequences "
+      "{}, auto_exclude {}): {}; largest angle between two used extrinsics {:.3f} deg ({}), "
+      "largest distance {:.4f} m ({})",
+      used.size(), params.consistency().min_sequences(),
+      params.consistency().auto_exclude() ? "true" : "false", failing, angle_deg, angle_pair,
+      distance_m, distance_pair);
+}
+
+// With one usable sequence the dataset's result is that sequence's: its
+// verdict (WEAK also when the dataset's observability thresholds see a weak
+// direction) and its reasons. With two or more: SUSPECT when fewer than
+// consistency.min_sequences are used, when a used sequence is inconsistent
+// with the joint value, or when the joint solve did not converge; else WEAK
+// or OK from the joint directions.
+void DecideVerdict(const std::vector<SequenceCalibration>& sequences,
+                   const proto::DatasetCalibrationParams& params, const Fusion& f,
+                   proto::CalibrationResult* out) {
   int used = 0;
+  const proto::CalibrationResult* single = nullptr;
   std::vector<std::string> notes;
-  for (const proto::DatasetSequence& s : out->sequences()) {
+  for (size_t i = 0; i < sequences.size(); ++i) {
+    const proto::DatasetSequence& s = out->sequences(static_cast<int>(i));
     if (s.used()) {
       ++used;
+      single = &sequences[i].result;
     } else {
       notes.push_back(fmt::format("left out {}: {}", s.name(), s.reason()));
     }
   }
-  std::vector<std::string> weak;
+  std::vector<std::string> reasons;
   for (const proto::ObservabilityDirection& d : out->observability()) {
-    if (d.weak()) weak.push_back("weakly determined: " + d.description());
+    if (d.weak()) reasons.push_back("weakly determined: " + d.description());
   }
-  out->clear_verdict_reasons();
-  if (used < static_cast<int>(params.consistency().min_sequences())) {
-    out->set_verdict(proto::CalibrationResult::SUSPECT);
-    out->add_verdict_reasons(fmt::format("only {} sequence(s) used (consistency.min_sequences {})",
-                                         used, params.consistency().min_sequences()));
+  proto::CalibrationResult::Verdict verdict =
+      reasons.empty() ? proto::CalibrationResult::OK : proto::CalibrationResult::WEAK;
+  if (f.usable == 1) {
+    verdict = Worse(verdict, single->verdict());
+    reasons.insert(reasons.begin(), "one sequence: no consistency check between sequences");
+    for (const std::string& r : single->verdict_reasons()) {
+      if (std::find(reasons.begin(), reasons.end(), r) == reasons.end()) reasons.push_back(r);
+    }
   } else {
-    out->set_verdict(weak.empty() ? proto::CalibrationResult::OK : proto::CalibrationResult::WEAK);
+    std::vector<std::string> suspect;
+    if (used < static_cast<int>(params.consistency().min_sequences())) {
+      suspect.push_back(fmt::format("only {} sequence(s) used (consistency.min_sequences {})",
+                                    used, params.consistency().min_sequences()));
+    }
+    const std::string disagreement = Disagreement(params, *out);
+    if (!disagreement.empty()) suspect.push_back(disagreement);
+    if (!f.fused.converged) {
+      suspect.push_back(fmt::format("the joint solve did not converge in {} iterations",
+                                    f.fused.iterations));
+    }
+    if (!suspect.empty()) verdict = proto::CalibrationResult::SUSPECT;
+    reasons.insert(reasons.begin(), suspect.begin(), suspect.end());
   }
-  for (const std::string& s : weak) out->add_verdict_reasons(s);
-  for (const std::string& s : notes) out->add_verdict_reasons(s);
+  out->set_verdict(verdict);
+  out->clear_verdict_reasons();
+  for (const std::string& r : reasons) out->add_verdict_reasons(r);
+  for (const std::string& r : notes) out->add_verdict_reasons(r);
+}
+
+// Exit 0 or 3 only with finite numbers (the inputs are checked, so this
+// holds; a failure here is an error, not a result).
+Status CheckFinite(const proto::CalibrationResult& out) {
+  const Rigid3d x = ToEigen(out.imu_from_lidar());
+  bool finite = x.rotation.coeffs().allFinite() && x.translation.allFinite() &&
+                std::isfinite(out.time_offset_s()) && std::isfinite(out.time_offset_sigma_s());
+  for (double v : out.covariance()) finite = finite && std::isfinite(v);
+  for (const proto::DatasetSequence& s : out.sequences()) {
+    finite = finite && std::isfinite(s.consistency_chi2()) && std::isfinite(s.consistency_limit());
+  }
+  if (finite) return Status::Ok();
+  return Status::Error("the joint solve gave non-finite values (extrinsic, tau or covariance)");
 }
 
 }  // namespace
@@ -243,6 +345,8 @@ void DecideVerdict(const proto::DatasetCalibrationParams& params, proto::Calibra
 Status CalibrateDataset(const std::vector<SequenceCalibration>& sequences,
                         const proto::DatasetCalibrationParams& params,
                         proto::CalibrationResult* out) {
+  TILTCAL_RETURN_IF_ERROR(ValidateSequenceInputParams(params.input()));
+  out->Clear();
   const int n = Dimension(params);
   Fusion f;
   f.estimates.resize(sequences.size());
@@ -250,14 +354,15 @@ Status CalibrateDataset(const std::vector<SequenceCalibration>& sequences,
   std::vector<std::string> reasons(sequences.size());
   std::string unusable;
   for (size_t i = 0; i < sequences.size(); ++i) {
-    reasons[i] = ReasonNotUsable(sequences[i], params);
-    if (sequences[i].result.covariance_size() == 49 && reasons[i] != "non-finite covariance") {
+    if (ReasonRefused(sequences[i].result, n, params.input()).empty()) {
       f.estimates[i] = ToEstimate(sequences[i].result, n);
     }
+    reasons[i] = ReasonNotUsable(sequences[i], params);
     f.used[i] = reasons[i].empty();
     if (!f.used[i]) unusable += fmt::format("; {}: {}", sequences[i].name, reasons[i]);
   }
-  if (std::find(f.used.begin(), f.used.end(), true) == f.used.end()) {
+  f.usable = static_cast<int>(std::count(f.used.begin(), f.used.end(), true));
+  if (f.usable == 0) {
     return Status::Error(fmt::format("no sequence can be used ({} read{})", sequences.size(),
                                      unusable));
   }
@@ -265,8 +370,8 @@ Status CalibrateDataset(const std::vector<SequenceCalibration>& sequences,
   ExcludeInconsistent(sequences, params, n, &f, &reasons);
   FillResult(sequences, params, f, out);
   FillSequences(sequences, params, f, reasons, out);
-  DecideVerdict(params, out);
-  return Status::Ok();
+  DecideVerdict(sequences, params, f, out);
+  return CheckFinite(*out);
 }
 
 namespace {

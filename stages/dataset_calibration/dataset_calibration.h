@@ -7,13 +7,21 @@
 // marginalised, linearised at the per-sequence optima), each sequence tested
 // against the joint value, inconsistent ones left out by the params' rule.
 //
-// Used: a calibration with a 7x7 covariance, not SUSPECT, not excluded by
-// the user. The result is a CalibrationResult: imu_from_lidar, its
-// covariance (7x7; the tau row and column are the fused tau when
-// time_offset_shared, else the weighted mean of the sequences' tau with the
-// larger of its sigma and their spread), the observability report and
-// verdict (WEAK from the joint covariance's directions, SUSPECT with fewer
-// than consistency.min_sequences used), and one DatasetSequence per input.
+// Usable: a calibration not excluded by the user, not refused by the input
+// checks (sequence_checks.h: non-finite numbers, non-unit quaternions, a
+// covariance that is not symmetric positive definite with bounded sigmas and
+// condition; the reason names the file) and OK or WEAK. The result is a
+// CalibrationResult: imu_from_lidar, its covariance (7x7; the tau row and
+// column are the fused tau when time_offset_shared, else the weighted mean
+// of the sequences' tau with the larger of its sigma and their spread), the
+// observability report, the verdict and one DatasetSequence per input.
+// Verdict: with one usable sequence, that sequence's (its value, and WEAK
+// also from the joint directions) with the reason "one sequence: no
+// consistency check between sequences"; with two or more, SUSPECT when fewer
+// than consistency.min_sequences are used, when a used sequence fails the
+// consistency test (named, with its chi2, the limit and the largest angle
+// between two used extrinsics) or when the joint solve does not converge,
+// else WEAK or OK from the joint covariance's directions.
 
 #include <ostream>
 #include <string>
@@ -31,7 +39,8 @@ struct SequenceCalibration {
   proto::CalibrationResult result;
 };
 
-// I/O free; an error when no sequence can be used.
+// I/O free; an error when no sequence can be used (or, which the input
+// checks rule out, the joint values are not finite).
 Status CalibrateDataset(const std::vector<SequenceCalibration>& sequences,
                         const proto::DatasetCalibrationParams& params,
                         proto::CalibrationResult* out);

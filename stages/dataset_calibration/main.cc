@@ -22,7 +22,8 @@ int main(int argc, char** argv) {
       "tiltcal_dataset_calibration --out=datasets/husky/out/calibration.txtpb "
       "datasets/husky/out/*/calibration.txtpb");
   cli.AddExitCode(tiltcal::cli::kExitSuspect,
-                  "result written but its verdict is SUSPECT (too few sequences used)");
+                  "result written but its verdict is SUSPECT (the used sequences disagree, or "
+                  "fewer than consistency.min_sequences used)");
   if (const auto exit_code = cli.Parse(argc, argv)) return *exit_code;
   tiltcal::dataset::DatasetCalibrationPaths paths;
   paths.calibrations = cli.positional();

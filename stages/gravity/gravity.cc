@@ -194,6 +194,8 @@ Status ReadDatasetReference(const std::string& rig_path, const proto::Rig& rig,
     return Status::Error(path + ": the gravity reference named by " + rig_path +
                          " has no gravity_flat_in_imu (was its sequence level?)");
   }
+  TILTCAL_RETURN_IF_ERROR(
+      ValidateGravityFlat(reference->gravity_flat_in_imu(), "gravity_flat_in_imu").WithContext(path));
   *source = "reference " + rig.gravity_reference();
   return Status::Ok();
 }

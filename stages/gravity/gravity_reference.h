@@ -14,7 +14,12 @@
 // residual) and is not SUSPECT (unless flat_calibrations.use_suspect). A used
 // g_a further than flat_calibrations.max_angle_from_combined_deg from g_f is
 // an error naming it: the IMU moved on the vehicle between runs, or a run did
-// not start on level ground.
+// not start on level ground. So are used g_a with no common direction within
+// that angle (e.g. opposite ones, whose mean direction does not exist), and
+// a g_a of any calibration that is not finite or whose norm lies outside
+// [min_gravity_norm_mps2, max_gravity_norm_mps2]; each error line names the
+// files and their g_a. A calibration whose g_a is zero has no estimate and is
+// left out.
 
 #include <ostream>
 #include <string>
@@ -31,6 +36,9 @@ struct FlatCalibration {
   std::string path;  // names it in the output and in errors
   proto::CalibrationResult result;
 };
+
+// min_gravity_norm_mps2 < max_gravity_norm_mps2.
+Status ValidateFlatCalibrationsParams(const proto::FlatCalibrationsParams& params);
 
 // Fills gravity_flat_in_imu, has_gravity_flat, gravity_flat_source and
 // flat_calibrations* of *out (I/O free).

@@ -45,21 +45,28 @@ truncate_half "$GOOD/seq.bag" "$BAD/truncated.bag"
 truncate_half "$GOOD/imu.binpb" "$BAD/truncated_imu.binpb"
 truncate_half "$GOOD/scans.binpb.lz4" "$BAD/truncated_scans.binpb.lz4"
 truncate_half "$GOOD/ground.binpb" "$BAD/truncated_ground.binpb"
-sed -E 's/^(  translation \{)/\1 x: nan/' "$GOOD/rig.txtpb" > "$BAD/nan_rig.txtpb"
-sed -E 's/^(  rotation \{)/\1 w: 1e300/' "$GOOD/rig.txtpb" > "$BAD/huge_rig.txtpb"
-echo "imu_height_m: -1" | cat "$GOOD/rig.txtpb" - > "$BAD/negative_height_rig.txtpb"
+sed -E '/^  translation \{/,/^  \}/ s/^(    x:).*/\1 nan/' "$GOOD/rig.txtpb" > "$BAD/nan_rig.txtpb"
+sed -E '/^  rotation \{/,/^  \}/ s/^(    w:).*/\1 1e300/' "$GOOD/rig.txtpb" > "$BAD/huge_rig.txtpb"
+grep -q "^    x: nan$" "$BAD/nan_rig.txtpb" && grep -q "^    w: 1e300$" "$BAD/huge_rig.txtpb" ||
+  { echo "the rig's translation x or rotation w not found" >&2; exit 1; }
+sed -E 's/^imu_height_m:.*/imu_height_m: -1/' "$GOOD/rig.txtpb" > "$BAD/negative_height_rig.txtpb"
+grep -q "^imu_height_m: -1$" "$BAD/negative_height_rig.txtpb" || { echo "no imu_height_m in the rig" >&2; exit 1; }
 echo "imu_from_lidar { rotation { w: nan } }" > "$BAD/nan_calibration.txtpb"
 echo "has_gravity_flat: true gravity_flat_in_imu { z: inf }" > "$BAD/inf_gravity.txtpb"
-params_with() {  # params_with STAGE TEXT FILE: the stage's defaults plus TEXT
-  { cat "$SRC/stages/$1/default_params.txtpb"; echo "$2"; } > "$3"
+# params_with STAGE FIELD VALUE FILE: the stage's defaults with the (one) line
+# of FIELD given VALUE instead (a field given twice is refused on its own).
+params_with() {
+  sed -E "s/^([[:space:]]*$2:).*/\1 $3/" "$SRC/stages/$1/default_params.txtpb" > "$4"
+  [ "$(grep -cE "^[[:space:]]*$2: $3\$" "$4")" = 1 ] || { echo "params_with: no one $2 in $1" >&2; exit 1; }
 }
-params_with decode "start_offset_s: 1e300" "$BAD/huge_decode_params.txtpb"
-params_with decode "min_range_m: nan" "$BAD/nan_decode_params.txtpb"
-params_with ground "static_detection { window_s: inf }" "$BAD/inf_ground_params.txtpb"
-params_with gravity "static_detection { hop_s: nan }" "$BAD/nan_gravity_params.txtpb"
-params_with calibrate "imu_noise { gyro_bias_segment_s: 1e-300 }" "$BAD/tiny_segment_params.txtpb"
-params_with calibrate "spline { knot_spacing_s: nan }" "$BAD/nan_calibrate_params.txtpb"
-{ cat "$GOOD/scenario.txtpb"; echo "duration_s: 1e300"; } > "$BAD/huge_scenario.txtpb"
+params_with decode start_offset_s 1e300 "$BAD/huge_decode_params.txtpb"
+params_with decode min_range_m nan "$BAD/nan_decode_params.txtpb"
+params_with ground window_s inf "$BAD/inf_ground_params.txtpb"
+params_with gravity hop_s nan "$BAD/nan_gravity_params.txtpb"
+params_with calibrate gyro_bias_segment_s 1e-300 "$BAD/tiny_segment_params.txtpb"
+params_with calibrate knot_spacing_s nan "$BAD/nan_calibrate_params.txtpb"
+sed -E 's/^duration_s:.*/duration_s: 1e300/' "$GOOD/scenario.txtpb" > "$BAD/huge_scenario.txtpb"
+grep -q "^duration_s: 1e300$" "$BAD/huge_scenario.txtpb" || { echo "no duration_s in the scenario" >&2; exit 1; }
 
 failures=0
 cases=0

@@ -2,7 +2,8 @@
 # End to end on a short simulated dataset: tiltcal_simulate writes two flat
 # sequences (real ROS1 bags + truth) and the rig, Makefile.pipeline runs every
 # stage with -j2, and the repeatability report must list both sequences with
-# their errors against the truth within loose bounds.
+# their errors against the truth within loose bounds; then a dataset of one
+# bag ends with its dataset calibration and its page.
 #   end_to_end_test.sh BUILD_DIR
 set -euo pipefail
 SRC=$(cd "$(dirname "$0")/../.." && pwd)
@@ -65,4 +66,32 @@ if /usr/bin/python3 -c 'import matplotlib' 2> /dev/null; then
 fi
 info=$("$BIN/tiltcal_inspect" info "$DATA/out/seq_1/scans.binpb.lz4")
 grep -qE "^records: 19[0-9]$" <<<"$info" || fail "inspect info does not count the scans"
+
+# One bag and a rig in a folder is a dataset: make ends with the dataset
+# calibration (that sequence's, with a reason saying there was no check
+# between sequences) and the page. The sequence's outputs are copied with
+# their times, so only the dataset-level stages run.
+ONE=$WORK/one_bag
+mkdir -p "$ONE/out"
+cp -p "$DATA/rig.txtpb" "$DATA/seq_1.bag" "$ONE/"
+cp -pr "$DATA/out/seq_1" "$ONE/out/"
+make --no-print-directory -s -f "$SRC/Makefile.pipeline" DATASET="$ONE" BIN="$BIN" -j2 \
+  > "$WORK/one.log" 2>&1 || { tail -20 "$WORK/one.log"; fail "make on a dataset of one bag failed"; }
+for f in calibration.txtpb report.html repeatability.txt; do
+  [ -s "$ONE/out/$f" ] || fail "one bag: no out/$f"
+done
+grep -qE "^verdict: (OK|WEAK)$" "$ONE/out/calibration.txtpb" || fail "one bag: dataset verdict"
+grep -q "one sequence: no consistency check between sequences" "$ONE/out/calibration.txtpb" ||
+  fail "one bag: the dataset calibration does not say it had one sequence"
+if command -v chromium > /dev/null; then
+  dom=$(chromium --headless --no-sandbox --disable-gpu --no-first-run \
+    --user-data-dir="$WORK/chromium" --virtual-time-budget=2000 \
+    --dump-dom "file://$ONE/out/report.html" 2> /dev/null) || fail "one bag: chromium failed"
+  [ "$(grep -o '<section class="sequence"' <<<"$dom" | wc -l)" = 1 ] ||
+    fail "one bag: the page does not show one sequence"
+  grep -q "one sequence: no consistency check between sequences" <<<"$dom" ||
+    fail "one bag: the page does not say there was one sequence"
+else
+  echo "chromium is not installed (scripts/setup.sh installs it): the one-bag page not opened"
+fi
 echo PASS

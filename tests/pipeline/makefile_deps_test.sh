@@ -49,7 +49,7 @@ fail() { echo "FAIL: $*" >&2; exit 1; }
 # Stages that `make -n` would run, one "stage sequence" per line, sorted.
 planned() {
   "${MAKE[@]}" -n "$@" | sed -e ':a' -e '/\\$/N; s/\\\n//; ta' | perl -ne '
-    next unless /(tiltcal_[a-z_]+|plot_[a-z_]+\.py)/; my $stage = $1;
+    next if /^echo /; next unless /(tiltcal_[a-z_]+|plot_[a-z_]+\.py)/; my $stage = $1;
     my ($seq) = $stage =~ /^tiltcal_(dataset_calibration|gravity_reference)$/ ? ("") :
       m{/out/([^/ ]+)/} ? ($1) : m{/([^/ ]+)\.bag} ? ($1) : ("");
     print $seq eq "" ? "$stage\n" : "$stage $seq\n";' | sort -u | tr '\n' ';'

@@ -75,6 +75,57 @@ TEST(Params, NanIsRejected) {
   EXPECT_NE(status.message().find("not finite"), std::string::npos) << status.message();
 }
 
+// protobuf's parser alone refuses "x: 5  x: 0" but keeps 5 of "x: 0  x: 5"
+// (a proto3 scalar at its default is not "present"): both are refused.
+TEST(Params, AFieldGivenTwiceIsRefusedInEitherOrder) {
+  for (const char* twice :
+       {"min_range_m: 0\nmin_range_m: 0.5\n", "min_range_m: 0.5\nmin_range_m: 0\n",
+        "min_range_m: 0\nmin_range_m: 0\n", "min_range_m: 0.5; min_range_m: 0.5\n"}) {
+    proto::DecodeParams params;
+    const Status status =
+        LoadFromText(std::string("chunk_cache_size: 4\nmax_stamp_gap_s: 60\n") + twice, &params);
+    ASSERT_FALSE(status.ok()) << twice;
+    EXPECT_NE(status.message().find("params.txtpb: line "), std::string::npos) << status.message();
+    EXPECT_NE(status.message().find("field min_range_m is given twice (first at line 3, column 1)"),
+              std::string::npos)
+        << status.message();
+  }
+}
+
+TEST(Params, ANestedFieldOrMessageGivenTwiceIsRefusedWithItsPath) {
+  const std::string defaults = testing::SourceDir() + "/stages/ground/default_params.txtpb";
+  std::string text;
+  ASSERT_TRUE(ReadFileToString(defaults, &text).ok());
+  proto::GroundParams params;
+  Status status = ParseTextProto(text, "ground.txtpb", &params);
+  ASSERT_TRUE(status.ok()) << status.message();
+  // A scalar at its default (0) then 1.5, inside a nested message.
+  const std::string nested_scalar = "frame {\n  use_rig_up_direction: true\n  "
+                                    "sensor_height_guess_m: 0.0\n  sensor_height_guess_m: 1.5\n}\n";
+  std::string edited = text;
+  const size_t frame = edited.find("frame {");
+  ASSERT_NE(frame, std::string::npos);
+  edited.replace(frame, edited.find("}", frame) + 2 - frame, nested_scalar);
+  status = ParseTextProto(edited, "ground.txtpb", &params);
+  ASSERT_FALSE(status.ok());
+  EXPECT_NE(status.message().find("ground.txtpb: line "), std::string::npos) << status.message();
+  EXPECT_NE(status.message().find("field frame.sensor_height_guess_m is given twice"),
+            std::string::npos)
+      << status.message();
+  // The whole nested message twice, the first one empty.
+  status = ParseTextProto("frame {}\n" + text, "ground.txtpb", &params);
+  ASSERT_FALSE(status.ok());
+  EXPECT_NE(status.message().find("field frame is given twice (first at line 1, column 1)"),
+            std::string::npos)
+      << status.message();
+  // Repeated fields and lists may be given more than once.
+  proto::GroundParams repeated;
+  status = ParseTextProto("zone_model { rings: 2 rings: [4, 4] rings: 4 }", "ground.txtpb",
+                          &repeated);
+  ASSERT_TRUE(status.ok()) << status.message();
+  EXPECT_EQ(repeated.zone_model().rings_size(), 4);
+}
+
 TEST(TextProto, WriteThenReadRoundTripsDoublesExactly) {
   testing::TempDir dir;
   proto::DecodeParams params;

@@ -90,13 +90,6 @@ class DecodeCli : public ::testing::Test {
     return bag;
   }
 
-  // The default params with `extra` appended, as a file in tmp_.
-  std::string ParamsWith(const std::string& extra) {
-    const std::string params = tmp_.File("params.txtpb");
-    WriteFile(params, testing::ReadFileOrEmpty(params_) + "\n" + extra + "\n");
-    return params;
-  }
-
   testing::TempDir tmp_;
   std::string params_;
 };
@@ -215,10 +208,10 @@ TEST_F(DecodeCli, MessageRunningPastItsRecord) {
 
 TEST_F(DecodeCli, ParamsOutOfRange) {
   const std::string params = tmp_.File("bad.txtpb");
-  WriteFile(params, testing::ReadFileOrEmpty(params_) + "\nmin_range_m: -1\n");
+  ASSERT_TRUE(WriteDefaultParamsWith(params, "min_range_m: 0.5", "min_range_m: -1"));
   std::string output;
   const int rc = Decode("/nonexistent.bag", params, &output);
-  ExpectCleanFailure(rc, output, {params, "min_range_m"});
+  ExpectCleanFailure(rc, output, {params, "min_range_m = -1 is below its minimum"});
 }
 
 TEST_F(DecodeCli, ParamsUnknownField) {
@@ -427,7 +420,11 @@ TEST_F(DecodeCli, ClockDomainsTenMinutesApart) {
                 "-599.981\n");
   ExpectCleanFailure(rc, output, {});
 
-  ASSERT_EQ(Decode(bag, ParamsWith("lidar_stamp_shift_s: -599.981"), &output), 0) << output;
+  // The defaults with lidar_stamp_shift_s replaced (a field given twice is an error).
+  const std::string params = tmp_.File("params.txtpb");
+  ASSERT_TRUE(
+      WriteDefaultParamsWith(params, "lidar_stamp_shift_s: 0", "lidar_stamp_shift_s: -599.981"));
+  ASSERT_EQ(Decode(bag, params, &output), 0) << output;
   EXPECT_NE(output.find("  clocks: IMU and LiDAR stamps overlap for 11.900 s (LiDAR stamps "
                         "shifted by -599.981 s, lidar_stamp_shift_s)\n"),
             std::string::npos)

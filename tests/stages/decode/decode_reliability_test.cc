@@ -103,9 +103,12 @@ TEST_F(DecodeReliability, ZeroStampsAreRefused) {
 TEST_F(DecodeReliability, HugeStartOffsetIsAParamsError) {
   const std::string bag = VehicleBag("vehicle.bag", {});
   const std::string params = tmp_.File("params.txtpb");
-  std::ofstream(params) << testing::ReadFileOrEmpty(testing::SourceDir() +
-                                                    "/stages/decode/default_params.txtpb")
-                        << "\nstart_offset_s: 1e300\n";
+  std::string text =
+      testing::ReadFileOrEmpty(testing::SourceDir() + "/stages/decode/default_params.txtpb");
+  const std::string line = "start_offset_s: 0";
+  ASSERT_NE(text.find(line), std::string::npos);
+  text.replace(text.find(line), line.size(), "start_offset_s: 1e300");
+  std::ofstream(params) << text;
   std::string output;
   const int rc = testing::RunCommand(DecodeCommand(bag, "--params=" + params), &output);
   ExpectCleanFailure(rc, output, {params, "start_offset_s", "maximum"});

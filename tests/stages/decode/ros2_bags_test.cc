@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -175,9 +176,13 @@ TEST_F(DecodeRos2BadInput, CorruptedMcapChunkNamesFileAndByte) {
     f.put('\x5A');
   }
   // The oracle bag has three PointCloud2 topics: choose one.
+  // The defaults with lidar_topic replaced (a field given twice is an error).
   std::ifstream defaults(testing::SourceDir() + "/stages/decode/default_params.txtpb");
-  std::ofstream(dir_.File("params.txtpb"))
-      << defaults.rdbuf() << "\nlidar_topic: \"/velodyne_points\"\n";
+  std::string text((std::istreambuf_iterator<char>(defaults)), std::istreambuf_iterator<char>());
+  const std::string line = "lidar_topic: \"\"";
+  ASSERT_NE(text.find(line), std::string::npos);
+  text.replace(text.find(line), line.size(), "lidar_topic: \"/velodyne_points\"");
+  std::ofstream(dir_.File("params.txtpb")) << text;
   ExpectCleanFailure(bag, {bag + ": byte ", "CRC mismatch"}, dir_.File("params.txtpb"));
 }
 

@@ -1,5 +1,6 @@
 #include "stages/gravity/gravity_reference.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <string>
@@ -151,6 +152,67 @@ TEST(GravityReference, ToolWritesTheReferenceOrFailsWithOneLine) {
             1);
   EXPECT_NE(output.find("no flat-ground calibration gives g_f"), std::string::npos) << output;
   EXPECT_FALSE(testing::FileExists(dir.File("ref2.txtpb")));
+}
+
+// g_a that are no gravity, or that cannot share one: exit 1 with one error
+// line naming the files and their values, no output.
+TEST(GravityReference, ToolRefusesOppositeNonFiniteAndWrongNormGravities) {
+  struct Case {
+    const char* what;
+    Eigen::Vector3d g_a, g_b;
+    std::vector<std::string> said;  // parts of the error line
+  };
+  const double nan = std::nan("");
+  const std::vector<Case> cases = {
+      {"opposite", {0, 0, 9.81}, {0, 0, -9.81},
+       {"disagree about gravity", "180.000 deg", "a.txtpb g_a (0, 0, 9.81)",
+        "b.txtpb g_a (0, 0, -9.81)", "max_angle_from_combined_deg"}},
+      {"90 deg apart", {0, 0, 9.81}, {9.81, 0, 0},
+       {"disagree about gravity", "a.txtpb: 45.000 deg (g_a (0, 0, 9.81))",
+        "b.txtpb: 45.000 deg (g_a (9.81, 0, 0))"}},
+      {"1e300", {0, 0, 9.81}, {0, 0, 1e300}, {"b.txtpb: gravity_in_world (0, 0, 1e+300) has norm"}},
+      {"norm 1.5", {0, 0, 9.81}, {0, 0, 1.5},
+       {"b.txtpb: gravity_in_world (0, 0, 1.5) has norm 1.5 m/s^2, outside "
+        "flat_calibrations.min_gravity_norm_mps2 9.7 to max_gravity_norm_mps2 9.9"}},
+      {"norm 9.6", {0, 0, 9.6}, {0, 0, 9.81},
+       {"a.txtpb: gravity_in_world (0, 0, 9.6) has norm 9.6"}},
+      {"nan", {0, 0, 9.81}, {nan, 0, 9.81},
+       {"b.txtpb: gravity_in_world (nan, 0, 9.81) is not finite"}},
+  };
+  const std::string tool = testing::ToolPath("tiltcal_gravity_reference");
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.what);
+    testing::TempDir dir;
+    FlatCalibration a = Level("a", Eigen::Vector3d::UnitX(), 0.0);
+    FlatCalibration b = a;
+    *a.result.mutable_gravity_in_world() = ToProto(c.g_a);
+    *b.result.mutable_gravity_in_world() = ToProto(c.g_b);
+    ASSERT_TRUE(WriteTextProto(dir.File("a.txtpb"), a.result).ok());
+    ASSERT_TRUE(WriteTextProto(dir.File("b.txtpb"), b.result).ok());
+    std::string output;
+    EXPECT_EQ(testing::RunCommand(tool + " --out=" + dir.File("ref.txtpb") + " " +
+                                      dir.File("a.txtpb") + " " + dir.File("b.txtpb"),
+                                  &output),
+              1)
+        << output;
+    EXPECT_FALSE(testing::FileExists(dir.File("ref.txtpb")));
+    EXPECT_EQ(std::count(output.begin(), output.end(), '\n'), 1) << output;
+    for (const std::string& part : c.said) {
+      EXPECT_NE(output.find(part), std::string::npos) << part << " in " << output;
+    }
+  }
+}
+
+TEST(GravityReference, NormBoundsAreValidated) {
+  proto::GravityReference out;
+  const Status status = CombineFlatCalibrations(
+      {Level("a", Eigen::Vector3d::UnitX(), 0.0)},
+      Params("flat_calibrations { min_gravity_norm_mps2: 9.9 max_gravity_norm_mps2: 9.7 }")
+          .flat_calibrations(),
+      &out);
+  ASSERT_FALSE(status.ok());
+  EXPECT_NE(status.message().find("min_gravity_norm_mps2 = 9.9 is not below"), std::string::npos)
+      << status.message();
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 #include "stages/gravity/gravity.h"
 
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -177,6 +178,21 @@ TEST(Gravity, RunWritesTheReferenceAndFailsCleanlyOnBadInputs) {
   EXPECT_EQ(out.gravity_flat_source(), "reference flat/gravity.txtpb");
   EXPECT_EQ(out.provenance().producer(), "tiltcal_gravity");
   EXPECT_NEAR(out.inclination(50).inclination_deg(), 8.0, 0.3);
+
+  // A reference whose g_f is not finite or not a gravity is an error naming
+  // the file (it used to be taken as it was).
+  for (const Eigen::Vector3d& bad :
+       {Eigen::Vector3d(0, 0, std::numeric_limits<double>::infinity()), Eigen::Vector3d(0, 0, 1.5),
+        Eigen::Vector3d(0, std::nan(""), 9.81)}) {
+    proto::GravityReference broken = flat;
+    *broken.mutable_gravity_flat_in_imu() = ToProto(bad);
+    ASSERT_TRUE(WriteTextProto(dir.File("flat/gravity.txtpb"), broken).ok());
+    status = gravity::Run(paths, DefaultParams(), nullptr);
+    ASSERT_FALSE(status.ok()) << bad.transpose();
+    EXPECT_EQ(status.message().rfind(dir.File("flat/gravity.txtpb") + ": gravity_flat_in_imu", 0), 0u)
+        << status.message();
+  }
+  ASSERT_TRUE(WriteTextProto(dir.File("flat/gravity.txtpb"), flat).ok());
 
   // A rig without the measured extrinsic is an error naming the field.
   proto::Rig no_extrinsic = rig;
