@@ -21,6 +21,8 @@
 # CPUs are the consumable resource (jobs asking for no memory share the node).
 # Ports: two free TCP ports picked at start.
 set -euo pipefail
+# The daemons live in /usr/sbin, which a user's PATH may lack.
+export PATH=$PATH:/usr/sbin:/sbin
 
 usage() {
   echo "usage: slurm_local_cluster.sh start|status|stop DIR  or  run DIR COMMAND..." >&2

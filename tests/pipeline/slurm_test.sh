@@ -12,6 +12,7 @@ set -euo pipefail
 SRC=$(cd "$(dirname "$0")/../.." && pwd)
 BIN=$(cd "${1:?usage: slurm_test.sh BUILD_DIR}" && pwd)/bin
 fail() { echo "FAIL: $*" >&2; exit 1; }
+export PATH=$PATH:/usr/sbin:/sbin  # the daemons
 
 for tool in srun sinfo slurmctld slurmd munged mungekey; do
   command -v "$tool" > /dev/null ||
