@@ -4,7 +4,8 @@
 # sequences run with LAUNCH="srun -N1 -n1 …" -j2, then the same dataset run
 # locally (no LAUNCH). Every $(LAUNCH) recipe must have run as one Slurm job
 # that completed (the controller's job completion log), and every output must
-# equal the local run's, apart from the provenance's creation time.
+# equal the local run's but for what the clock decides (created_utc, the
+# calibration's timings). About 45 s on 2 cores.
 #   slurm_test.sh BUILD_DIR
 # Exit 77 (skipped) without root or without Slurm and munge
 # (scripts/setup.sh --cluster installs them).
