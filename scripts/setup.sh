@@ -3,7 +3,18 @@
 # then the test oracles of tests/package.json (npm ci into tests/node_modules).
 # Idempotent: does nothing when everything is present. Needs root (or sudo)
 # for the Debian packages.
+#   setup.sh              build and test dependencies
+#   setup.sh --cluster    and Slurm + munge, for the one-node cluster of
+#                         scripts/slurm_local_cluster.sh (test pipeline.slurm)
 set -euo pipefail
+
+CLUSTER=0
+for arg in "$@"; do
+  case "$arg" in
+    --cluster) CLUSTER=1 ;;
+    *) echo "usage: setup.sh [--cluster]" >&2; exit 2 ;;
+  esac
+done
 
 PACKAGES=(
   build-essential cmake ninja-build pkg-config git
@@ -15,6 +26,12 @@ PACKAGES=(
   chromium
   clang libclang-rt-14-dev
 )
+# Slurm's controller, node daemon and client commands, and munge (its
+# authentication). Their services are not started here:
+# scripts/slurm_local_cluster.sh runs the daemons itself.
+if [ "$CLUSTER" = 1 ]; then
+  PACKAGES+=(slurmctld slurmd slurm-client munge)
+fi
 
 # One dpkg-query for all of them (one per package took seconds on a loaded
 # machine).
