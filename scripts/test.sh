@@ -4,6 +4,9 @@
 # need ../shared/fixtures skip with a message when it is absent.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# Slurm and munge too, so that the one-node cluster test (pipeline.slurm)
+# runs rather than skips; build.sh installs the rest.
+scripts/setup.sh --cluster
 # Tests on, whatever an earlier configure of the build directory chose.
 scripts/build.sh -DTILTCAL_WERROR=ON -DTILTCAL_BUILD_TESTS=ON
 source scripts/phase_time.sh
