@@ -10,35 +10,9 @@ BIN=$WORK/bin
 DATA=$WORK/data
 mkdir -p "$BIN" "$DATA/params"
 
-# A stub stage: writes every --out*=PATH it is given; fails when
-# TILTCAL_STUB_FAIL names it (after writing, as a crash midway would); exits 3
-# (result written, verdict SUSPECT) when TILTCAL_STUB_SUSPECT names it.
-cat > "$BIN/stub" <<'STUB'
-#!/usr/bin/env bash
-name=$(basename "$0")
-for arg in "$@"; do
-  case "$arg" in --out*=*) echo "$name" > "${arg#*=}" ;; esac
-done
-[ "$name" = tiltcal_inspect ] && echo "stamp_ns,valid,normal_in_lidar.z,height_m"
-[ "${TILTCAL_STUB_FAIL:-}" = "$name" ] && exit 1
-[ "${TILTCAL_STUB_SUSPECT:-}" = "$name" ] && exit 3
-exit 0
-STUB
-chmod +x "$BIN/stub"
-for stage in decode ground gravity gravity_reference calibrate dataset_calibration report inspect; do
-  ln -s stub "$BIN/tiltcal_$stage"
-done
-# A stub interpreter for the plot scripts.
-cat > "$BIN/python" <<'STUB'
-#!/usr/bin/env bash
-for arg in "$@"; do
-  case "$arg" in
-    --out=*) echo png > "${arg#*=}" ;;
-    --out_dir=*) echo png > "${arg#*=}/extrinsic_positions.png"; echo png > "${arg#*=}/extrinsic_spread.png" ;;
-  esac
-done
-STUB
-chmod +x "$BIN/python"
+# Stub stages and plot interpreter (stub_stages.sh).
+source "$(dirname "$0")/stub_stages.sh"
+make_stub_stages "$BIN"
 
 echo 'imu_height_m: 0.3' > "$DATA/rig.txtpb"
 for stage in decode ground gravity calibrate; do echo "# $stage" > "$DATA/params/$stage.txtpb"; done

@@ -15,31 +15,9 @@ trap 'rm -rf "$WORK"' EXIT
 BIN=$WORK/bin
 DATA=$WORK/data
 mkdir -p "$BIN" "$DATA"
-cat > "$BIN/stub" <<'STUB'
-#!/usr/bin/env bash
-name=$(basename "$0")
-sleep 0.05
-for arg in "$@"; do
-  case "$arg" in --out*=*) echo "$name" > "${arg#*=}.tmp" && mv "${arg#*=}.tmp" "${arg#*=}" ;; esac
-done
-[ "$name" = tiltcal_inspect ] && echo "stamp_ns,valid,normal_in_lidar.z,height_m"
-echo "$name $*" >> "$STUB_LOG"
-exit 0
-STUB
-chmod +x "$BIN/stub"
-for stage in decode ground gravity gravity_reference calibrate dataset_calibration report inspect; do
-  ln -s stub "$BIN/tiltcal_$stage"
-done
-cat > "$BIN/python" <<'STUB'
-#!/usr/bin/env bash
-for arg in "$@"; do
-  case "$arg" in
-    --out=*) echo png > "${arg#*=}" ;;
-    --out_dir=*) echo png > "${arg#*=}/extrinsic_positions.png"; echo png > "${arg#*=}/extrinsic_spread.png" ;;
-  esac
-done
-STUB
-chmod +x "$BIN/python"
+source "$(dirname "$0")/stub_stages.sh"
+make_stub_stages "$BIN"
+export STUB_SLEEP_S=0.05
 echo 'imu_height_m: 0.3' > "$DATA/rig.txtpb"
 touch "$DATA/seq_a.bag" "$DATA/seq_b.bag" "$DATA/seq_c.bag"
 export STUB_LOG=$WORK/stub.log

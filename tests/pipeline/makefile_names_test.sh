@@ -12,18 +12,8 @@ WORK=$(mktemp -d)
 trap 'rm -rf "$WORK"' EXIT
 BIN=$WORK/bin
 mkdir -p "$BIN" "$WORK/deep/er/run"
-cat > "$BIN/stub" <<'STUB'
-#!/usr/bin/env bash
-echo "$(basename "$0")" >> "$STUB_LOG"
-for arg in "$@"; do
-  case "$arg" in --out*=*) echo stub > "${arg#*=}" ;; esac
-done
-exit 0
-STUB
-chmod +x "$BIN/stub"
-for stage in decode ground gravity gravity_reference calibrate dataset_calibration report inspect; do
-  ln -s stub "$BIN/tiltcal_$stage"
-done
+source "$(dirname "$0")/stub_stages.sh"
+make_stub_stages "$BIN"
 export STUB_LOG=$WORK/stub.log
 failures=0
 fail() { echo "FAIL: $*" >&2; failures=$((failures + 1)); }
