@@ -102,6 +102,7 @@ TEST_F(CalibrateFaultsTest, ShortRecordingWithARightRigIsRefusedForItsMotion) {
   const std::string params = dir_->File("short_5s_params.txtpb");
   ASSERT_TRUE(WriteTextProto(params, LidarImuParams()).ok());
   const std::string out = dir_->File("short_5s_calibration.txtpb");
+  output.clear();
   const int exit_code = testing::RunCommand(
       testing::ToolPath("tiltcal_calibrate") + " --quiet --imu=" + imu + " --scans=" + scans +
           " --rig=" + rig + " --params=" + params + " --out=" + out,
