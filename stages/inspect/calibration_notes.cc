@@ -71,7 +71,8 @@ void AddLidarNotes(const proto::CheckParams& params, CheckFindings* f) {
         "becomes error (slow down, or use a driver that publishes point times)");
   }
   if (lidar.stamps.num_gaps > 0) {
-    notes.push_back(fmt::format("{} gap(s) between scans (longest {:.3f} s)", lidar.stamps.num_gaps,
+    notes.push_back(fmt::format("{} gap(s) between scans, about {} scan(s) dropped (longest {:.3f} s)",
+                                lidar.stamps.num_gaps, lidar.stamps.num_missing,
                                 lidar.stamps.longest_gap_s));
   }
   if (lidar.stamps.num_duplicates + lidar.stamps.num_backwards > 0) {

@@ -17,8 +17,8 @@ std::string Seconds(int64_t ns) { return fmt::format("{:.3f}", 1e-9 * static_cas
 
 std::string Gaps(const StampStatistics& s) {
   if (s.num_gaps == 0) return fmt::format("none (> {:g} nominal intervals)", s.gap_factor);
-  return fmt::format("{} (> {:g} nominal intervals), longest {:.3f} s", s.num_gaps, s.gap_factor,
-                     s.longest_gap_s);
+  return fmt::format("{} (> {:g} nominal intervals), about {} message(s) missing, longest {:.3f} s",
+                     s.num_gaps, s.gap_factor, s.num_missing, s.longest_gap_s);
 }
 
 void WriteStampLines(const StampStatistics& s, const char* count_label, std::ostream& out) {

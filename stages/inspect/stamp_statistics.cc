@@ -41,6 +41,7 @@ StampStatistics ComputeStampStatistics(const std::vector<int64_t>& stamps_ns, do
     if (d > gap_factor * s.nominal_interval_s) {
       ++s.num_gaps;
       s.longest_gap_s = std::max(s.longest_gap_s, d);
+      s.num_missing += std::max<int64_t>(std::llround(d / s.nominal_interval_s) - 1, 1);
     } else {
       sum += d;
       ++n;

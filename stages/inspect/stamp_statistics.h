@@ -19,6 +19,8 @@ struct StampStatistics {
   double interval_stddev_s = 0.0;  // jitter: σ of the positive intervals that are no gap
   int64_t num_gaps = 0;            // intervals > gap_factor · nominal
   double longest_gap_s = 0.0;      // longest such interval (0 without gaps)
+  // Messages missing in the gaps: sum over gaps of round(interval / nominal) - 1.
+  int64_t num_missing = 0;
   int64_t num_duplicates = 0;      // interval == 0
   int64_t num_backwards = 0;       // interval < 0
   double span_s() const { return 1e-9 * static_cast<double>(last_ns - first_ns); }

@@ -36,11 +36,35 @@ TEST(StampStatistics, RateJitterGapsDuplicatesAndBackwards) {
   EXPECT_NEAR(s.rate_hz, 100.0, 1e-9);
   EXPECT_EQ(s.num_gaps, 1);
   EXPECT_NEAR(s.longest_gap_s, 0.05, 1e-12);
+  EXPECT_EQ(s.num_missing, 4);
   EXPECT_EQ(s.num_duplicates, 1);
   EXPECT_EQ(s.num_backwards, 1);
   // Positive intervals that are not gaps: 100 + 95 of 10 ms and one of 15 ms
   // (after the backward step): σ = 5 ms · sqrt(195)/196.
   EXPECT_NEAR(s.interval_stddev_s, 0.005 * std::sqrt(195.0) / 196.0, 1e-9);
+}
+
+// 10 Hz scans with single scans dropped (5 %) and one run of three: with the
+// LiDAR's gap factor 1.5 every drop is a gap and counted, and the jitter is
+// that of the scans kept (before, a factor 3 let a dropped scan pass as
+// 25 ms of jitter and "no gaps").
+TEST(StampStatistics, DroppedScansAreGapsWithTheirCount) {
+  std::vector<int64_t> stamps;
+  int64_t dropped = 0;
+  for (int i = 0; i < 400; ++i) {
+    const bool drop = (i % 20 == 7) || (i >= 300 && i < 303);
+    if (drop) {
+      ++dropped;
+      continue;
+    }
+    stamps.push_back(100'000'000LL * i);
+  }
+  const StampStatistics s = ComputeStampStatistics(stamps, 1.5);
+  EXPECT_EQ(s.num_gaps, 21);  // 20 single drops and the run of 3
+  EXPECT_EQ(s.num_missing, dropped);
+  EXPECT_NEAR(s.longest_gap_s, 0.4, 1e-12);
+  EXPECT_NEAR(s.interval_stddev_s, 0.0, 1e-12);
+  EXPECT_NEAR(s.rate_hz, 10.0, 1e-9);
 }
 
 TEST(StampStatistics, JitterOfAlternatingIntervals) {
