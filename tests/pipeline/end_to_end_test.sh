@@ -14,16 +14,8 @@ DATA=$WORK/flat
 mkdir -p "$DATA"
 fail() { echo "FAIL: $*" >&2; exit 1; }
 
-for i in 1 2; do
-  sed -E -e "s/^seed: .*/seed: $((40 + i))/" -e "s/^duration_s: .*/duration_s: 20/" \
-    -e "s/^([[:space:]]*heading_deg:).*/\1 $((30 * i))/" \
-    -e "s/^(  length_m:).*/\1 10/" -e "s/^(  width_m:).*/\1 5/" -e "s/^(  speed_mps:).*/\1 1.2/" \
-    "$SRC/stages/simulate/scenarios/flat_vlp16.txtpb" > "$WORK/seq_$i.txtpb"
-  rig=""
-  [ "$i" = 1 ] && rig="--out_rig=$DATA/rig.txtpb"
-  "$BIN/tiltcal_simulate" --params="$WORK/seq_$i.txtpb" --out_bag="$DATA/seq_$i.bag" \
-    --out_truth="$DATA/seq_$i.truth.txtpb" $rig 2> /dev/null
-done
+source "$(dirname "$0")/flat_pair_dataset.sh"
+simulate_flat_pair "$BIN" "$SRC" "$WORK" "$DATA"
 
 make --no-print-directory -s -f "$SRC/Makefile.pipeline" DATASET="$DATA" BIN="$BIN" -j2 \
   > "$WORK/make.log" 2>&1 || { tail -20 "$WORK/make.log"; fail "the pipeline failed"; }

@@ -31,17 +31,8 @@ trap cleanup EXIT
 trap 'exit 143' TERM INT HUP
 
 # Two flat 20 s sequences, as in end_to_end_test.sh, kept pristine in $WORK/dataset.
-mkdir -p "$WORK/dataset"
-for i in 1 2; do
-  sed -E -e "s/^seed: .*/seed: $((40 + i))/" -e "s/^duration_s: .*/duration_s: 20/" \
-    -e "s/^([[:space:]]*heading_deg:).*/\1 $((30 * i))/" \
-    -e "s/^(  length_m:).*/\1 10/" -e "s/^(  width_m:).*/\1 5/" -e "s/^(  speed_mps:).*/\1 1.2/" \
-    "$SRC/stages/simulate/scenarios/flat_vlp16.txtpb" > "$WORK/seq_$i.txtpb"
-  rig=""
-  [ "$i" = 1 ] && rig="--out_rig=$WORK/dataset/rig.txtpb"
-  "$BIN/tiltcal_simulate" --params="$WORK/seq_$i.txtpb" --out_bag="$WORK/dataset/seq_$i.bag" \
-    --out_truth="$WORK/dataset/seq_$i.truth.txtpb" $rig 2> /dev/null
-done
+source "$(dirname "$0")/flat_pair_dataset.sh"
+simulate_flat_pair "$BIN" "$SRC" "$WORK" "$WORK/dataset"
 
 bash "$SRC/scripts/slurm_local_cluster.sh" start "$CLUSTER"
 export SLURM_CONF=$CLUSTER/slurm.conf

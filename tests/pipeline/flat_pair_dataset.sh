@@ -1,0 +1,19 @@
+# Sourced by the pipeline tests (bash): simulate_flat_pair BIN SRC WORK DATA
+# writes two flat 20 s sequences (the flat_vlp16 scenario in a 10 x 5 m
+# figure-eight at 1.2 m/s, seeds 41 and 42, headings 30 and 60 deg) into
+# DATA as seq_1.bag, seq_2.bag with their truths, and the rig DATA/rig.txtpb;
+# the scenario files go to WORK.
+simulate_flat_pair() {
+  local bin=$1 src=$2 work=$3 data=$4 i rig
+  mkdir -p "$data"
+  for i in 1 2; do
+    sed -E -e "s/^seed: .*/seed: $((40 + i))/" -e "s/^duration_s: .*/duration_s: 20/" \
+      -e "s/^([[:space:]]*heading_deg:).*/\1 $((30 * i))/" \
+      -e "s/^(  length_m:).*/\1 10/" -e "s/^(  width_m:).*/\1 5/" -e "s/^(  speed_mps:).*/\1 1.2/" \
+      "$src/stages/simulate/scenarios/flat_vlp16.txtpb" > "$work/seq_$i.txtpb"
+    rig=()
+    [ "$i" = 1 ] && rig=(--out_rig="$data/rig.txtpb")
+    "$bin/tiltcal_simulate" --params="$work/seq_$i.txtpb" --out_bag="$data/seq_$i.bag" \
+      --out_truth="$data/seq_$i.truth.txtpb" "${rig[@]}" 2> /dev/null || return 1
+  done
+}
