@@ -57,8 +57,14 @@ Status ValidateImuFromLidar(bool present, proto::Rigid3* imu_from_lidar,
 }
 
 Status ValidateRig(proto::Rig* rig) {
-  TILTCAL_RETURN_IF_ERROR(ValidateImuFromLidar(rig->has_imu_from_lidar(),
-                                               rig->mutable_imu_from_lidar(), "imu_from_lidar"));
+  if (rig->has_imu_from_lidar()) {
+    TILTCAL_RETURN_IF_ERROR(ValidateImuFromLidar(true, rig->mutable_imu_from_lidar(),
+                                                 "imu_from_lidar"));
+  }
+  if (rig->has_starting_extrinsic() && rig->starting_extrinsic().has_guess()) {
+    TILTCAL_RETURN_IF_ERROR(ValidateImuFromLidar(
+        true, rig->mutable_starting_extrinsic()->mutable_guess(), "starting_extrinsic.guess"));
+  }
   if (!std::isfinite(rig->imu_height_m()) || rig->imu_height_m() < 0 ||
       rig->imu_height_m() > kRigMaxImuHeightM) {
     return Status::Error(fmt::format("imu_height_m = {} is outside [0, {}] m (0 = unknown)",
@@ -83,6 +89,16 @@ Status ValidateGravityFlat(const proto::Vector3& gravity, const std::string& fie
 Status LoadRig(const std::string& path, proto::Rig* rig) {
   TILTCAL_RETURN_IF_ERROR(ReadTextProto(path, rig));
   return ValidateRig(rig).WithContext(path);
+}
+
+Status LoadRigWithExtrinsic(const std::string& path, proto::Rig* rig) {
+  TILTCAL_RETURN_IF_ERROR(LoadRig(path, rig));
+  if (rig->has_imu_from_lidar()) return Status::Ok();
+  return Status::Error(
+             "imu_from_lidar.rotation is missing (the extrinsic C_bl): give this stage the "
+             "sequence's rig that tiltcal_initial_extrinsic writes (out/<sequence>/rig.txtpb), "
+             "which has the rotation found from the motion")
+      .WithContext(path);
 }
 
 }  // namespace tiltcal

@@ -30,7 +30,8 @@ Status ValidateImuFromLidar(bool present, proto::Rigid3* imu_from_lidar,
 // `field`.
 Status ValidateGravityFlat(const proto::Vector3& gravity, const std::string& field);
 
-// Checks a rig (the dataset's rig.txtpb): imu_from_lidar present with a unit
+// Checks a rig (the dataset's rig.txtpb): imu_from_lidar, when present
+// (tiltcal_initial_extrinsic finds it from the motion otherwise), with a unit
 // quaternion (within kRigQuaternionNormTolerance; normalised in place),
 // every value finite, the translation, imu_height_m and gravity_flat_in_imu
 // (when set) within the bounds above, imu_accel_unit and imu_gyro_unit
@@ -40,6 +41,12 @@ Status ValidateRig(proto::Rig* rig);
 // Reads rig.txtpb (a regular, non-empty file) and validates it; every error
 // names the file and the field. Every stage reads the rig through this.
 Status LoadRig(const std::string& path, proto::Rig* rig);
+
+// LoadRig for the stages that need the extrinsic (ground, gravity,
+// calibrate): imu_from_lidar must be present. They read the sequence's rig
+// that tiltcal_initial_extrinsic writes (out/<sequence>/rig.txtpb), which
+// always has it.
+Status LoadRigWithExtrinsic(const std::string& path, proto::Rig* rig);
 
 }  // namespace tiltcal
 

@@ -6,6 +6,7 @@
 #include <ctime>
 #include <future>
 #include <memory>
+#include <optional>
 
 #include <ceres/solver.h>
 #include <fmt/format.h>
@@ -55,7 +56,7 @@ void Log(std::ostream* log, const std::string& line) {
 Status ReadCalibrateInputs(const CalibratePaths& paths, const proto::CalibrateParams& params,
                            CalibrateInputs* inputs) {
   *inputs = CalibrateInputs();
-  TILTCAL_RETURN_IF_ERROR(LoadRig(paths.rig, &inputs->rig));
+  TILTCAL_RETURN_IF_ERROR(LoadRigWithExtrinsic(paths.rig, &inputs->rig));
   TILTCAL_RETURN_IF_ERROR(
       ReadImuReadings(paths.imu, &inputs->imu, &inputs->first_imu_stamp_ns));
   TILTCAL_RETURN_IF_ERROR(
@@ -403,6 +404,37 @@ MapSharpnessPair MeasureBothMapSharpnesses(const CalibrateInputs& inputs,
   return out;
 }
 
+// The sequence rig's starting extrinsic (initial_extrinsic.h) against the
+// estimate, and the bag's /tf_static against it, as verdict notes.
+void FillStartingExtrinsicNotes(const proto::Rig& rig, const CalibrationState& state,
+                                proto::CalibrationResult* result) {
+  result->clear_verdict_notes();
+  if (!rig.has_starting_extrinsic()) return;
+  const proto::StartingExtrinsic& start = rig.starting_extrinsic();
+  *result->mutable_starting_extrinsic() = start;
+  const Eigen::Quaterniond c_bl = state.ImuFromLidarRotation();
+  const Eigen::Vector3d r_bl = state.ImuFromLidarTranslation();
+  auto rotation_deg = [&](const Rigid3d& t) {
+    return Eigen::AngleAxisd(t.rotation.conjugate() * c_bl).angle() * 180.0 / M_PI;
+  };
+  std::string line = "starting extrinsic: " + start.summary();
+  if (start.has_guess()) {
+    const Rigid3d guess = ToEigen(start.guess());
+    result->set_rotation_from_guess_deg(rotation_deg(guess));
+    result->set_translation_from_guess_m((r_bl - guess.translation).norm());
+    line += fmt::format("; the estimate is {:.2f} deg and {:.3f} m from that guess",
+                        result->rotation_from_guess_deg(), result->translation_from_guess_m());
+  }
+  result->add_verdict_notes(line);
+  if (start.has_tf_static()) {
+    const Rigid3d tf = ToEigen(start.tf_static());
+    result->add_verdict_notes(fmt::format(
+        "the bag's /tf_static (the vehicle's URDF) differs from the estimate by {:.2f} deg and "
+        "{:.1f} cm",
+        rotation_deg(tf), (r_bl - tf.translation).norm() * 100.0));
+  }
+}
+
 // What the verdict is decided from besides the estimate and the covariance:
 // residual statistics and tau bounds of the last problem, the map sharpness
 // with the estimate and with the rig's extrinsic (same trajectory and tau,
@@ -438,6 +470,7 @@ void FillVerdictFacts(const CalibrateInputs& inputs, const proto::CalibrateParam
   }
   result->set_static_start(init.imu.from_static_start);
   result->set_static_samples(init.imu.num_samples_averaged);
+  FillStartingExtrinsicNotes(inputs.rig, state, result);
   AddTiming("verdict_facts", Seconds(start), result);
   AddTiming("map_sharpness", sharpness.seconds, result);
 }
@@ -467,22 +500,9 @@ Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& pa
                  std::ostream* log) {
   result->Clear();
   const auto total_start = Clock::now();
-  if (inputs.imu.size() < 10) return Status::Error("too few IMU samples");
-
-  // Grid over the IMU samples (IMU clock, t0 = first sample = 0).
-  const double t0 = inputs.imu.front().time_s;
-  const double duration = inputs.imu.back().time_s - t0;
-  if (!(duration <= params.spline().max_duration_s())) {
-    return Status::Error(fmt::format(
-        "imu: the stamps span {} s, more than spline.max_duration_s = {} s (a stamp far from "
-        "its neighbours?)",
-        duration, params.spline().max_duration_s()));
-  }
-  CalibrationState state(
-      spline::UniformKnotGrid::ForDuration(t0, duration, params.spline().knot_spacing_s()));
-  state.gravity_norm_mps2 = params.gravity_norm_mps2();
-  TILTCAL_RETURN_IF_ERROR(state.SetBiasSegments(params.imu_noise().gyro_bias_segment_s(),
-                                                params.imu_noise().accel_bias_segment_s()));
+  std::optional<CalibrationState> new_state;
+  TILTCAL_RETURN_IF_ERROR(MakeStateOverImu(inputs.imu, params, &new_state));
+  CalibrationState& state = *new_state;
   InitialisationReport init;
   TILTCAL_RETURN_IF_ERROR(Initialise(inputs, params, &state, &init, result, log));
 
@@ -559,7 +579,14 @@ Status Run(const CalibratePaths& paths, const proto::CalibrateParams& params, st
   // Replaced by the final state (the grid here is a placeholder).
   CalibrationState final_state(
       spline::UniformKnotGrid::ForDuration(0.0, 1.0, params.spline().knot_spacing_s()));
-  TILTCAL_RETURN_IF_ERROR(Calibrate(inputs, params, &result, &final_state, log));
+  proto::CalibrateParams used = params;
+  if (inputs.rig.has_starting_extrinsic() &&
+      !inputs.rig.starting_extrinsic().translation_known()) {
+    used.set_extrinsic_translation_prior_sigma_m(params.unknown_translation_prior_sigma_m());
+    Log(log, fmt::format("no translation guess: prior sigma {} m at zero",
+                         params.unknown_translation_prior_sigma_m()));
+  }
+  TILTCAL_RETURN_IF_ERROR(Calibrate(inputs, used, &result, &final_state, log));
   TILTCAL_RETURN_IF_ERROR(WriteMaps(paths, params, inputs, final_state, log));
   proto::PhaseTiming* t = result.add_timings();
   t->set_phase("read_inputs");
@@ -569,7 +596,7 @@ Status Run(const CalibratePaths& paths, const proto::CalibrateParams& params, st
   if (!paths.ground.empty()) input_paths.push_back({"ground", paths.ground});
   if (!paths.gravity.empty()) input_paths.push_back({"gravity", paths.gravity});
   *result.mutable_provenance() =
-      MakeProvenance("tiltcal_calibrate", params, input_paths, paths.command_line);
+      MakeProvenance("tiltcal_calibrate", used, input_paths, paths.command_line);
   TILTCAL_RETURN_IF_ERROR(WriteTextProto(paths.out, result));
   if (written != nullptr) *written = std::move(result);
   return Status::Ok();

@@ -17,6 +17,7 @@
 #include "common/spline/so3_spline.h"
 #include "stages/calibrate/coarse_time_offset.h"
 #include "stages/calibrate/covariance_report.h"
+#include "stages/calibrate/init_odometry.h"
 #include "stages/calibrate/orientation_sample_cost_function.h"
 #include "stages/calibrate/problem_builder.h"
 #include "stages/calibrate/rig_rotation_check.h"
@@ -293,135 +294,6 @@ double FitPositionSpline(const std::vector<double>& times_s,
 
 namespace {
 
-// Step 3: the odometry's poses and, per pose, its scan and C_ab at the scan
-// stamp + tau (the state's).
-struct OdometryRun {
-  std::vector<LidarOdometryPose> poses;
-  std::vector<int> scan_of_pose;
-  std::vector<Eigen::Quaterniond> imu_rotations;
-  // Of the poses used further on (pose 0 and every registered one): their
-  // indices, C_ab and C_{l0 lk}.
-  std::vector<size_t> used;
-  std::vector<Eigen::Quaterniond> imu_used;
-  std::vector<Eigen::Quaterniond> lidar_used;
-};
-
-// Deskews scan k with the state's rotation spline and the rig's C_bl,
-// T_{lk a} T_{a l(t_j)} p, into *deskewed. False when the sweep is outside
-// the spline.
-bool DeskewScan(const CalibrationState& state, const LidarScan& scan, double node_spacing_s,
-                ScanPoseTable* table, std::vector<Eigen::Vector3f>* deskewed) {
-  if (!table->Build(state, scan, node_spacing_s)) return false;
-  Eigen::Quaterniond q_k;
-  Eigen::Vector3d t_k;
-  table->Interpolate(0.0, &q_k, &t_k);
-  const Eigen::Quaterniond q_k_inv = q_k.conjugate();
-  deskewed->resize(scan.points.size());
-  for (size_t j = 0; j < scan.points.size(); ++j) {
-    Eigen::Quaterniond q;
-    Eigen::Vector3d t;
-    table->Interpolate(scan.point_time_s[j], &q, &t);
-    (*deskewed)[j] = (q_k_inv * (q * scan.points[j].cast<double>() + t - t_k)).cast<float>();
-  }
-  return true;
-}
-
-// Odometry on scans deskewed with the rotation spline at the state's tau
-// (positions are still zero, so only rotation and the lever arm move the
-// points) and a rotation prior from it; scans whose stamp + tau is outside
-// the spline are left out. Without gyro_aided: raw scans, no prior (the
-// gyro's speeds are then only compared with the LiDAR's, not trusted).
-OdometryRun RunOdometry(const std::vector<LidarScan>& scans, const CalibrationState& state,
-                        const proto::CalibrateParams& params, bool gyro_aided,
-                        InitialisationReport* report) {
-  report->odometry_scans = 0;
-  report->odometry_registered = 0;
-  report->odometry_quality_scans = 0;
-  report->odometry_mean_fitness_m = 0.0;
-  report->odometry_mean_inlier_fraction = 0.0;
-  const double tau = state.time_offset_s[0];
-  const int num_threads = std::max(static_cast<int>(params.num_threads()), 1);
-  LidarOdometry odometry(params.odometry(), params.scans(), num_threads);
-  const spline::SplineTrajectory& traj = state.trajectory;
-  const Eigen::Quaterniond c_bl = state.ImuFromLidarRotation();
-  OdometryRun run;
-  bool have_first = false;
-  Eigen::Quaterniond c_ab_first = Eigen::Quaterniond::Identity();
-  const size_t scan_step = std::max<size_t>(params.odometry().scan_step(), 1);
-  // Scan k deskewed and prepared for registration (reads only the state).
-  struct Prepared {
-    bool usable = false;
-    Eigen::Quaterniond c_ab = Eigen::Quaterniond::Identity();  // C_ab at the scan time
-    std::shared_ptr<LidarOdometry::PreparedScan> scan;
-  };
-  auto prepare = [&](size_t k, int threads) {
-    Prepared out;
-    const LidarScan& scan = scans[k];
-    if (scan.points.empty()) return out;
-    spline::So3SplineSample rot;
-    if (!traj.Evaluate(scan.stamp_s + tau, spline::kSo3Rotation, &rot, nullptr)) return out;
-    std::vector<Eigen::Vector3f> deskewed;
-    ScanPoseTable table;
-    if (!gyro_aided) {
-      deskewed = scan.points;
-    } else if (!DeskewScan(state, scan, params.init().deskew_node_spacing_s(), &table,
-                           &deskewed)) {
-      return out;
-    }
-    out.usable = true;
-    out.c_ab = Eigen::Quaterniond(rot.rotation);
-    out.scan = odometry.Prepare(deskewed, threads);
-    return out;
-  };
-  // With two threads or more, scan k + scan_step is prepared (on one thread)
-  // while scan k is registered.
-  const bool ahead = num_threads > 1;
-  std::future<Prepared> next;
-  if (!scans.empty()) next = std::async(std::launch::deferred, prepare, size_t{0}, num_threads);
-  for (size_t k = 0; k < scans.size(); k += scan_step) {
-    const Prepared current = next.get();
-    if (k + scan_step < scans.size()) {
-      next = std::async(ahead ? std::launch::async : std::launch::deferred, prepare,
-                        k + scan_step, ahead ? 1 : num_threads);
-    }
-    if (!current.usable) continue;
-    if (!have_first) {
-      c_ab_first = current.c_ab;
-      have_first = true;
-    }
-    std::optional<Eigen::Quaterniond> prior;
-    if (gyro_aided) prior = LidarRotationPriorFromImu(c_ab_first, current.c_ab, c_bl);
-    odometry.AddPrepared(scans[k].stamp_s, *current.scan, prior);
-    run.scan_of_pose.push_back(static_cast<int>(k));
-    run.imu_rotations.push_back(current.c_ab);
-  }
-  run.poses = odometry.poses();
-  report->odometry_scans = static_cast<int>(run.poses.size());
-  double fitness_sum = 0.0;
-  double inlier_fraction_sum = 0.0;
-  int measured = 0;
-  for (size_t i = 0; i < run.poses.size(); ++i) {
-    const LidarOdometryPose& pose = run.poses[i];
-    if (i > 0 && !pose.registered) continue;
-    if (i > 0) {
-      ++report->odometry_registered;
-      if (pose.num_quality_points > 0) {
-        fitness_sum += pose.fitness_rms_m;
-        inlier_fraction_sum += pose.inlier_fraction;
-        ++measured;
-      }
-    }
-    run.used.push_back(i);
-    run.imu_used.push_back(run.imu_rotations[i]);
-    run.lidar_used.push_back(Eigen::Quaterniond(pose.l0_from_lidar.rotation()));
-  }
-  report->odometry_quality_scans = measured;
-  if (measured > 0) {
-    report->odometry_mean_fitness_m = fitness_sum / measured;
-    report->odometry_mean_inlier_fraction = inlier_fraction_sum / measured;
-  }
-  return run;
-}
 
 // Step 4: an error when the motion turned too little to decide the rotation
 // (MissingTurning); else C_bl from the rig, or hand-eye when excited; without
@@ -510,35 +382,6 @@ Eigen::Quaterniond RefineHeading(const OdometryRun& run, const std::vector<Lidar
   return anchor;
 }
 
-// Step 3b: tau over the wide window from the angular speeds of the gyro and
-// of the odometry (run at the state's tau), the gyro unit check, and the
-// centre of the later tau searches: the coarse tau when trusted (rounded to
-// the grid search's step, so that the grid keeps its points), else 0.
-Status EstimateCoarseTau(const OdometryRun& run, const std::vector<LidarScan>& scans,
-                         const std::vector<imu::ImuReading>& imu_samples,
-                         const proto::CalibrateParams& params, const CalibrationState& state,
-                         InitialisationReport* report) {
-  const proto::InitParams& init = params.init();
-  report->time_offset_center_s = 0.0;
-  if (init.coarse_time_offset_window_s() <= 0.0) return Status::Ok();
-  std::vector<double> times;
-  for (const size_t i : run.used) times.push_back(scans[run.scan_of_pose[i]].stamp_s);
-  CoarseTimeOffset coarse;
-  const Status status =
-      EstimateCoarseTimeOffset(GyroAngularSpeeds(imu_samples, state.GyroBias()),
-                               LidarAngularSpeeds(times, run.lidar_used), init, &coarse);
-  report->coarse = coarse;
-  if (!status.ok()) {
-    report->coarse.distrust_reason = status.message();
-    report->coarse.trusted = false;
-    return Status::Ok();
-  }
-  if (!coarse.trusted) return Status::Ok();
-  const double step = init.time_offset_search_step_s();
-  const double tau = coarse.alignment.time_offset_s;
-  report->time_offset_center_s = step > 0.0 ? std::round(tau / step) * step : tau;
-  return Status::Ok();
-}
 
 // Scans whose sweep at t_l + tau is not inside the IMU's spline.
 int CountScansOutsideImu(const std::vector<LidarScan>& scans, const CalibrationState& state) {
@@ -657,11 +500,29 @@ Status OdometryAndCoarseTau(const std::vector<LidarScan>& scans,
 
 }  // namespace
 
-Status InitialiseState(const std::vector<imu::ImuReading>& imu_samples,
-                       const std::vector<LidarScan>& scans, const Rigid3d& measured_imu_from_lidar,
-                       const proto::CalibrateParams& params, CalibrationState* state,
-                       InitialisationReport* report) {
-  *report = InitialisationReport();
+Status MakeStateOverImu(const std::vector<imu::ImuReading>& imu_samples,
+                        const proto::CalibrateParams& params,
+                        std::optional<CalibrationState>* state) {
+  if (imu_samples.size() < 10) return Status::Error("too few IMU samples");
+  // Grid over the IMU samples (IMU clock, t0 = first sample = 0).
+  const double t0 = imu_samples.front().time_s;
+  const double duration = imu_samples.back().time_s - t0;
+  if (!(duration <= params.spline().max_duration_s())) {
+    return Status::Error(fmt::format(
+        "imu: the stamps span {} s, more than spline.max_duration_s = {} s (a stamp far from "
+        "its neighbours?)",
+        duration, params.spline().max_duration_s()));
+  }
+  state->emplace(
+      spline::UniformKnotGrid::ForDuration(t0, duration, params.spline().knot_spacing_s()));
+  (*state)->gravity_norm_mps2 = params.gravity_norm_mps2();
+  return (*state)->SetBiasSegments(params.imu_noise().gyro_bias_segment_s(),
+                                   params.imu_noise().accel_bias_segment_s());
+}
+
+Status InitialiseImuAndRotationSpline(const std::vector<imu::ImuReading>& imu_samples,
+                                      const proto::CalibrateParams& params,
+                                      CalibrationState* state, InitialisationReport* report) {
   // 1. IMU: gyro bias, gravity.
   auto start = std::chrono::steady_clock::now();
   TILTCAL_RETURN_IF_ERROR(
@@ -669,8 +530,6 @@ Status InitialiseState(const std::vector<imu::ImuReading>& imu_samples,
   state->SetGyroBias(report->imu.gyro_bias_radps);
   state->SetAccelBias(Eigen::Vector3d::Zero());
   state->SetGravityDirection(report->imu.gravity_in_world_mps2);
-  state->SetImuFromLidarRotation(measured_imu_from_lidar.rotation);
-  state->SetImuFromLidarTranslation(measured_imu_from_lidar.translation);
   state->time_offset_s[0] = 0.0;
   report->imu_seconds = Seconds(start);
 
@@ -682,6 +541,19 @@ Status InitialiseState(const std::vector<imu::ImuReading>& imu_samples,
   start = std::chrono::steady_clock::now();
   report->gyro_fit_rms = FitRotationSplineToGyro(imu_samples, params, state);
   report->rotation_fit_seconds = Seconds(start);
+  return Status::Ok();
+}
+
+Status InitialiseState(const std::vector<imu::ImuReading>& imu_samples,
+                       const std::vector<LidarScan>& scans, const Rigid3d& measured_imu_from_lidar,
+                       const proto::CalibrateParams& params, CalibrationState* state,
+                       InitialisationReport* report) {
+  *report = InitialisationReport();
+  state->SetImuFromLidarRotation(measured_imu_from_lidar.rotation);
+  state->SetImuFromLidarTranslation(measured_imu_from_lidar.translation);
+  // 1. and 2.
+  TILTCAL_RETURN_IF_ERROR(InitialiseImuAndRotationSpline(imu_samples, params, state, report));
+  const MotionAxis axis{report->rotation_axis_b, report->rotation_axis_fraction};
 
   // 3. Odometry and the wide-window tau.
   OdometryRun run;
@@ -707,7 +579,7 @@ Status InitialiseState(const std::vector<imu::ImuReading>& imu_samples,
   state->time_offset_s[0] = report->time_offset_init_s;
 
   // 4c. Heading; 4d. the starting C_bl against the accelerations.
-  start = std::chrono::steady_clock::now();
+  auto start = std::chrono::steady_clock::now();
   const Eigen::Quaterniond anchor =
       RefineHeading(run, scans, imu_samples, c_bl_init, params, state, report);
   report->rotation_fit_seconds += Seconds(start);

@@ -52,6 +52,7 @@
 // coarse tau),
 // extrinsic_translation_prior_sigma_m and num_threads.
 
+#include <optional>
 #include <vector>
 
 #include "common/imu/imu_initialisation.h"
@@ -114,6 +115,20 @@ struct InitialisationReport {
   double odometry_seconds = 0.0;
   double position_fit_seconds = 0.0;
 };
+
+// A state whose spline grid covers the IMU samples (knot spacing and bias
+// segments from the params, |g_a| = gravity_norm_mps2). Errors: fewer than
+// 10 samples, a span beyond spline.max_duration_s.
+Status MakeStateOverImu(const std::vector<imu::ImuReading>& imu_samples,
+                        const proto::CalibrateParams& params,
+                        std::optional<CalibrationState>* state);
+
+// Steps 1 and 2 alone: gyro bias, g_a (accelerometer bias 0, tau 0), the
+// motion's principal rotation axis and the rotation spline fitted to the
+// gyro, into *state and the matching fields of *report.
+Status InitialiseImuAndRotationSpline(const std::vector<imu::ImuReading>& imu_samples,
+                                      const proto::CalibrateParams& params,
+                                      CalibrationState* state, InitialisationReport* report);
 
 // Fills *state (whose grid covers the IMU samples) from the IMU samples
 // (times relative to the first sample), the raw scans and the rig's

@@ -202,6 +202,7 @@ std::string FormatVerdict(const proto::CalibrationResult& result,
                           const proto::VerdictParams& params) {
   std::string out = "verdict " + proto::CalibrationResult::Verdict_Name(result.verdict());
   for (const std::string& reason : result.verdict_reasons()) out += "\n  - " + reason;
+  for (const std::string& note : result.verdict_notes()) out += "\n  note: " + note;
   if (MovedFarFromRig(result, params)) out += "\n  note: " + DescribeMoveFromRig(result);
   return out;
 }

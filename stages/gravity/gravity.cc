@@ -264,7 +264,7 @@ Status Run(const GravityPaths& paths, const proto::GravityParams& params, std::o
     TILTCAL_RETURN_IF_ERROR(ReadAllRecords<proto::GroundPlane>(paths.ground, &inputs.ground));
     TILTCAL_RETURN_IF_ERROR(CheckGroundNormals(paths.ground, inputs.ground));
   }
-  TILTCAL_RETURN_IF_ERROR(LoadRig(paths.rig, &inputs.rig));
+  TILTCAL_RETURN_IF_ERROR(LoadRigWithExtrinsic(paths.rig, &inputs.rig));
   TILTCAL_RETURN_IF_ERROR(ReadDatasetReference(paths.rig, inputs.rig, &inputs.dataset_reference,
                                                &inputs.dataset_reference_source));
   proto::CalibrationResult calibration;

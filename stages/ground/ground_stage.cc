@@ -169,7 +169,7 @@ Status Run(const GroundPaths& paths, const proto::GroundParams& params, std::ost
   TILTCAL_RETURN_IF_ERROR(CheckOutputPath(paths.out_ground));
   if (!paths.out_scans.empty()) TILTCAL_RETURN_IF_ERROR(CheckOutputPath(paths.out_scans));
   proto::Rig rig;
-  TILTCAL_RETURN_IF_ERROR(LoadRig(paths.rig, &rig));
+  TILTCAL_RETURN_IF_ERROR(LoadRigWithExtrinsic(paths.rig, &rig));
   ImuAttitude attitude;
   TILTCAL_RETURN_IF_ERROR(ReadImuAttitude(paths.imu, params.deskew(), &attitude));
   RunSummary summary;

@@ -33,7 +33,8 @@ GroundFrame MakeGroundFrame(const proto::Rig& rig, const proto::GroundFrameParam
   }
   if (params.sensor_height_guess_m() > 0.0) {
     frame.height_prior_m = params.sensor_height_guess_m();
-  } else if (rig.imu_height_m() > 0.0) {
+  } else if (rig.imu_height_m() > 0.0 &&
+             !(rig.has_starting_extrinsic() && !rig.starting_extrinsic().translation_known())) {
     // d_l = d_b + n_l · (C_bl^T r_b^{lb}) (the distance residual
     // e_dist = d_l − d_b − n_l^T C_bl^T r_b^{lb} = 0; docs/design.md §8) with n_l ≈ up.
     const Eigen::Vector3d r = ToEigen(rig.imu_from_lidar().translation());

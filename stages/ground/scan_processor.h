@@ -28,7 +28,9 @@ struct GroundFrame {
 // The frame and height prior from the rig and the params: up is
 // C_bl^T (−g_f/|g_f|) when use_rig_up_direction and the rig has g_f, else the
 // LiDAR z axis; the height prior is sensor_height_guess_m when > 0, else
-// d_b + up_l · (C_bl^T r_b^{lb}) when the rig has d_b > 0, else none.
+// d_b + up_l · (C_bl^T r_b^{lb}) when the rig has d_b > 0 and r_b^{lb} is
+// known (not a sequence rig whose starting_extrinsic.translation_known is
+// false), else none.
 GroundFrame MakeGroundFrame(const proto::Rig& rig, const proto::GroundFrameParams& params);
 
 // Deskew + segmentation + plane fit of one scan at a time; buffers are reused.

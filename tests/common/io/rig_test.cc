@@ -52,11 +52,30 @@ TEST(LoadRig, NonUnitQuaternionIsAnError) {
       << error;
 }
 
-TEST(LoadRig, ZeroOrMissingRotationIsAnError) {
+TEST(LoadRig, ZeroRotationIsAnError) {
   EXPECT_NE(LoadError("imu_from_lidar { rotation { w: 0 } }").find("not a unit quaternion"),
             std::string::npos);
-  EXPECT_NE(LoadError("imu_height_m: 0.3").find("imu_from_lidar.rotation is missing"),
-            std::string::npos);
+}
+
+// A dataset rig may leave the extrinsic out (tiltcal_initial_extrinsic finds
+// it); the stages that need it refuse a rig without it, naming the stage
+// that writes the sequence's rig.
+TEST(LoadRig, ExtrinsicIsOptionalButRequiredWhereItIsUsed) {
+  proto::Rig rig;
+  EXPECT_TRUE(LoadFromText("imu_height_m: 0.3", &rig).ok());
+  EXPECT_FALSE(rig.has_imu_from_lidar());
+  testing::TempDir dir;
+  const std::string path = dir.File("rig.txtpb");
+  ASSERT_TRUE(WriteFileAtomically(path, "imu_height_m: 0.3").ok());
+  const Status status = LoadRigWithExtrinsic(path, &rig);
+  ASSERT_FALSE(status.ok());
+  EXPECT_NE(status.message().find("rig.txtpb: imu_from_lidar.rotation is missing"),
+            std::string::npos)
+      << status.message();
+  EXPECT_NE(status.message().find("tiltcal_initial_extrinsic"), std::string::npos)
+      << status.message();
+  ASSERT_TRUE(WriteFileAtomically(path, "imu_from_lidar { rotation { w: 1 } }").ok());
+  EXPECT_TRUE(LoadRigWithExtrinsic(path, &rig).ok());
 }
 
 TEST(LoadRig, NonFiniteAndOutOfBoundValuesNameTheField) {
