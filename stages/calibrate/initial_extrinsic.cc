@@ -93,8 +93,8 @@ Status RunInitialExtrinsic(const InitialExtrinsicPaths& paths,
       imu, scans, guess ? std::optional<Eigen::Quaterniond>(guess->rotation) : std::nullopt,
       translation, params, &found);
   if (!status.ok()) {
-    return Status::Error(fmt::format("the extrinsic rotation (starting from {}): {}",
-                                     SourceName(start.guess_source()), status.message()));
+    return Status::Error("cannot find the extrinsic rotation from the motion: " +
+                         status.message());
   }
   const double change_deg =
       guess ? Eigen::AngleAxisd(found.imu_from_lidar * guess->rotation.conjugate()).angle() *

@@ -67,10 +67,10 @@ std::string ExtrinsicLines(const bag::StaticTransforms& tf) {
   if (!tf.found) {
     return "# imu_from_lidar: not in the bag (" + Printable(tf.summary) +
            ").\n"
-           "# The calibration will estimate it from the motion, starting from the value\n"
-           "# stated here, which the rig requires: put in your best one (the vehicle's URDF,\n"
-           "# a drawing, a tape measure; p_imu = R p_lidar + t, quaternion w x y z, metres)\n"
-           "# and remove the '#':\n"
+           "# Optional: without it, tiltcal_initial_extrinsic finds the rotation from the\n"
+           "# motion and the calibration the translation. If you know the mounting (the\n"
+           "# vehicle's URDF, a drawing, a tape measure; p_imu = R p_lidar + t, quaternion\n"
+           "# w x y z, metres), put it in and remove the '#':\n"
            "# imu_from_lidar { rotation { w: 1 x: 0 y: 0 z: 0 } translation { x: 0 y: 0 z: 0 } }\n";
   }
   const geometry::FrameChain& c = tf.imu_from_lidar;
@@ -86,7 +86,9 @@ std::string ExtrinsicLines(const bag::StaticTransforms& tf) {
   return "# From the bag's /tf_static, along " + Printable(chain) +
          "\n"
          "# (C_bl, r_b^{lb}: p_imu = C_bl p_lidar + r_b^{lb}, metres). The calibration starts\n"
-         "# from it and estimates the extrinsic; a URDF is often off by degrees and centimetres.\n"
+         "# from it (its rotation corrected from the motion by any angle) and estimates the\n"
+         "# extrinsic; a URDF is often off by degrees and centimetres. Optional: delete it\n"
+         "# and the bag's /tf_static is still the start.\n"
          "imu_from_lidar {\n" +
          body + "}\n";
 }
@@ -139,7 +141,7 @@ Status RunRigDraft(const RigDraftPaths& paths, const proto::CheckParams& params,
   }
   log << fmt::format("tiltcal_inspect rig: {}; imu_from_lidar {}; fill in imu_height_m\n",
                      paths.out.empty() ? "the rig on standard output" : "wrote " + paths.out,
-                     findings.tf_static.found ? "from /tf_static" : "left to the calibration");
+                     findings.tf_static.found ? "from /tf_static" : "left to the motion (optional)");
   return Status::Ok();
 }
 

@@ -244,7 +244,16 @@ std::string SequenceSection(const SequencePage& s) {
   for (const std::string& reason : c.verdict_reasons()) {
     out += "<li>" + EscapeHtml(reason) + "</li>\n";
   }
-  out += "</ul>\n" + ExtrinsicTable(c) + "<h3>Map sharpness</h3>\n" + SharpnessTable(c) +
+  out += "</ul>\n";
+  // Where the start came from, how far /tf_static is (verdict_notes).
+  if (c.verdict_notes_size() > 0) {
+    out += "<ul class=\"notes\">\n";
+    for (const std::string& note : c.verdict_notes()) {
+      out += "<li>" + EscapeHtml(note) + "</li>\n";
+    }
+    out += "</ul>\n";
+  }
+  out += ExtrinsicTable(c) + "<h3>Map sharpness</h3>\n" + SharpnessTable(c) +
          SnapshotsBlock(s);
   out += "<h3>Normalised residuals</h3>\n<div class=\"histograms\">\n";
   for (const proto::ResidualStatistics& r : c.residual_statistics()) {

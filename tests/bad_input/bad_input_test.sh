@@ -120,6 +120,23 @@ done
 expect_failure "$WORK/no_dir/imu.binpb" "$BIN/tiltcal_decode" --bag="$GOOD/seq.bag" \
   --out_imu="$WORK/no_dir/imu.binpb" --out_scans="$OUT/scans.binpb.lz4"
 
+# ---- tiltcal_initial_extrinsic ----
+initial_extrinsic() {  # initial_extrinsic IMU SCANS RIG PARAMS
+  "$BIN/tiltcal_initial_extrinsic" --imu="$1" --scans="$2" --rig="$3" ${4:+--params="$4"} \
+    --out="$OUT/rig.txtpb"
+}
+for f in $(generic_bad_files) "$BAD/bad_header.binpb" "$BAD/truncated_imu.binpb" \
+    "$GOOD/scans.binpb.lz4"; do
+  expect_failure "$f" initial_extrinsic "$f" "$GOOD/scans.binpb.lz4" "$GOOD/rig.txtpb" ""
+done
+for f in $(generic_bad_files) "$BAD/truncated_scans.binpb.lz4" "$GOOD/imu.binpb"; do
+  expect_failure "$f" initial_extrinsic "$GOOD/imu.binpb" "$f" "$GOOD/rig.txtpb" ""
+done
+for f in $(generic_bad_files) "$BAD/nan_rig.txtpb" "$BAD/huge_rig.txtpb" \
+    "$BAD/negative_height_rig.txtpb"; do
+  expect_failure "$f" initial_extrinsic "$GOOD/imu.binpb" "$GOOD/scans.binpb.lz4" "$f" ""
+done
+
 # ---- tiltcal_ground ----
 ground() {  # ground IMU SCANS RIG PARAMS
   "$BIN/tiltcal_ground" --imu="$1" --scans="$2" --rig="$3" ${4:+--params="$4"} \

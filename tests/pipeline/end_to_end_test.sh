@@ -59,16 +59,30 @@ fi
 info=$("$BIN/tiltcal_inspect" info "$DATA/out/seq_1/scans.binpb.lz4")
 grep -qE "^records: 19[0-9]$" <<<"$info" || fail "inspect info does not count the scans"
 
-# One bag and a rig in a folder is a dataset: make ends with the dataset
-# calibration (that sequence's, with a reason saying there was no check
-# between sequences) and the page. The sequence's outputs are copied with
-# their times, so only the dataset-level stages run.
+# One bag and a rig in a folder is a dataset, and the rig needs no
+# extrinsic: a first user's rig (topics, IMU height) without imu_from_lidar.
+# make ends with the dataset calibration (that sequence's, with a reason
+# saying there was no check between sequences) and the page; the starting
+# extrinsic came from the motion alone, and the errors against the truth
+# stay within the bounds above.
 ONE=$WORK/one_bag
-mkdir -p "$ONE/out"
-cp -p "$DATA/rig.txtpb" "$DATA/seq_1.bag" "$ONE/"
-cp -pr "$DATA/out/seq_1" "$ONE/out/"
+mkdir -p "$ONE"
+sed '/^imu_from_lidar {/,/^}/d' "$DATA/rig.txtpb" > "$ONE/rig.txtpb"
+! grep -q imu_from_lidar "$ONE/rig.txtpb" || fail "the rig still has imu_from_lidar"
+cp -p "$DATA/seq_1.bag" "$DATA/seq_1.truth.txtpb" "$ONE/"
 make --no-print-directory -s -f "$SRC/Makefile.pipeline" DATASET="$ONE" BIN="$BIN" -j2 \
   > "$WORK/one.log" 2>&1 || { tail -20 "$WORK/one.log"; fail "make on a dataset of one bag failed"; }
+grep -q "guess_source: NONE" "$ONE/out/seq_1/rig.txtpb" || fail "one bag: the start was not from the motion"
+grep -q "starting extrinsic: no guess" "$ONE/out/seq_1/calibration.txtpb" ||
+  fail "one bag: the calibration does not say where its start came from"
+awk -F, 'function abs(v) { return v < 0 ? -v : v }
+NR > 1 && $1 == "seq_1" {
+  found = 1
+  if ($9 == "" || $9 > 0.25 || abs($10) > 1 || abs($11) > 1 || abs($12) > 1 || abs($13) > 0.5) {
+    print "FAIL: no rig extrinsic: errors rot " $9 " deg, x " $10 " cm, y " $11 " cm, z " $12 " cm, tau " $13 " ms"
+    bad = 1
+  }
+} END { exit bad || !found }' "$ONE/out/repeatability.csv" || fail "one bag without a rig extrinsic: errors too large"
 for f in calibration.txtpb report.html repeatability.txt; do
   [ -s "$ONE/out/$f" ] || fail "one bag: no out/$f"
 done
@@ -83,6 +97,8 @@ if command -v chromium > /dev/null; then
     fail "one bag: the page does not show one sequence"
   grep -q "one sequence: no consistency check between sequences" <<<"$dom" ||
     fail "one bag: the page does not say there was one sequence"
+  grep -q "starting extrinsic: no guess" <<<"$dom" ||
+    fail "one bag: the page does not say where the starting extrinsic came from"
 else
   echo "chromium is not installed (scripts/setup.sh installs it): the one-bag page not opened"
 fi

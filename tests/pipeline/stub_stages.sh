@@ -24,7 +24,7 @@ done
 exit 0
 STUB
   chmod +x "$bin/stub"
-  for stage in decode ground gravity gravity_reference calibrate dataset_calibration report inspect; do
+  for stage in decode initial_extrinsic ground gravity gravity_reference calibrate dataset_calibration report inspect; do
     ln -sf stub "$bin/tiltcal_$stage"
   done
   cat > "$bin/python" <<'STUB'

@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -19,6 +20,7 @@
 #include "common/io/text_proto.h"
 #include "tiltcal/proto/imu.pb.h"
 #include "tiltcal/proto/simulate_params.pb.h"
+#include "stages/calibrate/rotation_from_motion.h"
 #include "tests/stages/calibrate/short_sequence_fixture.h"
 
 namespace tiltcal::calibrate {
@@ -71,6 +73,52 @@ TEST_F(CalibrateFaultsTest, UndeclaredUpsideDownImuIsRefusedWithTheAxisAngle) {
   EXPECT_GT(angle, 170.0) << m;
 }
 
+// The starting extrinsic from the motion (rotation_from_motion.h): the rig
+// cases that calibrate alone refuses above, and no guess at all, end within
+// 2 deg of the truth, where the calibration takes over; the calibration
+// started there is within 0.1 deg.
+double RotationFromTruthDeg(const Eigen::Quaterniond& q, const proto::SimulationTruth& truth) {
+  const Eigen::Quaterniond t = ToEigen(truth.imu_from_lidar()).rotation;
+  return Eigen::AngleAxisd(q * t.conjugate()).angle() * 180.0 / M_PI;
+}
+
+TEST_F(CalibrateFaultsTest, WrongRigRotationsAndNoGuessAreCorrectedFromTheMotion) {
+  const Eigen::Quaterniond truth = ToEigen(truth_.imu_from_lidar()).rotation;
+  const struct {
+    const char* name;
+    std::optional<Eigen::Quaterniond> guess;
+  } cases[] = {
+      {"yaw off by 90 deg",
+       Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ())) * truth},
+      {"upside down (180 deg about x)",
+       Eigen::Quaterniond(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX())) * truth},
+      {"identity", Eigen::Quaterniond::Identity()},
+      {"no guess", std::nullopt},
+  };
+  for (const auto& c : cases) {
+    RotationFromMotion found;
+    const Status status = FindImuFromLidarRotation(inputs_.imu, inputs_.scans, c.guess,
+                                                   Eigen::Vector3d::Zero(), LidarImuParams(),
+                                                   &found);
+    ASSERT_TRUE(status.ok()) << c.name << ": " << status.message();
+    const double error_deg = RotationFromTruthDeg(found.imu_from_lidar, truth_);
+    std::printf("%s: %.3f deg from the truth after %zu rounds, %.2f s\n", c.name, error_deg,
+                found.rounds.size(), found.seconds);
+    EXPECT_LT(error_deg, 2.0) << c.name;
+    EXPECT_TRUE(found.about_axis_decided) << c.name;
+  }
+  // The calibration from the start found without a guess.
+  RotationFromMotion found;
+  ASSERT_TRUE(FindImuFromLidarRotation(inputs_.imu, inputs_.scans, std::nullopt,
+                                       Eigen::Vector3d::Zero(), LidarImuParams(), &found)
+                  .ok());
+  RotateRig(found.imu_from_lidar * ToEigen(inputs_.rig.imu_from_lidar()).rotation.conjugate());
+  proto::CalibrationResult result;
+  std::string log;
+  ASSERT_TRUE(Run(&result, &log).ok()) << log;
+  EXPECT_LT(RotationFromTruthDeg(ToEigen(result.imu_from_lidar()).rotation, truth_), 0.1) << log;
+}
+
 // A 5 s recording (3 s still, then 2 s of driving off nearly straight) with
 // the rig's right rotation, through the executables: exit 1 and an error
 // that names the missing turning with the measured amounts, not the rig
@@ -117,6 +165,21 @@ TEST_F(CalibrateFaultsTest, ShortRecordingWithARightRigIsRefusedForItsMotion) {
       << output;
   EXPECT_EQ(output.find("rig"), std::string::npos) << "the error blames the rig: " << output;
   EXPECT_FALSE(testing::FileExists(out));
+  // The pipeline meets the motion first in tiltcal_initial_extrinsic: the
+  // same refusal, naming the motion, not the rig.
+  const std::string sequence_rig = dir_->File("short_5s_sequence_rig.txtpb");
+  output.clear();
+  const int search_exit = testing::RunCommand(
+      testing::ToolPath("tiltcal_initial_extrinsic") + " --quiet --imu=" + imu + " --scans=" +
+          scans + " --rig=" + rig + " --params=" + params + " --out=" + sequence_rig,
+      &output);
+  std::printf("%s", output.c_str());
+  EXPECT_EQ(search_exit, 1) << output;
+  EXPECT_NE(output.find("too little turning"), std::string::npos) << output;
+  EXPECT_NE(output.find("record 30 s or more of driving with turns both ways"), std::string::npos)
+      << output;
+  EXPECT_EQ(output.find("rig"), std::string::npos) << "the error blames the rig: " << output;
+  EXPECT_FALSE(testing::FileExists(sequence_rig));
 }
 
 // Through the executable: exit code 1, one error line, no output left.
