@@ -47,13 +47,9 @@ Status RunRigCommand(const CommandLine& cli) {
 
 // `info --bag=... [--format=text|json]`: what a bag holds.
 Status RunBagInfoCommand(const CommandLine& cli) {
-  const std::string format = cli.Get("format");
-  if (format != "text" && format != "json") {
-    return Status::Error("--format=" + format + ": expected text or json");
-  }
   tiltcal::inspect::BagInfo info;
   TILTCAL_RETURN_IF_ERROR(tiltcal::inspect::ReadBagInfo(cli.Get("bag"), &info));
-  if (format == "json") {
+  if (cli.Get("format") == "json") {
     tiltcal::inspect::WriteBagInfoJson(info, std::cout);
   } else {
     tiltcal::inspect::WriteBagInfoText(info, std::cout);
@@ -139,6 +135,10 @@ int main(int argc, char** argv) {
                   : command == "info" ? " needs one FILE or --bag=BAG"
                                       : " needs one FILE")
               << " (see --help)\n";
+    return tiltcal::cli::kExitUsage;
+  }
+  if (cli.Get("format") != "text" && cli.Get("format") != "json") {
+    std::cerr << "tiltcal_inspect: --format=" << cli.Get("format") << ": expected text or json\n";
     return tiltcal::cli::kExitUsage;
   }
   std::ios::sync_with_stdio(false);

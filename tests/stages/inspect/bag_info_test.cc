@@ -326,6 +326,15 @@ TEST_F(BagInfo, EveryInputShape) {
   }
 }
 
+TEST_F(BagInfo, AnUnknownFormatIsAUsageError) {
+  std::string output;
+  EXPECT_EQ(testing::RunCommand(testing::ToolPath("tiltcal_inspect") +
+                                    " info --bag=any.bag --format=yaml",
+                                &output),
+            2);
+  EXPECT_EQ(output, "tiltcal_inspect: --format=yaml: expected text or json\n");
+}
+
 // A hostile name stays data: the JSON gives it back, the text keeps it on
 // its own line.
 TEST(BagInfoReport, NamesFromTheBagStayData) {
