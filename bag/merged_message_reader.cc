@@ -220,6 +220,16 @@ uint64_t MergedMessageReader::chunks_decompressed() const {
   return total;
 }
 
+Status MergedMessageReader::ChunkCompressions(std::map<std::string, int64_t>* compressions) const {
+  compressions->clear();
+  for (const auto& f : files_) {
+    std::map<std::string, int64_t> of_file;
+    TILTCAL_RETURN_IF_ERROR(f->ChunkCompressions(&of_file));
+    for (const auto& [name, count] : of_file) (*compressions)[name] += count;
+  }
+  return Status::Ok();
+}
+
 bool MergedMessageReader::TimeRange(int64_t* start_ns, int64_t* end_ns) const {
   bool any = false;
   for (const auto& f : files_) {

@@ -57,6 +57,7 @@ class MergedMessageReader : public MessageReader {
   int64_t num_salvaged_messages() const override;
   std::string salvage_note() const override;
   uint64_t chunks_decompressed() const override;
+  Status ChunkCompressions(std::map<std::string, int64_t>* compressions) const override;
   int64_t duplicates_dropped() const override { return duplicates_dropped_; }
   const std::vector<TopicInfo>& topics() const override { return topics_; }
   bool TimeRange(int64_t* start_ns, int64_t* end_ns) const override;

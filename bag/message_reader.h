@@ -10,6 +10,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -69,6 +70,12 @@ class MessageReader {
   virtual std::string salvage_note() const { return ""; }
   // Compressed chunks decompressed so far.
   virtual uint64_t chunks_decompressed() const { return 0; }
+  // The chunks of the file(s) by compression ("none", "bz2", "lz4",
+  // "zstd"); empty for a format without chunks (rosbag2 sqlite3).
+  virtual Status ChunkCompressions(std::map<std::string, int64_t>* compressions) const {
+    compressions->clear();
+    return Status::Ok();
+  }
   // Messages left out because another file of the sequence held the same
   // message (bag/merged_message_reader.h), in the last ReadMessages().
   virtual int64_t duplicates_dropped() const { return 0; }

@@ -29,6 +29,10 @@ class Ros1MessageReader : public MessageReader {
   int64_t num_salvaged_messages() const override { return reader_.num_salvaged_messages(); }
   std::string salvage_note() const override { return reader_.salvage_note(); }
   uint64_t chunks_decompressed() const override { return reader_.stats().chunks_decompressed; }
+  Status ChunkCompressions(std::map<std::string, int64_t>* compressions) const override {
+    *compressions = reader_.ChunkCompressions();
+    return Status::Ok();
+  }
   const std::vector<TopicInfo>& topics() const override { return topics_; }
   bool TimeRange(int64_t* start_ns, int64_t* end_ns) const override {
     return reader_.TimeRange(start_ns, end_ns);

@@ -149,12 +149,10 @@ Status ParseChunkIndex(const uint8_t* content, size_t size, ChunkIndexRecord* r)
 
 Status ParseMessage(const uint8_t* content, size_t size, MessageRecord* r) {
   FieldReader f(content, size);
-  uint32_t sequence = 0;
-  uint64_t publish_time = 0;
   TILTCAL_RETURN_IF_ERROR(f.U16("message channel_id", &r->channel_id));
-  TILTCAL_RETURN_IF_ERROR(f.U32("message sequence", &sequence));
+  TILTCAL_RETURN_IF_ERROR(f.U32("message sequence", &r->sequence));
   TILTCAL_RETURN_IF_ERROR(f.U64("message log_time", &r->log_time));
-  TILTCAL_RETURN_IF_ERROR(f.U64("message publish_time", &publish_time));
+  TILTCAL_RETURN_IF_ERROR(f.U64("message publish_time", &r->publish_time));
   r->data = f.here();
   r->size = f.remaining();
   return Status::Ok();

@@ -121,7 +121,9 @@ struct ChunkIndexRecord {
 inline constexpr size_t kMessageFixedBytes = 2 + 4 + 8 + 8;
 struct MessageRecord {
   uint16_t channel_id = 0;
+  uint32_t sequence = 0;
   uint64_t log_time = 0;
+  uint64_t publish_time = 0;
   const uint8_t* data = nullptr;
   size_t size = 0;
 };

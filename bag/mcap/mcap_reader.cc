@@ -82,7 +82,7 @@ Status McapReader::ReadRecord(uint64_t offset, uint64_t end, uint8_t* opcode,
   return ReadAt(offset + kRecordPrefixBytes, length, content->data());
 }
 
-Status McapReader::Open(const std::string& path) {
+Status McapReader::Open(const std::string& path, SummaryUse summary_use) {
   path_ = path;
   fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd_ < 0) return Status::Error(path + ": cannot open: " + std::strerror(errno));
@@ -91,7 +91,7 @@ Status McapReader::Open(const std::string& path) {
   file_size_ = static_cast<uint64_t>(st.st_size);
   TILTCAL_RETURN_IF_ERROR(ReadHeader());
   bool usable = false;
-  TILTCAL_RETURN_IF_ERROR(ReadSummary(&usable));
+  if (summary_use == SummaryUse::kIfUsable) TILTCAL_RETURN_IF_ERROR(ReadSummary(&usable));
   if (!usable) {
     indexed_ = false;
     schema_names_.clear();
@@ -347,8 +347,47 @@ Status McapReader::LoadChunk(uint32_t chunk, const std::vector<uint8_t>** record
   return Status::Ok();
 }
 
+Status McapReader::ChunkCompressions(std::map<std::string, int64_t>* compressions) const {
+  compressions->clear();
+  // Chunk content: start u64, end u64, uncompressed_size u64, crc u32, then
+  // the compression string (u32 length + bytes).
+  constexpr uint64_t kCompressionAt = kRecordPrefixBytes + 8 + 8 + 8 + 4;
+  for (const Chunk& chunk : chunks_) {
+    uint32_t length = 0;
+    if (chunk.length < kCompressionAt + 4) return Error(chunk.offset, "Chunk record too short");
+    TILTCAL_RETURN_IF_ERROR(ReadAt(chunk.offset + kCompressionAt, 4, &length));
+    if (length > chunk.length - kCompressionAt - 4) {
+      return Error(chunk.offset, "Chunk compression runs past its record");
+    }
+    std::string name(length, '\0');
+    TILTCAL_RETURN_IF_ERROR(ReadAt(chunk.offset + kCompressionAt + 4, length, name.data()));
+    ++(*compressions)[name.empty() ? "none" : name];
+  }
+  return Status::Ok();
+}
+
 Status McapReader::ReadMessages(const bag::MessageSelection& selection,
                                 const std::function<Status(const bag::Message&)>& fn) {
+  for (size_t id = 0; id < channels_.size(); ++id) {
+    const Channel* c = channels_[id].get();
+    if (c == nullptr || (!selection.topics.empty() &&
+                         std::find(selection.topics.begin(), selection.topics.end(), c->topic) ==
+                             selection.topics.end())) {
+      continue;
+    }
+    if (c->message_encoding != "ros1" && c->message_encoding != "cdr") {
+      return Status::Error(path_ + ": channel " + std::to_string(id) + " (topic '" + c->topic +
+                           "') has message encoding '" + c->message_encoding +
+                           "'; only cdr (ROS 2) and ros1 are read");
+    }
+  }
+  return ReadMessageRecords(selection, Order::kLogTime,
+                            [&fn](const bag::Message& m, const MessageRecord&) { return fn(m); });
+}
+
+Status McapReader::ReadMessageRecords(
+    const bag::MessageSelection& selection, Order order,
+    const std::function<Status(const bag::Message&, const MessageRecord&)>& fn) {
   std::vector<bool> selected(channels_.size(), false);
   std::vector<bag::Encoding> encodings(channels_.size(), bag::Encoding::kCdr);
   for (size_t id = 0; id < channels_.size(); ++id) {
@@ -358,13 +397,7 @@ Status McapReader::ReadMessages(const bag::MessageSelection& selection,
                              selection.topics.end())) {
       continue;
     }
-    if (c->message_encoding == "ros1") {
-      encodings[id] = bag::Encoding::kRos1;
-    } else if (c->message_encoding != "cdr") {
-      return Status::Error(path_ + ": channel " + std::to_string(id) + " (topic '" + c->topic +
-                           "') has message encoding '" + c->message_encoding +
-                           "'; only cdr (ROS 2) and ros1 are read");
-    }
+    if (c->message_encoding == "ros1") encodings[id] = bag::Encoding::kRos1;
     selected[id] = true;
   }
   std::vector<const Entry*> items;
@@ -374,15 +407,23 @@ Status McapReader::ReadMessages(const bag::MessageSelection& selection,
       items.push_back(&e);
     }
   }
-  // (log time, file position of the chunk or record, offset in the chunk).
+  // File order: (file position of the chunk or record, offset in the
+  // chunk); log-time order: (log time, file order).
   auto file_position = [this](const Entry* e) {
     return e->chunk == kNoChunk ? e->offset : chunks_[e->chunk].offset;
   };
-  std::sort(items.begin(), items.end(), [&](const Entry* a, const Entry* b) {
-    if (a->time_ns != b->time_ns) return a->time_ns < b->time_ns;
+  auto file_order = [&](const Entry* a, const Entry* b) {
     if (file_position(a) != file_position(b)) return file_position(a) < file_position(b);
     return a->offset < b->offset;
-  });
+  };
+  if (order == Order::kFile) {
+    std::sort(items.begin(), items.end(), file_order);
+  } else {
+    std::sort(items.begin(), items.end(), [&](const Entry* a, const Entry* b) {
+      if (a->time_ns != b->time_ns) return a->time_ns < b->time_ns;
+      return file_order(a, b);
+    });
+  }
   bag::Message m;
   m.file = nullptr;  // one file: the caller names it
   std::vector<uint8_t> record;
@@ -427,7 +468,7 @@ Status McapReader::ReadMessages(const bag::MessageSelection& selection,
     m.position = where;
     m.data = message.data;
     m.size = message.size;
-    TILTCAL_RETURN_IF_ERROR(fn(m));
+    TILTCAL_RETURN_IF_ERROR(fn(m, message));
     ++m.sequence;
   }
   // The decompressed chunks are freed once read (one file of a sequence

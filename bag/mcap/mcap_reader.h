@@ -22,7 +22,9 @@
 // the file and the byte offset of the record.
 
 #include <cstdint>
+#include <functional>
 #include <list>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -41,7 +43,25 @@ class McapReader : public bag::MessageReader {
   McapReader(const McapReader&) = delete;
   McapReader& operator=(const McapReader&) = delete;
 
-  Status Open(const std::string& path);
+  // Whether Open() may read the summary (kNever: the data section is
+  // scanned even when a usable summary is there, the streaming read).
+  enum class SummaryUse { kIfUsable, kNever };
+  Status Open(const std::string& path, SummaryUse summary_use = SummaryUse::kIfUsable);
+
+  // The order of ReadMessageRecords().
+  enum class Order {
+    kLogTime,  // (log time, file position), as ReadMessages()
+    kFile,     // as the Message records lie in the file
+  };
+  // Calls `fn` for every selected message with its Message record as the
+  // file holds it (channel, sequence, log and publish time, data), whatever
+  // its channel's message encoding: bag::Message::encoding is kRos1 for
+  // "ros1" channels and kCdr for every other. ReadMessages() is this in
+  // log-time order, for cdr and ros1 channels only.
+  Status ReadMessageRecords(
+      const bag::MessageSelection& selection, Order order,
+      const std::function<Status(const bag::Message&, const MessageRecord&)>& fn);
+
 
   // The profile of the Header record ("ros2", "ros1", ...).
   const std::string& profile() const { return profile_; }
@@ -59,6 +79,8 @@ class McapReader : public bag::MessageReader {
   }
   std::string salvage_note() const override { return salvage_note_; }
   uint64_t chunks_decompressed() const override { return chunks_decompressed_; }
+  // Read from the compression field of each Chunk record.
+  Status ChunkCompressions(std::map<std::string, int64_t>* compressions) const override;
   const std::vector<bag::TopicInfo>& topics() const override { return topics_; }
   bool TimeRange(int64_t* start_ns, int64_t* end_ns) const override;
   Status ReadMessages(const bag::MessageSelection& selection,

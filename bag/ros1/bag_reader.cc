@@ -952,4 +952,10 @@ Status BagReader::ReadMessages(const ReadOptions& options,
   return Status::Ok();
 }
 
+std::map<std::string, int64_t> BagReader::ChunkCompressions() const {
+  std::map<std::string, int64_t> compressions;
+  for (const Chunk& chunk : chunks_) ++compressions[ChunkCompressionName(chunk.compression)];
+  return compressions;
+}
+
 }  // namespace tiltcal::ros1

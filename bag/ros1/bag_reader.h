@@ -19,6 +19,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -111,6 +112,8 @@ class BagReader {
                       const std::function<Status(const MessageView&)>& fn);
 
   const ReaderStats& stats() const { return stats_; }
+  // The chunks by compression ("none", "bz2", "lz4").
+  std::map<std::string, int64_t> ChunkCompressions() const;
 
  private:
   struct Chunk;

@@ -6,6 +6,8 @@
 
 #include "common/cli/command_line.h"
 #include "common/io/params.h"
+#include "stages/inspect/bag_info.h"
+#include "stages/inspect/bag_info_report.h"
 #include "stages/inspect/check.h"
 #include "stages/inspect/default_params_text.h"
 #include "stages/inspect/ground_summary.h"
@@ -43,6 +45,18 @@ Status RunRigCommand(const CommandLine& cli) {
                                        std::cerr);
 }
 
+// `info --bag=... [--format=text|json]`: what a bag holds.
+Status RunBagInfoCommand(const CommandLine& cli) {
+  tiltcal::inspect::BagInfo info;
+  TILTCAL_RETURN_IF_ERROR(tiltcal::inspect::ReadBagInfo(cli.Get("bag"), &info));
+  if (cli.Get("format") == "json") {
+    tiltcal::inspect::WriteBagInfoJson(info, std::cout);
+  } else {
+    tiltcal::inspect::WriteBagInfoText(info, std::cout);
+  }
+  return Status::Ok();
+}
+
 Status RunCommand(const CommandLine& cli, const std::string& command, const std::string& path) {
   namespace inspect = tiltcal::inspect;
   int64_t from = 0, count = 0, record = 0;
@@ -67,11 +81,13 @@ Status RunCommand(const CommandLine& cli, const std::string& command, const std:
 
 int main(int argc, char** argv) {
   CommandLine cli("tiltcal_inspect", "looks into any file of the pipeline");
-  cli.SetPositional("info|cat|csv|pcd FILE  or  check  or  rig",
+  cli.SetPositional("info|cat|csv|pcd FILE  or  info|check|rig --bag=BAG",
                     "info: what the file is; cat: its records as text; csv: a table; "
-                    "pcd: one scan as a PCD file; check: the pre-flight check of a bag "
-                    "(--bag, --rig, --params); rig: a rig.txtpb drafted from a bag (--bag, "
-                    "--out, --params)",
+                    "pcd: one scan as a PCD file; info --bag: what a bag holds (format, "
+                    "compression, every topic with its type, count, encoding, rate and span; "
+                    "a rosbag2 bag's metadata.yaml beside it, disagreements as warnings; "
+                    "--format); check: the pre-flight check of a bag (--bag, --rig, "
+                    "--params); rig: a rig.txtpb drafted from a bag (--bag, --out, --params)",
                     1, 2);
   cli.AddFlag("from", "cat: first record to print", tiltcal::cli::kOptional, "0");
   cli.AddFlag("count", "cat: number of records to print (-1: all)", tiltcal::cli::kOptional,
@@ -83,8 +99,9 @@ int main(int argc, char** argv) {
   cli.AddFlag("ground", "pcd: ground.binpb whose point masks label the points");
   cli.AddFlag("out", "pcd: the PCD file to write; rig: the rig to write (default: stdout)");
   cli.AddFlag("bag",
-              "check, rig: the bag to look at (.bag, .mcap, .db3, a rosbag2 folder or a folder "
-              "of bag files)");
+              "info, check, rig: the bag to look at (.bag, .mcap, .db3, a rosbag2 folder or a "
+              "folder of bag files)");
+  cli.AddFlag("format", "info --bag: text or json", tiltcal::cli::kOptional, "text");
   cli.AddFlag("rig", "check, optional: rig.txtpb (topics, extrinsic for up, imu_height_m)");
   cli.AddFlag("params",
               "check, rig, optional: check params, text format (default: "
@@ -93,6 +110,8 @@ int main(int argc, char** argv) {
                  "--rig=datasets/husky/rig.txtpb");
   cli.AddExample("tiltcal_inspect rig --bag=datasets/husky/run1.bag "
                  "--out=datasets/husky/rig.txtpb");
+  cli.AddExample("tiltcal_inspect info --bag=datasets/husky/run1.bag");
+  cli.AddExample("tiltcal_inspect info --bag=datasets/husky/run2 --format=json");
   cli.AddExample("tiltcal_inspect info out/run1/scans.binpb.lz4");
   cli.AddExample("tiltcal_inspect csv out/run1/ground.binpb > ground.csv");
   cli.AddExample("tiltcal_inspect csv out/run1/scans.binpb.lz4 --points --record=10");
@@ -107,16 +126,25 @@ int main(int argc, char** argv) {
               << "' (info, cat, csv, pcd, check, rig; see tiltcal_inspect --help)\n";
     return tiltcal::cli::kExitUsage;
   }
-  const bool check = command == "check" || command == "rig";  // both take --bag
+  // check and rig take --bag; info takes --bag or a FILE.
+  const bool bag_info = command == "info" && !cli.Get("bag").empty();
+  const bool check = command == "check" || command == "rig" || bag_info;
   if (cli.positional().size() != (check ? 1u : 2u) || (check && cli.Get("bag").empty())) {
     std::cerr << "tiltcal_inspect: " << command
-              << (check ? " takes --bag=FILE and no FILE argument" : " needs one FILE")
+              << (check ? " takes --bag=FILE and no FILE argument"
+                  : command == "info" ? " needs one FILE or --bag=BAG"
+                                      : " needs one FILE")
               << " (see --help)\n";
+    return tiltcal::cli::kExitUsage;
+  }
+  if (cli.Get("format") != "text" && cli.Get("format") != "json") {
+    std::cerr << "tiltcal_inspect: --format=" << cli.Get("format") << ": expected text or json\n";
     return tiltcal::cli::kExitUsage;
   }
   std::ios::sync_with_stdio(false);
   Status status = command == "check" ? RunCheckCommand(cli)
                   : command == "rig" ? RunRigCommand(cli)
+                  : bag_info         ? RunBagInfoCommand(cli)
                                      : RunCommand(cli, command, cli.positional()[1]);
   if (status.ok()) status = FlushStdout();
   return cli.Finish(status);

@@ -237,6 +237,9 @@ for cmd in info cat csv; do
     STREAMING=1 expect_failure "$f" "$BIN/tiltcal_inspect" "$cmd" "$f"
   done
 done
+for f in $(generic_bad_files); do
+  expect_failure "$f" "$BIN/tiltcal_inspect" info --bag="$f"
+done
 for f in $(generic_bad_files) "$BAD/truncated_scans.binpb.lz4"; do
   # The last scan lies past the truncation.
   expect_failure "$f" "$BIN/tiltcal_inspect" pcd "$f" --record=29 --out="$OUT/scan.pcd"
