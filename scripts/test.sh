@@ -7,8 +7,9 @@ cd "$(dirname "$0")/.."
 # Slurm and munge too, so that the one-node cluster test (pipeline.slurm)
 # runs rather than skips; build.sh installs the rest.
 scripts/setup.sh --cluster
-# Tests on, whatever an earlier configure of the build directory chose.
-scripts/build.sh -DTILTCAL_WERROR=ON -DTILTCAL_BUILD_TESTS=ON
+# Tests on, whatever an earlier configure of the build directory chose; the
+# benchmarks (bench/, run by hand, never by a test) left out.
+scripts/build.sh -DTILTCAL_WERROR=ON -DTILTCAL_BUILD_TESTS=ON -DTILTCAL_BUILD_BENCHMARKS=OFF
 source scripts/phase_time.sh
 (cd "${BUILD_DIR:-build}" && ctest --output-on-failure -j "$(nproc)" "$@")
 phase_done ctest
