@@ -77,9 +77,9 @@ Status FindImuFromLidarRotation(const std::vector<imu::ImuReading>& imu_samples,
   const int pair_step = std::max(1, static_cast<int>(params.hand_eye().pair_step()));
   for (uint32_t round = 0; round < options.max_rounds(); ++round) {
     RotationSearchRound r;
-    // Without a guess, the first odometry uses neither the gyro's deskew
-    // nor its prediction (both would turn the wrong way).
-    r.gyro_aided = guess.has_value() || round > 0;
+    // The first odometry uses neither the gyro's deskew nor its prediction:
+    // with a guess off by tens of degrees both would turn the wrong way.
+    r.gyro_aided = round > 0;
     state.SetImuFromLidarRotation(c_bl);
     const OdometryRun run = RunOdometry(scans, state, search, r.gyro_aided, &report);
     if (run.used.size() < 3) {

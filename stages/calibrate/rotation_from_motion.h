@@ -3,9 +3,10 @@
 
 // The extrinsic rotation C_bl found from the motion alone, from any
 // starting guess or none (docs/design.md §9, "The starting extrinsic"):
-//  - the LiDAR odometry (every rotation_search.scan_step-th scan; without a
-//    guess on raw scans and without a gyro prior, afterwards deskewed and
-//    given the prior with the current C_bl) and the coarse tau;
+//  - the LiDAR odometry (every rotation_search.scan_step-th scan; in the
+//    first round on raw scans and without a gyro prior, which a wrong guess
+//    would turn the wrong way; afterwards deskewed and given the prior with
+//    the current C_bl) and the coarse tau;
 //  - when the motion turns about more than one axis (hand-eye excitation),
 //    the hand-eye rotation;
 //  - otherwise (planar motion) two steps: the smallest rotation that maps
