@@ -19,7 +19,8 @@ int main(int argc, char** argv) {
   cli.AddFlag("imu_frame", "name of the IMU frame/link", tiltcal::cli::kOptional, "imu_link");
   cli.AddFlag("lidar_frame", "name of the LiDAR frame/link", tiltcal::cli::kOptional,
               "lidar_link");
-  cli.AddSwitch("allow_suspect", "export a calibration whose verdict is SUSPECT (refused, exit 1, without it)");
+  cli.AddSwitch("allow_suspect",
+                "export a calibration whose verdict is SUSPECT (refused, exit 1, without it)");
   cli.AddExample("tiltcal_export --calibration=out/run1/calibration.txtpb --format=fast_lio");
   cli.AddExample(
       "tiltcal_export --calibration=out/run1/calibration.txtpb --format=urdf "

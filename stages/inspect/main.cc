@@ -72,7 +72,8 @@ int main(int argc, char** argv) {
   cli.SetPositional("info|cat|csv|pcd FILE  or  check  or  rig",
                     "info: what the file is; cat: its records as text; csv: a table; "
                     "pcd: one scan as a PCD file; check: the pre-flight check of a bag "
-                    "(--bag, --rig, --params; exit 1 when it cannot be calibrated); rig: a rig.txtpb drafted from a bag (--bag, "
+                    "(--bag, --rig, --params; exit 1 when it cannot be calibrated); rig: "
+                    "a rig.txtpb drafted from a bag (--bag, "
                     "--out, --params)",
                     1, 2);
   cli.AddFlag("from", "cat: first record to print", tiltcal::cli::kOptional, "0");
