@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The parsers under the sanitizers (README.md, "Reliability"): builds, with
+# The parsers under the sanitizers (fuzz/README.md, docs/reliability.md): builds, with
 # clang, ASan + UBSan (float-cast-overflow included, stop at the first
 # finding) and libFuzzer coverage, only what the I/O, bag and decode tests
 # and the fuzz harnesses need; runs those tests; then runs each harness for

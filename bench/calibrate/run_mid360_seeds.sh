@@ -4,8 +4,8 @@
 # LivoxPipelineTest (tests/stages/calibrate/short_flat_mid360.txtpb, seed 3
 # there) observes the yaw of the extrinsic weakly (σ about 0.1 deg): it is
 # the first sequence to show a worse initial trajectory, and one seed cannot
-# tell a worse method from an unlucky path (stages/calibrate/README.md,
-# "The odometry on the slower machine"). Each seed is simulated, decoded and
+# tell a worse method from an unlucky path (bench/calibrate/README.md).
+# Each seed is simulated, decoded and
 # ground-segmented once into <scratch>/s<seed> (reused while the scenario is
 # the same), then calibrated as the test does (--ground, no --gravity, the
 # ground residuals as the params set them) with each params file.

@@ -2,7 +2,7 @@
 # Accuracy and speed of tiltcal_calibrate over many simulated seeds of one
 # scenario, against an anchor build on the same inputs (docs/design.md §13).
 # A single sequence's error wanders by about its σ with the path the outer
-# loop takes (stages/calibrate/README.md, "The LM path"), so a change is
+# loop takes (docs/decisions.md), so a change is
 # judged on the RMS and the maximum over seeds, not on one run.
 #
 # For each seed (default 1-16) it simulates the scenario (default the 40 s

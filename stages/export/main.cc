@@ -10,13 +10,17 @@ int main(int argc, char** argv) {
   tiltcal::cli::CommandLine cli(
       "tiltcal_export",
       "the LiDAR-IMU extrinsic and time offset of a calibration.txtpb, ready to paste");
-  cli.AddFlag("calibration", "input: calibration.txtpb of one sequence", kRequired);
+  cli.AddFlag("calibration",
+              "input: a calibration.txtpb, the dataset's (out/calibration.txtpb) or a "
+              "sequence's (out/<sequence>/calibration.txtpb)",
+              kRequired);
   cli.AddFlag("format", "output format: " + tiltcal::exporter::ExportFormatNames(), kRequired);
   cli.AddFlag("out", "output file (default: stdout)");
   cli.AddFlag("imu_frame", "name of the IMU frame/link", tiltcal::cli::kOptional, "imu_link");
   cli.AddFlag("lidar_frame", "name of the LiDAR frame/link", tiltcal::cli::kOptional,
               "lidar_link");
-  cli.AddSwitch("allow_suspect", "export a calibration whose verdict is SUSPECT");
+  cli.AddSwitch("allow_suspect",
+                "export a calibration whose verdict is SUSPECT (refused, exit 1, without it)");
   cli.AddExample("tiltcal_export --calibration=out/run1/calibration.txtpb --format=fast_lio");
   cli.AddExample(
       "tiltcal_export --calibration=out/run1/calibration.txtpb --format=urdf "

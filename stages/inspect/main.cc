@@ -80,14 +80,17 @@ Status RunCommand(const CommandLine& cli, const std::string& command, const std:
 }  // namespace
 
 int main(int argc, char** argv) {
-  CommandLine cli("tiltcal_inspect", "looks into any file of the pipeline");
+  CommandLine cli("tiltcal_inspect",
+                  "looks into a bag before you calibrate (info --bag, check, rig) and into any "
+                  "file of the pipeline (info, cat, csv, pcd)");
   cli.SetPositional("info|cat|csv|pcd FILE  or  info|check|rig --bag=BAG",
                     "info: what the file is; cat: its records as text; csv: a table; "
                     "pcd: one scan as a PCD file; info --bag: what a bag holds (format, "
                     "compression, every topic with its type, count, encoding, rate and span; "
                     "a rosbag2 bag's metadata.yaml beside it, disagreements as warnings; "
                     "--format); check: the pre-flight check of a bag (--bag, --rig, "
-                    "--params); rig: a rig.txtpb drafted from a bag (--bag, --out, --params)",
+                    "--params; exit 1 when it cannot be calibrated); rig: a rig.txtpb "
+                    "drafted from a bag (--bag, --out, --params)",
                     1, 2);
   cli.AddFlag("from", "cat: first record to print", tiltcal::cli::kOptional, "0");
   cli.AddFlag("count", "cat: number of records to print (-1: all)", tiltcal::cli::kOptional,

@@ -9,7 +9,8 @@
 int main(int argc, char** argv) {
   tiltcal::cli::CommandLine cli("tiltcal_report",
                                 "repeatability over the calibrations of a dataset (SO(3) mean, "
-                                "sigma per component, errors against a simulation truth)");
+                                "sigma per component, errors against a simulation truth) and the "
+                                "dataset's page report.html");
   cli.SetPositional("SEQUENCE_DIR...",
                     "out/<sequence> folders, each with calibration.txtpb (+ truth.txtpb)", 1, -1);
   cli.AddFlag("out", "output: the repeatability table (text)", tiltcal::cli::kRequired);
