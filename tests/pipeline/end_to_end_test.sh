@@ -63,9 +63,9 @@ info=$("$BIN/tiltcal_inspect" info "$DATA/out/seq_1/scans.binpb.lz4")
 grep -qE "^records: 19[0-9]$" <<<"$info" || fail "inspect info does not count the scans"
 
 # The check against a stored calibration (here the dataset's own). These 20 s
-# sequences notice about 0.3-0.5 deg of yaw and 5 mm, not the 0.3 deg the
-# defaults require of a 40 s one (stages/verify/README.md): the dataset's
-# params/verify.txtpb asks for what they can decide.
+# sequences notice less yaw than the 0.5 deg the defaults ask of a 40 s one
+# (stages/verify/README.md): the dataset's params/verify.txtpb asks for what
+# they can decide, 1 deg.
 mkdir -p "$DATA/params"
 sed -e 's/^\(  rotation_deg:\).*/\1 1.0/' -e 's/^\(  translation_m:\).*/\1 0.02/' \
   "$SRC/stages/verify/default_params.txtpb" > "$DATA/params/verify.txtpb"
