@@ -215,16 +215,19 @@ void CompareWithReference(const proto::CalibrationResult& estimate,
       out->set_time_offset_difference_sigma(sigma);
       out->set_detectable_time_offset_s(axes[0]);
     }
-    const char* preposition = g.size == 1 ? "of" : g.start == 0 ? "about" : "along";
+    // "rotation about b (…)", "translation along b (…)", "tau change".
+    const std::string what =
+        g.size == 1 ? std::string(g.name) + " change"
+                    : fmt::format("{} {}{}", g.name, g.start == 0 ? "about" : "along",
+                                  Direction(weakest));
     if (!std::isfinite(weakest_m)) {
-      undecided.push_back(fmt::format("no {} {}{} is detected, whatever its size (the sequence "
-                                      "holds no information about it)",
-                                      g.name, preposition, Direction(weakest)));
+      undecided.push_back(fmt::format(
+          "no {} is detected, whatever its size (the sequence holds no information about it)",
+          what));
     } else if (weakest_m > g.detectable) {
       undecided.push_back(fmt::format(
-          "a {} {}{} below {:.3g} {} goes unnoticed (the check must notice {:.3g} {})", g.name,
-          preposition, Direction(weakest), weakest_m * g.unit_scale, g.unit,
-          g.detectable * g.unit_scale, g.unit));
+          "a {} below {:.3g} {} goes unnoticed (the check must notice {:.3g} {})", what,
+          weakest_m * g.unit_scale, g.unit, g.detectable * g.unit_scale, g.unit));
     } else {
       detected.push_back(fmt::format("{} {:.3g} {}", g.name, weakest_m * g.unit_scale, g.unit));
     }

@@ -110,6 +110,10 @@ std::string FormatTable(const proto::VerifyResult& result) {
         fmt::format("{:.2f}/{:.2f}", 1e3 * s.map_sharpness_estimate().median_thickness_m(),
                     1e3 * s.map_sharpness_reference().median_thickness_m()));
   }
+  for (const proto::SequenceVerification& s : result.sequences()) {
+    out += fmt::format("{} {}:\n", s.name(), proto::VerifyResult::Verdict_Name(s.verdict()));
+    for (const std::string& r : s.reasons()) out += "  - " + r + "\n";
+  }
   out += fmt::format("tiltcal_verify: {} against {}\n",
                      proto::VerifyResult::Verdict_Name(result.verdict()), result.reference());
   for (const std::string& r : result.verdict_reasons()) out += "  - " + r + "\n";

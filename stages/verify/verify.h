@@ -40,7 +40,8 @@ Status Run(const VerifyPaths& paths, const proto::VerifyParams& params,
            const proto::CalibrateParams& calibrate_params, std::ostream* log, std::ostream* table,
            proto::VerifyResult* result);
 
-// The table of the sequences and the dataset's verdict with its reasons.
+// The table of the sequences, each sequence's reasons, and the dataset's
+// verdict with its reasons.
 std::string FormatTable(const proto::VerifyResult& result);
 
 }  // namespace tiltcal::verify
