@@ -100,8 +100,8 @@ std::string DescribeDifference(const Group& g, const Eigen::VectorXd& d_g, doubl
   }
   const char* preposition = g.start == 0 ? "about" : "along";
   if (d_g.norm() == 0.0) return fmt::format("{} 0 {}, {:.1f} sigma", g.name, g.unit, sigma);
-  return fmt::format("{} {:.3f} {} {}{}, {:.1f} sigma", g.name, size, g.unit, preposition,
-                     Direction(d_g.normalized(), true), sigma);
+  return fmt::format("{} {:.{}f} {} {}{}, {:.1f} sigma", g.name, size, g.start == 3 ? 1 : 3,
+                     g.unit, preposition, Direction(d_g.normalized(), true), sigma);
 }
 
 // The smallest move along unit u the test detects (tangent units); +inf when
