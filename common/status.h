@@ -14,18 +14,32 @@ class [[nodiscard]] Status {
   Status() = default;
   static Status Ok() { return Status(); }
   static Status Error(std::string message) { return Status(std::move(message)); }
+  // A failure that is not the input's fault: the data cannot determine the
+  // result (e.g. a motion that turned too little to decide the extrinsic
+  // rotation). Callers that compare results (tiltcal_verify) report it as
+  // "cannot tell"; everyone else treats it as any error.
+  static Status NotDetermined(std::string message) {
+    Status s(std::move(message));
+    s.not_determined_ = true;
+    return s;
+  }
 
   bool ok() const { return !failed_; }
+  bool not_determined() const { return not_determined_; }
   const std::string& message() const { return message_; }
 
   // Prefixes the message with context, e.g. the file name: "file: message".
   Status WithContext(const std::string& context) const {
-    return ok() ? *this : Status(context + ": " + message_);
+    if (ok()) return *this;
+    Status s(context + ": " + message_);
+    s.not_determined_ = not_determined_;
+    return s;
   }
 
  private:
   explicit Status(std::string message) : failed_(true), message_(std::move(message)) {}
   bool failed_ = false;
+  bool not_determined_ = false;
   std::string message_;
 };
 

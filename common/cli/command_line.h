@@ -24,6 +24,10 @@ inline constexpr int kExitUsage = 2;    // the command line is wrong (unknown or
 // The result was written but is not to be used without reading why (e.g.
 // tiltcal_calibrate's verdict SUSPECT; the reasons are in the file and on stderr).
 inline constexpr int kExitSuspect = 3;
+// The result was written but decides nothing (tiltcal_verify's verdict
+// CANNOT_TELL: the recordings are too weak to decide; the reasons say which
+// direction).
+inline constexpr int kExitCannotTell = 4;
 
 // The command line of one tool: named flags `--name=value` (or `--name value`),
 // switches `--name` (or `--name=true|false`), and positional arguments.

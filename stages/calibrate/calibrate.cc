@@ -11,6 +11,7 @@
 #include <ceres/solver.h>
 #include <fmt/format.h>
 
+#include "common/geometry/translation_prior.h"
 #include "common/io/atomic_file.h"
 #include "common/io/eigen_proto.h"
 #include "common/io/imu_stream.h"
@@ -334,7 +335,7 @@ void FillCovariance(const CalibrateInputs& inputs, const proto::CalibrateParams&
       result->set_redundancy(factor.redundancy);
       if (params.observability().scale_by_variance_factor() && factor.redundancy > 0) {
         Matrix7d prior_information = Matrix7d::Zero();
-        prior_information.block<3, 3>(3, 3) = TranslationPriorInformation(
+        prior_information.block<3, 3>(3, 3) = geometry::TranslationPriorInformation(
             result->translation_prior_sigma_m(), ToEigen(result->translation_prior_axis_b()));
         cov = ScaleDataInformation(cov, prior_information, factor.sigma0_squared);
         result->set_covariance_scaled_by_variance_factor(true);

@@ -72,10 +72,6 @@ struct VarianceFactor {
 };
 VarianceFactor ComputeVarianceFactor(ceres::Problem* problem);
 
-// Information of the prior on r_b^{lb}, frame b: a a^T / sigma^2 along a unit
-// axis a, I / sigma^2 for a zero axis, zero for sigma <= 0.
-Eigen::Matrix3d TranslationPriorInformation(double sigma_m, const Eigen::Vector3d& axis_b);
-
 // The covariance with the data's information scaled by 1/sigma0^2 and the
 // priors' kept: a prior acts on the extrinsic block only, so the marginal
 // information is P^{-1} = S_data + L_prior, and the result is

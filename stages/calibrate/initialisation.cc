@@ -317,7 +317,7 @@ Status InitialExtrinsicRotation(const OdometryRun& run, const std::vector<LidarS
   // Without turning, the motion's axis is noise: neither hand-eye, nor the
   // axis alignment, nor a check of the rig can use it.
   const std::string missing = MissingTurning(report->turning, params.init());
-  if (!missing.empty()) return Status::Error(missing);
+  if (!missing.empty()) return Status::NotDetermined(missing);
   report->hand_eye = EstimateHandEyeRotation(pairs, params.hand_eye());
   Eigen::Quaterniond c_bl_init = ChooseInitialRotation(measured_imu_from_lidar, report->hand_eye);
   report->rotation_from_hand_eye = report->hand_eye.excited;

@@ -9,18 +9,22 @@
 
 #include <Eigen/Core>
 
+#include "common/calibration/calibration_checks.h"
+#include "common/calibration/extrinsic_estimate.h"
 #include "common/geometry/extrinsic_fusion.h"
 #include "common/io/eigen_proto.h"
 #include "common/io/provenance.h"
 #include "common/io/text_proto.h"
 #include "stages/calibrate/covariance_report.h"
-#include "stages/dataset_calibration/sequence_checks.h"
 
 namespace tiltcal::dataset {
 namespace {
 
+using calibration::DescribeComponent;
+using calibration::PriorInformation;
+using calibration::ReasonRefused;
+using calibration::ToEstimate;
 using geometry::ExtrinsicEstimate;
-using RowMajor7d = Eigen::Matrix<double, 7, 7, Eigen::RowMajor>;
 constexpr double kDegPerRad = 180.0 / M_PI;
 
 int Dimension(const proto::DatasetCalibrationParams& params) {
@@ -28,7 +32,7 @@ int Dimension(const proto::DatasetCalibrationParams& params) {
 }
 
 // Why a sequence cannot be fused ("" when it can): left out by the user,
-// refused (sequence_checks.h; the reason names the file), or SUSPECT.
+// refused (common/calibration/calibration_checks.h; the reason names the file), or SUSPECT.
 std::string ReasonNotUsable(const SequenceCalibration& s,
                             const proto::DatasetCalibrationParams& params) {
   const auto& excluded = params.exclude_sequences();
@@ -50,28 +54,6 @@ std::string ReasonNotUsable(const SequenceCalibration& s,
   }
 }
 
-// Information of the translation prior of one solve, n x n (zero: none);
-// the solve's covariance holds it unscaled.
-Eigen::MatrixXd PriorInformation(const proto::CalibrationResult& r, int n) {
-  Eigen::MatrixXd information = Eigen::MatrixXd::Zero(n, n);
-  information.block<3, 3>(3, 3) = calibrate::TranslationPriorInformation(
-      r.translation_prior_sigma_m(), ToEigen(r.translation_prior_axis_b()));
-  return information;
-}
-
-ExtrinsicEstimate ToEstimate(const proto::CalibrationResult& r, int n) {
-  const RowMajor7d covariance = Eigen::Map<const RowMajor7d>(r.covariance().data());
-  const Rigid3d extrinsic = ToEigen(r.imu_from_lidar());
-  ExtrinsicEstimate e;
-  e.rotation = extrinsic.rotation;
-  e.rest = Eigen::VectorXd(n - 3);
-  e.rest.head<3>() = extrinsic.translation;
-  if (n == 7) e.rest[3] = r.time_offset_s();
-  e.covariance = covariance.topLeftCorner(n, n);
-  e.prior_information = PriorInformation(r, n);
-  return e;
-}
-
 // The prior counted once: centred on the rig, the mean of the solves' own
 // prior information (their axes differ slightly with each motion).
 geometry::ExtrinsicPrior JointPrior(const std::vector<const proto::CalibrationResult*>& used,
@@ -84,14 +66,6 @@ geometry::ExtrinsicPrior JointPrior(const std::vector<const proto::CalibrationRe
     prior.information += PriorInformation(*r, n) / static_cast<double>(used.size());
   }
   return prior;
-}
-
-std::string DescribeComponent(int component, double z) {
-  static const char* kNames[] = {"rotation about l-x", "rotation about l-y",
-                                 "rotation about l-z", "translation along b-x",
-                                 "translation along b-y", "translation along b-z",
-                                 "time offset"};
-  return fmt::format("{}: {:+.1f} sigma", kNames[component], z);
 }
 
 struct Fusion {
@@ -345,7 +319,7 @@ Status CheckFinite(const proto::CalibrationResult& out) {
 Status CalibrateDataset(const std::vector<SequenceCalibration>& sequences,
                         const proto::DatasetCalibrationParams& params,
                         proto::CalibrationResult* out) {
-  TILTCAL_RETURN_IF_ERROR(ValidateSequenceInputParams(params.input()));
+  TILTCAL_RETURN_IF_ERROR(calibration::ValidateSequenceInputParams(params.input()));
   out->Clear();
   const int n = Dimension(params);
   Fusion f;

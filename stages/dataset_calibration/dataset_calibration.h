@@ -8,7 +8,7 @@
 // against the joint value, inconsistent ones left out by the params' rule.
 //
 // Usable: a calibration not excluded by the user, not refused by the input
-// checks (sequence_checks.h: non-finite numbers, non-unit quaternions, a
+// checks (common/calibration/calibration_checks.h: non-finite numbers, non-unit quaternions, a
 // covariance that is not symmetric positive definite with bounded sigmas and
 // condition; the reason names the file) and OK or WEAK. The result is a
 // CalibrationResult: imu_from_lidar, its covariance (7x7; the tau row and

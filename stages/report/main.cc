@@ -24,6 +24,9 @@ int main(int argc, char** argv) {
   cli.AddFlag("dataset_calibration",
               "input: the dataset's calibration.txtpb (tiltcal_dataset_calibration), for the joint "
               "row and the consistency column");
+  cli.AddFlag("verify",
+              "input: out/verify.txtpb (tiltcal_verify), for the page's section on the check "
+              "against a stored calibration");
   cli.AddExample(
       "tiltcal_report --out=out/repeatability.txt --out_csv=out/repeatability.csv "
       "--out_html=out/report.html "
@@ -37,6 +40,7 @@ int main(int argc, char** argv) {
   paths.out_html = cli.Get("out_html");
   paths.title = cli.Get("title");
   paths.dataset_calibration = cli.Get("dataset_calibration");
+  paths.verify = cli.Get("verify");
   tiltcal::proto::ReportParams params;
   const tiltcal::Status status = tiltcal::LoadParamsOrDefaults(
       cli.Get("params"), tiltcal::report::DefaultParamsText(), &params);

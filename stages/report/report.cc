@@ -320,6 +320,12 @@ Status Run(const ReportPaths& paths, const proto::ReportParams& params, std::ost
         ReadCalibrationAnswer(paths.dataset_calibration, &dataset->calibration));
     AddDatasetCalibration(dataset->calibration, results, &repeatability);
   }
+  std::optional<VerifyPage> verify;
+  if (!paths.verify.empty()) {
+    verify.emplace();
+    TILTCAL_RETURN_IF_ERROR(ReadTextProto(paths.verify, &verify->result));
+    if (!paths.out_html.empty()) verify->link = RelativeToPage(paths.out_html, paths.verify);
+  }
   // Everything is read and computed before the first output is written.
   std::string html;
   if (!paths.out_html.empty()) {
@@ -331,7 +337,8 @@ Status Run(const ReportPaths& paths, const proto::ReportParams& params, std::ost
       dataset->exports = MakePageExports(dataset->calibration, paths.dataset_calibration,
                                          &dataset->exports_note);
     }
-    html = FormatHtml(paths.title, repeatability, pages, dataset ? &*dataset : nullptr);
+    html = FormatHtml(paths.title, repeatability, pages, dataset ? &*dataset : nullptr,
+                      verify ? &*verify : nullptr);
   }
   const std::string table = FormatTable(repeatability, paths.title);
   TILTCAL_RETURN_IF_ERROR(WriteFileAtomically(paths.out, table));

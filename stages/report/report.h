@@ -80,6 +80,7 @@ struct ReportPaths {
   std::string out_html;
   std::string title;                       // first line of the table
   std::string dataset_calibration;         // optional: out/calibration.txtpb of the dataset
+  std::string verify;                      // optional: out/verify.txtpb (tiltcal_verify), page only
 };
 
 // Reads <dir>/calibration.txtpb and <dir>/truth.txtpb (if present) for each

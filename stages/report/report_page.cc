@@ -20,6 +20,7 @@ constexpr char kStyle[] =
     "td,th{border:1px solid #ccc;padding:2px 8px;text-align:right}"
     "th:first-child,td:first-child{text-align:left}"
     ".verdict-OK{color:#1e7b34}.verdict-WEAK{color:#a06800}.verdict-SUSPECT{color:#b00020}"
+    ".verdict-HOLDS{color:#1e7b34}.verdict-CANNOT_TELL{color:#a06800}.verdict-MOVED{color:#b00020}"
     ".histograms,.time-series-plots,.side-views,.snapshot-views{display:flex;flex-wrap:wrap;"
     "gap:1em}"
     "figure{margin:0.3em 0}figcaption{font-size:90%}"
@@ -270,12 +271,14 @@ std::string SequenceSection(const SequencePage& s) {
 }  // namespace
 
 std::string FormatHtml(const std::string& title, const Repeatability& repeatability,
-                       const std::vector<SequencePage>& sequences, const DatasetPage* dataset) {
+                       const std::vector<SequencePage>& sequences, const DatasetPage* dataset,
+                       const VerifyPage* verify) {
   std::string out = fmt::format(
       "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
       "<title>{0}</title>\n<style>{1}</style>\n</head>\n<body>\n<h1>{0}</h1>\n",
       EscapeHtml(title.empty() ? "tiltcal report" : title), kStyle);
   if (dataset != nullptr) out += DatasetSection(*dataset);
+  if (verify != nullptr) out += VerifySection(*verify);
   out += RepeatabilityTable(repeatability);
   for (const SequencePage& s : sequences) out += SequenceSection(s);
   out += "</body>\n</html>\n";

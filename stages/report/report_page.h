@@ -7,6 +7,7 @@
 #include "stages/report/map_snapshots.h"
 #include "stages/report/page_exports.h"
 #include "stages/report/report.h"
+#include "stages/report/verify_section.h"
 #include "tiltcal/proto/calibration.pb.h"
 
 namespace tiltcal::report {
@@ -40,14 +41,16 @@ struct DatasetPage {
 // The dataset's report page: one self-contained HTML file (inline CSS and
 // SVG, PNG as data: URIs; no script, no network): the dataset's calibration
 // with σ, its per-sequence consistency and its exports (when `dataset` is
-// given), the repeatability table and, per sequence, the verdict and its
+// given), the check against a stored calibration (when `verify` is given,
+// verify_section.h), the repeatability table and, per sequence, the verdict and its
 // reasons, the extrinsic and τ with σ, the map sharpness with the rig's
 // extrinsic and with the estimate and the wall snapshots of both maps, the
 // normalised residuals as histograms against N(0,1) and over time, the
 // exports, and the links to the calibration and the map PCDs.
 std::string FormatHtml(const std::string& title, const Repeatability& repeatability,
                        const std::vector<SequencePage>& sequences,
-                       const DatasetPage* dataset = nullptr);
+                       const DatasetPage* dataset = nullptr,
+                       const VerifyPage* verify = nullptr);
 
 }  // namespace tiltcal::report
 

@@ -111,6 +111,28 @@ for reference in '../flat$(touch PWNED)' '../flat`touch PWNED`' 'flat;touch PWNE
   rm -rf "$WORK"/flat*
 done
 
+# The verify target's REFERENCE (a path on the command line).
+dataset=$WORK/ds_verify
+make_dataset "$dataset"
+for reference in 'ref$(touch PWNED).txtpb' 'ref`touch PWNED`' 'ref;touch PWNED' 'my ref.txtpb'; do
+  for mode in run dry; do
+    if [ $mode = dry ]; then
+      run_make "$dataset" -n verify REFERENCE="$reference"
+    else
+      run_make "$dataset" verify REFERENCE="$reference"
+    fi
+    sleep 0.1
+    [ "$status" -ne 0 ] || fail "REFERENCE '$reference' ($mode): make exited 0"
+    pwned && fail "REFERENCE '$reference' ($mode): the name ran a command"
+    [ -s "$STUB_LOG" ] && fail "REFERENCE '$reference' ($mode): a stage ran"
+    grep -qF -- "REFERENCE '$reference' holds characters" "$WORK/make.out" ||
+      fail "REFERENCE '$reference' ($mode): not refused: $(head -c 600 "$WORK/make.out")"
+    find "$WORK" -name PWNED -delete
+  done
+  echo "ok: REFERENCE '$reference'"
+done
+rm -rf "$dataset"
+
 # Safe names run, every character of the safe set in use.
 dataset=$WORK/data-set_1+v2@site
 make_dataset "$dataset"

@@ -21,6 +21,7 @@
 #include <Eigen/Geometry>
 
 #include "common/geometry/so3.h"
+#include "common/geometry/translation_prior.h"
 #include "common/io/atomic_file.h"
 #include "common/io/eigen_proto.h"
 #include "common/io/text_proto.h"
@@ -419,13 +420,13 @@ TEST(CovarianceReportTest, ScalingTheDataKeepsThePrior) {
   Matrix7d a = Matrix7d::Random();
   const Matrix7d data = a * a.transpose() + Matrix7d::Identity();
   Matrix7d prior = Matrix7d::Zero();
-  prior.block<3, 3>(3, 3) = TranslationPriorInformation(0.05, Eigen::Vector3d(0, 0, 2));
+  prior.block<3, 3>(3, 3) = geometry::TranslationPriorInformation(0.05, Eigen::Vector3d(0, 0, 2));
   EXPECT_DOUBLE_EQ(prior(5, 5), 400.0);
   EXPECT_DOUBLE_EQ(prior(3, 3), 0.0);
   const Matrix7d scaled = ScaleDataInformation((data + prior).inverse(), prior, 0.25);
   EXPECT_LT((scaled - (data / 0.25 + prior).inverse()).norm(), 1e-12 * scaled.norm());
-  EXPECT_EQ(TranslationPriorInformation(0.0, Eigen::Vector3d::UnitZ()), Eigen::Matrix3d::Zero());
-  EXPECT_EQ(TranslationPriorInformation(0.5, Eigen::Vector3d::Zero()),
+  EXPECT_EQ(geometry::TranslationPriorInformation(0.0, Eigen::Vector3d::UnitZ()), Eigen::Matrix3d::Zero());
+  EXPECT_EQ(geometry::TranslationPriorInformation(0.5, Eigen::Vector3d::Zero()),
             Eigen::Matrix3d::Identity() * 4.0);
 }
 
@@ -521,7 +522,7 @@ TEST(CovarianceReportTest, ScalingKeepsAHeldParameterAtZero) {
   Eigen::Matrix<double, 6, 6> a = Eigen::Matrix<double, 6, 6>::Random();
   const Eigen::Matrix<double, 6, 6> data = a * a.transpose() + Eigen::Matrix<double, 6, 6>::Identity();
   Matrix7d prior = Matrix7d::Zero();
-  prior.block<3, 3>(3, 3) = TranslationPriorInformation(0.05, Eigen::Vector3d::UnitZ());
+  prior.block<3, 3>(3, 3) = geometry::TranslationPriorInformation(0.05, Eigen::Vector3d::UnitZ());
   const Eigen::Matrix<double, 6, 6> prior6 = prior.topLeftCorner<6, 6>();
   Matrix7d held = Matrix7d::Zero();
   held.topLeftCorner<6, 6>() = (data + prior6).inverse();

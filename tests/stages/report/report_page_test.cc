@@ -110,6 +110,47 @@ TEST(ResidualTimeSvg, BandsMedianRmsAndMarks) {
   EXPECT_THAT(ResidualTimeSvg(old), HasSubstr("lidar: no residuals over time"));
 }
 
+// The check against a stored calibration: verdicts, numbers and escaped
+// strings; no section without it.
+TEST(ReportPage, VerifySectionShowsVerdictsDifferencesAndEscapedStrings) {
+  VerifyPage verify;
+  verify.link = "verify.txtpb";
+  proto::VerifyResult& r = verify.result;
+  r.set_verdict(proto::VerifyResult::MOVED);
+  r.set_reference("vehicle<7>/calibration.txtpb");
+  r.add_verdict_reasons("run<1>: moved: rotation 1.000 deg about b (0.00, 0.00, 1.00)");
+  proto::SequenceVerification* s = r.add_sequences();
+  s->set_name("run<1>");
+  s->set_verdict(proto::VerifyResult::MOVED);
+  s->set_chi2(412.5);
+  s->set_dof(7);
+  s->set_limit(24.3);
+  s->mutable_rotation_difference_deg()->set_z(1.0);
+  s->set_rotation_difference_sigma(20.3);
+  s->mutable_translation_difference_m()->set_x(-0.03);
+  s->mutable_detectable_rotation_deg()->set_x(0.05);
+  s->mutable_detectable_rotation_deg()->set_z(0.41);
+  s->add_reasons("moved: rotation & more");
+  proto::SequenceVerification* weak = r.add_sequences();
+  weak->set_name("straight");
+  weak->set_verdict(proto::VerifyResult::CANNOT_TELL);
+  weak->add_reasons("cannot tell: the sequence cannot be calibrated: too little turning");
+  const std::string html = FormatHtml("d", Repeatability{}, {}, nullptr, &verify);
+  EXPECT_THAT(html, HasSubstr("<section class=\"verify\" id=\"verify\">"));
+  EXPECT_THAT(html, HasSubstr("verdict verdict-MOVED\">MOVED</span>"));
+  EXPECT_THAT(html, HasSubstr("<code>vehicle&lt;7&gt;/calibration.txtpb</code>"));
+  EXPECT_THAT(html, HasSubstr("<li>run&lt;1&gt;: moved: rotation 1.000 deg"));
+  EXPECT_THAT(html, HasSubstr("<td>run&lt;1&gt;</td><td class=\"verdict-MOVED\">MOVED</td>"
+                              "<td>412.5 / 24.3 (7)</td><td>(+0.000, +0.000, +1.000) (20.3)</td>"
+                              "<td>(-30.0, +0.0, +0.0) (0.0)</td>"));
+  EXPECT_THAT(html, HasSubstr("<td>(0.05, none, 0.41); (none, none, none); none</td>"));
+  EXPECT_THAT(html, HasSubstr("<td class=\"verdict-CANNOT_TELL\">CANNOT_TELL</td>"));
+  EXPECT_THAT(html, HasSubstr("<li>moved: rotation &amp; more</li>"));
+  EXPECT_THAT(html, HasSubstr("too little turning</li>"));
+  EXPECT_THAT(html, Not(HasSubstr("<run<1>")));
+  EXPECT_THAT(FormatHtml("d", Repeatability{}, {}), Not(HasSubstr("class=\"verify\"")));
+}
+
 TEST(ReportPage, SectionsShowVerdictExtrinsicSharpnessAndEscapedReasons) {
   SequencePage page;
   page.name = "run1";

@@ -1,8 +1,10 @@
-#ifndef TILTCAL_STAGES_DATASET_CALIBRATION_SEQUENCE_CHECKS_H_
-#define TILTCAL_STAGES_DATASET_CALIBRATION_SEQUENCE_CHECKS_H_
+#ifndef TILTCAL_COMMON_CALIBRATION_CALIBRATION_CHECKS_H_
+#define TILTCAL_COMMON_CALIBRATION_CALIBRATION_CHECKS_H_
 
-// What a sequence's calibration must hold before it is fused
-// (proto::SequenceInputParams): every number the fusion reads finite, the
+// What a calibration must hold before its extrinsic and covariance are
+// used (proto::SequenceInputParams): by tiltcal_dataset_calibration before
+// it fuses a sequence, by tiltcal_verify for the reference and each
+// sequence's estimate: every number the fusion reads finite, the
 // quaternions of imu_from_lidar and rig_imu_from_lidar unit within
 // max_quaternion_norm_error, tau sigma >= 0, and the fused block of the
 // covariance (6x6: rotation [rad] and translation [m]; 7x7 with tau [s] when
@@ -17,7 +19,7 @@
 #include "tiltcal/proto/calibration.pb.h"
 #include "tiltcal/proto/dataset_params.pb.h"
 
-namespace tiltcal::dataset {
+namespace tiltcal::calibration {
 
 // min_sigma < max_sigma (what the schema's bounds cannot say).
 Status ValidateSequenceInputParams(const proto::SequenceInputParams& params);
@@ -27,6 +29,6 @@ Status ValidateSequenceInputParams(const proto::SequenceInputParams& params);
 std::string ReasonRefused(const proto::CalibrationResult& result, int n,
                           const proto::SequenceInputParams& params);
 
-}  // namespace tiltcal::dataset
+}  // namespace tiltcal::calibration
 
-#endif  // TILTCAL_STAGES_DATASET_CALIBRATION_SEQUENCE_CHECKS_H_
+#endif  // TILTCAL_COMMON_CALIBRATION_CALIBRATION_CHECKS_H_

@@ -1,4 +1,4 @@
-#include "stages/dataset_calibration/sequence_checks.h"
+#include "common/calibration/calibration_checks.h"
 
 #include <fmt/format.h>
 
@@ -8,10 +8,10 @@
 #include <algorithm>
 #include <cmath>
 
+#include "common/geometry/translation_prior.h"
 #include "common/io/eigen_proto.h"
-#include "stages/calibrate/covariance_report.h"
 
-namespace tiltcal::dataset {
+namespace tiltcal::calibration {
 namespace {
 
 using RowMajor7d = Eigen::Matrix<double, 7, 7, Eigen::RowMajor>;
@@ -98,7 +98,7 @@ std::string CheckPriorWithinCovariance(const proto::CalibrationResult& r, int n)
   const Eigen::MatrixXd p = Eigen::Map<const RowMajor7d>(r.covariance().data()).topLeftCorner(n, n);
   const Eigen::MatrixXd information = p.inverse();
   Eigen::MatrixXd prior = Eigen::MatrixXd::Zero(n, n);
-  prior.block<3, 3>(3, 3) = calibrate::TranslationPriorInformation(
+  prior.block<3, 3>(3, 3) = geometry::TranslationPriorInformation(
       r.translation_prior_sigma_m(), ToEigen(r.translation_prior_axis_b()));
   const Eigen::MatrixXd data = information - prior;
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(0.5 * (data + data.transpose()),
@@ -157,4 +157,4 @@ std::string ReasonRefused(const proto::CalibrationResult& r, int n,
   return reason;
 }
 
-}  // namespace tiltcal::dataset
+}  // namespace tiltcal::calibration
