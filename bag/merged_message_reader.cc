@@ -6,6 +6,7 @@
 #include <deque>
 #include <map>
 #include <mutex>
+#include <new>
 #include <thread>
 #include <unordered_map>
 
@@ -53,9 +54,12 @@ class MergedMessageReader::Source {
   // Starts reading the messages of `selection` that this file has.
   void Start(MessageSelection selection) {
     thread_ = std::thread([this, selection = std::move(selection)] {
-      Status status = reader_->ReadMessages(selection, [this](const Message& m) {
-        return Push(m);
-      });
+      Status status;
+      try {  // an exception would end the process from this thread
+        status = reader_->ReadMessages(selection, [this](const Message& m) { return Push(m); });
+      } catch (const std::bad_alloc&) {
+        status = Status::Error(file_ + ": out of memory reading its messages");
+      }
       std::lock_guard<std::mutex> lock(mutex_);
       if (!stop_) status_ = status;
       done_ = true;

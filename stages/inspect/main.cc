@@ -65,7 +65,9 @@ Status RunCommand(const CommandLine& cli, const std::string& command, const std:
 
 }  // namespace
 
-int main(int argc, char** argv) {
+namespace {
+
+int Main(int argc, char** argv) {
   CommandLine cli("tiltcal_inspect", "looks into any file of the pipeline");
   cli.SetPositional("info|cat|csv|pcd FILE  or  check  or  rig",
                     "info: what the file is; cat: its records as text; csv: a table; "
@@ -120,4 +122,10 @@ int main(int argc, char** argv) {
                                      : RunCommand(cli, command, cli.positional()[1]);
   if (status.ok()) status = FlushStdout();
   return cli.Finish(status);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return tiltcal::cli::RunMain("tiltcal_inspect", Main, argc, argv);
 }
