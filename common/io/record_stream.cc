@@ -199,8 +199,7 @@ Status RecordReader::Open(const std::string& path, const std::string& expected_p
     ::close(fd);
     return Status::Error(path + ": cannot open: " + std::strerror(errno));
   }
-  if (std::FILE* manifest = std::fopen(CommitManifestPath(path).c_str(), "rb")) {
-    std::fclose(manifest);
+  if (::access(CommitManifestPath(path).c_str(), F_OK) == 0) {  // exists (never opened)
     return Status::Error(path + ": its writer was interrupted while committing it with other "
                          "outputs (" + CommitManifestPath(path) +
                          " exists); rerun the stage that wrote it");
