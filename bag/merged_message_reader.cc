@@ -6,6 +6,7 @@
 #include <deque>
 #include <map>
 #include <mutex>
+#include <new>
 #include <thread>
 #include <unordered_map>
 
@@ -53,9 +54,12 @@ class MergedMessageReader::Source {
   // Starts reading the messages of `selection` that this file has.
   void Start(MessageSelection selection) {
     thread_ = std::thread([this, selection = std::move(selection)] {
-      Status status = reader_->ReadMessages(selection, [this](const Message& m) {
-        return Push(m);
-      });
+      Status status;
+      try {  // an exception would end the process from this thread
+        status = reader_->ReadMessages(selection, [this](const Message& m) { return Push(m); });
+      } catch (const std::bad_alloc&) {
+        status = Status::Error(file_ + ": out of memory reading its messages");
+      }
       std::lock_guard<std::mutex> lock(mutex_);
       if (!stop_) status_ = status;
       done_ = true;
@@ -148,7 +152,10 @@ Status MergedMessageReader::Open(const std::string& path,
   const MessageReader* ros1_file = nullptr;
   const MessageReader* ros2_file = nullptr;
   for (const auto& f : files_) {
-    (HasRos2TypeNames(*f) ? ros2_file : ros1_file) = f.get();
+    // The first file of each ROS version that holds messages (an empty
+    // file has no version).
+    const MessageReader*& first = HasRos2TypeNames(*f) ? ros2_file : ros1_file;
+    if (first == nullptr && f->TotalMessageCount() > 0) first = f.get();
     for (const TopicInfo& t : f->topics()) {
       auto [it, inserted] = topics.emplace(t.name, TopicInfo{t.name, t.type, 0});
       if (inserted) file_of_topic[t.name] = f->path();
@@ -159,7 +166,7 @@ Status MergedMessageReader::Open(const std::string& path,
       it->second.message_count += t.message_count;
     }
   }
-  if (ros1_file != nullptr && ros2_file != nullptr && ros1_file->TotalMessageCount() > 0) {
+  if (ros1_file != nullptr && ros2_file != nullptr) {
     return Status::Error(path + ": " + ros1_file->path() + " holds ROS 1 messages and " +
                          ros2_file->path() +
                          " ROS 2 ones; the files of one sequence must come from one ROS version");
@@ -210,6 +217,14 @@ std::string MergedMessageReader::salvage_note() const {
   for (const auto& f : files_) {
     const std::string note = f->salvage_note();
     if (!note.empty()) out += (out.empty() ? "" : "; ") + f->path() + ": " + note;
+  }
+  return out;
+}
+
+std::vector<std::string> MergedMessageReader::warnings() const {
+  std::vector<std::string> out;
+  for (const auto& f : files_) {
+    for (std::string& w : f->warnings()) out.push_back(std::move(w));
   }
   return out;
 }

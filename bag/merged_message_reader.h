@@ -22,7 +22,8 @@
 //
 // Files whose type names are ROS 1 ("sensor_msgs/Imu") and files whose
 // names are ROS 2 ("sensor_msgs/msg/Imu") are not merged: an error names
-// one file of each.
+// the first file of each that holds messages (files without messages are
+// of neither version).
 
 #include <cstdint>
 #include <memory>
@@ -56,6 +57,7 @@ class MergedMessageReader : public MessageReader {
   bool indexed() const override;
   int64_t num_salvaged_messages() const override;
   std::string salvage_note() const override;
+  std::vector<std::string> warnings() const override;  // every file's
   uint64_t chunks_decompressed() const override;
   Status ChunkCompressions(std::map<std::string, int64_t>* compressions) const override;
   int64_t duplicates_dropped() const override { return duplicates_dropped_; }

@@ -18,6 +18,10 @@
 
 namespace tiltcal::bag {
 
+// The most bytes one decompressed chunk of any format may hold, unless the
+// caller sets its own limit (decode params max_decompressed_chunk_mib).
+inline constexpr uint64_t kDefaultMaxChunkBytes = uint64_t{256} << 20;
+
 // How the messages are serialized.
 enum class Encoding { kRos1, kCdr };
 
@@ -68,6 +72,12 @@ class MessageReader {
   virtual bool indexed() const = 0;
   virtual int64_t num_salvaged_messages() const { return 0; }
   virtual std::string salvage_note() const { return ""; }
+  // What the reader left out of what the files hold, and why, one line each
+  // naming the file and with counts (a damaged record skipped, rows without
+  // a usable record time, files of the folder not read, a summary that
+  // disagrees with the data). Empty when everything was read. Known after
+  // Open(); decode prints them as warnings and keeps them in the provenance.
+  virtual std::vector<std::string> warnings() const { return {}; }
   // Compressed chunks decompressed so far.
   virtual uint64_t chunks_decompressed() const { return 0; }
   // The chunks of the file(s) by compression ("none", "bz2", "lz4",

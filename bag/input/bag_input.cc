@@ -1,17 +1,21 @@
 #include "bag/input/bag_input.h"
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <vector>
 
 #include "bag/mcap/mcap_reader.h"
 #include "bag/merged_message_reader.h"
 #include "bag/ros1/messages.h"
 #include "bag/ros2/messages.h"
+#include "bag/ros2/rosbag2_metadata.h"
 #include "bag/ros2/sqlite_bag_reader.h"
 #include "bag/input/ros1_message_reader.h"
+#include "common/io/input_file.h"
 
 namespace tiltcal::bag {
 
@@ -26,43 +30,74 @@ constexpr char kShapes[] =
     "a .bag (ROS 1), a .mcap, a .db3, a ROS 2 bag folder with metadata.yaml, or a folder of "
     ".bag / .mcap / .db3 files";
 
-// The storage_identifier of a rosbag2 metadata.yaml ("sqlite3", "mcap"),
-// and its relative_file_paths entries.
-void ReadStorage(const std::string& metadata, std::string* storage,
-                 std::vector<std::string>* files) {
-  std::ifstream in(metadata);
-  bool in_list = false;
-  for (std::string line; std::getline(in, line);) {
-    const size_t start = line.find_first_not_of(" \t");
-    if (start == std::string::npos) continue;
-    std::string t = line.substr(start);
-    t.erase(t.find_last_not_of(" \t\r") + 1);
-    if (in_list && t.rfind("- ", 0) == 0) {
-      files->push_back(t.substr(2));
-      continue;
-    }
-    in_list = t.rfind("relative_file_paths:", 0) == 0;
-    if (t.rfind("storage_identifier:", 0) == 0) {
-      *storage = t.substr(19);
-      storage->erase(0, storage->find_first_not_of(" \t\"'"));
-      storage->erase(storage->find_last_not_of(" \t\"'") + 1);
-    }
-  }
-}
-
 // The bag files directly in `folder` (.bag, .mcap, .db3), in name order.
-std::vector<std::string> BagFilesIn(const fs::path& folder) {
-  std::vector<std::string> files;
+// Sub-folders are not read; any other entry named like a bag that is not a
+// regular file (a dangling symbolic link, a link loop, a FIFO, a device) is
+// an error naming it.
+Status BagFilesIn(const fs::path& folder, std::vector<std::string>* files) {
   std::error_code ec;
   for (const fs::directory_entry& e : fs::directory_iterator(folder, ec)) {
     const std::string ext = e.path().extension().string();
-    if (e.is_regular_file(ec) && (ext == ".bag" || ext == ".mcap" || ext == ".db3")) {
-      files.push_back(e.path().string());
+    if (ext != ".bag" && ext != ".mcap" && ext != ".db3") continue;
+    std::error_code status_error;
+    const fs::file_status status = fs::status(e.path(), status_error);
+    if (fs::is_directory(status)) continue;
+    if (fs::is_regular_file(status)) {
+      files->push_back(e.path().string());
+      continue;
     }
+    const bool link = fs::is_symlink(fs::symlink_status(e.path(), ec));
+    if (link && status_error.value() == ELOOP) {
+      return Status::Error(e.path().string() + ": a symbolic link loop, not a bag file");
+    }
+    if (link && !fs::exists(status)) {
+      std::error_code target_error;
+      return Status::Error(e.path().string() + ": a symbolic link to " +
+                           fs::read_symlink(e.path(), target_error).string() +
+                           ", which does not exist");
+    }
+    TILTCAL_RETURN_IF_ERROR(CheckInputFile(e.path().string()));
   }
-  std::sort(files.begin(), files.end());
-  return files;
+  if (ec) return Status::Error(folder.string() + ": cannot list: " + ec.message());
+  std::sort(files->begin(), files->end());
+  return Status::Ok();
 }
+
+// A reader with the warnings of the folder around it (files it does not
+// read), everything else the reader's own.
+class FolderWarnings : public MessageReader {
+ public:
+  FolderWarnings(std::string path, std::unique_ptr<MessageReader> reader,
+                 std::vector<std::string> warnings)
+      : path_(std::move(path)), reader_(std::move(reader)), warnings_(std::move(warnings)) {}
+  const std::string& path() const override { return path_; }
+  std::vector<std::string> input_files() const override { return reader_->input_files(); }
+  uint64_t size_bytes() const override { return reader_->size_bytes(); }
+  std::string format_name() const override { return reader_->format_name(); }
+  bool indexed() const override { return reader_->indexed(); }
+  int64_t num_salvaged_messages() const override { return reader_->num_salvaged_messages(); }
+  std::string salvage_note() const override { return reader_->salvage_note(); }
+  std::vector<std::string> warnings() const override {
+    std::vector<std::string> all = warnings_;
+    for (std::string& w : reader_->warnings()) all.push_back(std::move(w));
+    return all;
+  }
+  uint64_t chunks_decompressed() const override { return reader_->chunks_decompressed(); }
+  int64_t duplicates_dropped() const override { return reader_->duplicates_dropped(); }
+  const std::vector<TopicInfo>& topics() const override { return reader_->topics(); }
+  bool TimeRange(int64_t* start_ns, int64_t* end_ns) const override {
+    return reader_->TimeRange(start_ns, end_ns);
+  }
+  Status ReadMessages(const MessageSelection& selection,
+                      const std::function<Status(const Message&)>& fn) override {
+    return reader_->ReadMessages(selection, fn);
+  }
+
+ private:
+  std::string path_;
+  std::unique_ptr<MessageReader> reader_;
+  std::vector<std::string> warnings_;
+};
 
 template <typename Reader>
 Status OpenWith(std::unique_ptr<Reader> r, const std::string& path,
@@ -75,11 +110,12 @@ Status OpenWith(std::unique_ptr<Reader> r, const std::string& path,
 // Opens every file of `files` (each by its first bytes) and merges them;
 // a single file is opened alone.
 Status OpenFiles(const std::string& path, const std::vector<std::string>& files,
-                 const Ros1ChunkSettings& ros1_chunks, std::unique_ptr<MessageReader>* reader) {
-  if (files.size() == 1) return OpenBagFile(files[0], ros1_chunks, reader);
+                 const Ros1ChunkSettings& ros1_chunks, const ReaderLimits& limits,
+                 std::unique_ptr<MessageReader>* reader) {
+  if (files.size() == 1) return OpenBagFile(files[0], ros1_chunks, reader, limits);
   std::vector<std::unique_ptr<MessageReader>> readers(files.size());
   for (size_t i = 0; i < files.size(); ++i) {
-    TILTCAL_RETURN_IF_ERROR(OpenBagFile(files[i], ros1_chunks, &readers[i]));
+    TILTCAL_RETURN_IF_ERROR(OpenBagFile(files[i], ros1_chunks, &readers[i], limits));
   }
   auto merged = std::make_unique<MergedMessageReader>();
   TILTCAL_RETURN_IF_ERROR(merged->Open(path, std::move(readers)));
@@ -116,31 +152,61 @@ SensorTypes SensorTypesOf(const MessageReader& reader) {
 }
 
 Status OpenBagInput(const std::string& path, const Ros1ChunkSettings& ros1_chunks,
-                    std::unique_ptr<MessageReader>* reader) {
+                    std::unique_ptr<MessageReader>* reader, const ReaderLimits& limits) {
   std::error_code ec;
   const fs::path p(path);
-  if (!fs::is_directory(p, ec)) return OpenBagFile(path, ros1_chunks, reader);
+  if (!fs::is_directory(p, ec)) return OpenBagFile(path, ros1_chunks, reader, limits);
   const fs::path metadata = p / "metadata.yaml";
-  if (!fs::exists(metadata, ec)) {
-    const std::vector<std::string> files = BagFilesIn(p);
+  if (!fs::exists(fs::symlink_status(metadata, ec))) {
+    std::vector<std::string> files;
+    TILTCAL_RETURN_IF_ERROR(BagFilesIn(p, &files));
     if (files.empty()) {
       return Status::Error(path + ": a folder with neither metadata.yaml nor bag files; expected " +
                            kShapes);
     }
-    return OpenFiles(path, files, ros1_chunks, reader);
+    return OpenFiles(path, files, ros1_chunks, limits, reader);
   }
-  std::string storage;
-  std::vector<std::string> relative_files;
-  ReadStorage(metadata.string(), &storage, &relative_files);
+  ros2::Rosbag2Metadata parsed;
+  TILTCAL_RETURN_IF_ERROR(ros2::ReadRosbag2Metadata(metadata.string(), &parsed));
+  const std::string& storage = parsed.storage_identifier;
   if (storage == "mcap") {
-    if (relative_files.empty()) {
+    if (!parsed.compression_format.empty()) {
+      return Status::Error(metadata.string() + ": compression_format '" +
+                           parsed.compression_format +
+                           "': compressed rosbag2 bags are not supported (decompress them with "
+                           "`ros2 bag convert`)");
+    }
+    if (parsed.relative_file_paths.empty()) {
       return Status::Error(metadata.string() + ": no relative_file_paths");
     }
     std::vector<std::string> files;
-    for (const std::string& f : relative_files) {
-      files.push_back((p / fs::path(f).filename()).string());
+    for (const std::string& f : parsed.relative_file_paths) {
+      const std::string file = (p / fs::path(f).filename()).string();
+      if (!fs::exists(file, ec)) {
+        return Status::Error(metadata.string() + ": lists '" + f + "', which is not in " + path);
+      }
+      files.push_back(file);
     }
-    return OpenFiles(path, files, ros1_chunks, reader);
+    std::string unlisted;
+    int num_unlisted = 0;
+    for (const fs::directory_entry& e : fs::directory_iterator(p, ec)) {
+      if (e.path().extension() == ".mcap" &&
+          std::find(files.begin(), files.end(), e.path().string()) == files.end()) {
+        unlisted += (num_unlisted++ == 0 ? "" : ", ") + e.path().filename().string();
+      }
+    }
+    std::unique_ptr<MessageReader> opened;
+    TILTCAL_RETURN_IF_ERROR(OpenFiles(path, files, ros1_chunks, limits, &opened));
+    if (num_unlisted == 0) {
+      *reader = std::move(opened);
+      return Status::Ok();
+    }
+    *reader = std::make_unique<FolderWarnings>(
+        path, std::move(opened),
+        std::vector<std::string>{path + ": " + std::to_string(num_unlisted) +
+                                 " .mcap file(s) of the folder not listed in metadata.yaml, not "
+                                 "read: " + unlisted});
+    return Status::Ok();
   }
   if (!storage.empty() && storage != "sqlite3") {
     return Status::Error(metadata.string() + ": storage_identifier '" + storage +
@@ -150,14 +216,19 @@ Status OpenBagInput(const std::string& path, const Ros1ChunkSettings& ros1_chunk
 }
 
 Status OpenBagFile(const std::string& path, const Ros1ChunkSettings& ros1_chunks,
-                   std::unique_ptr<MessageReader>* reader) {
+                   std::unique_ptr<MessageReader>* reader, const ReaderLimits& limits) {
   // A file is recognised by its first bytes, whatever its name; anything
   // that is neither MCAP nor sqlite3 goes to the ROS 1 reader, whose errors
-  // say what is wrong with it.
+  // say what is wrong with it. A FIFO or a device is refused first.
+  int fd = -1;
+  uint64_t size = 0;
+  TILTCAL_RETURN_IF_ERROR(OpenInputFile(path, &fd, &size));
   char head[16] = {};
-  std::ifstream(path, std::ios::binary).read(head, sizeof(head));
+  const ssize_t got = ::pread(fd, head, sizeof(head), 0);
+  ::close(fd);
+  if (got < 0) return Status::Error(path + ": cannot read: " + std::strerror(errno));
   if (std::memcmp(head, mcap::kMagic, sizeof(mcap::kMagic)) == 0) {
-    return OpenWith(std::make_unique<mcap::McapReader>(), path, reader);
+    return OpenWith(std::make_unique<mcap::McapReader>(limits.max_chunk_bytes), path, reader);
   }
   if (std::memcmp(head, kSqliteMagic, sizeof(kSqliteMagic)) == 0) {
     return OpenWith(std::make_unique<ros2::SqliteBagReader>(), path, reader);

@@ -13,7 +13,15 @@
 //                                            (each by its first bytes; not
 //                                            its sub-folders), merged in
 //                                            record time (bag/merged_message_reader.h)
-// A folder with neither is an error naming it and the shapes.
+// A folder with neither is an error naming it and the shapes. Every file is
+// refused before it is read unless it is a regular file (common/io/input_file.h);
+// in a folder without metadata.yaml, an entry named like a bag that is a
+// dangling symbolic link, a symbolic link loop, a FIFO or a device is an
+// error naming it (sub-folders are not read). A rosbag2 folder's
+// metadata.yaml is read by one parser for both storages
+// (bag/ros2/rosbag2_metadata.h): its files must exist, a compression_format
+// is refused, and files of the storage's extension it does not list are
+// named in a warning (MessageReader::warnings()).
 
 #include <memory>
 #include <string>
@@ -42,13 +50,21 @@ struct Ros1ChunkSettings {
   size_t read_ahead = 0;  // chunks decompressed ahead on a second thread
 };
 
+// The most memory one decompressed MCAP chunk may take (decode params
+// max_decompressed_chunk_mib); a chunk that declares more is an error.
+struct ReaderLimits {
+  uint64_t max_chunk_bytes = kDefaultMaxChunkBytes;
+};
+
 // Opens `path` with the reader of its shape.
 Status OpenBagInput(const std::string& path, const Ros1ChunkSettings& ros1_chunks,
-                    std::unique_ptr<MessageReader>* reader);
+                    std::unique_ptr<MessageReader>* reader,
+                    const ReaderLimits& limits = ReaderLimits());
 
 // Opens the one file `path` by its first bytes (MCAP, sqlite3, else ROS 1).
 Status OpenBagFile(const std::string& path, const Ros1ChunkSettings& ros1_chunks,
-                   std::unique_ptr<MessageReader>* reader);
+                   std::unique_ptr<MessageReader>* reader,
+                   const ReaderLimits& limits = ReaderLimits());
 
 }  // namespace tiltcal::bag
 

@@ -5,6 +5,7 @@
 #define ZSTD_STATIC_LINKING_ONLY
 #include <zstd.h>
 
+#include <algorithm>
 #include <cstring>
 
 namespace tiltcal::mcap {
@@ -34,7 +35,8 @@ Status CheckRatio(const char* codec, uint64_t compressed, uint64_t uncompressed,
 
 }  // namespace
 
-ChunkDecompressor::ChunkDecompressor() = default;
+ChunkDecompressor::ChunkDecompressor(uint64_t max_uncompressed_bytes)
+    : max_uncompressed_bytes_(std::min(max_uncompressed_bytes, kMaxChunkBytes)) {}
 
 ChunkDecompressor::~ChunkDecompressor() {
   if (lz4_ != nullptr) LZ4F_freeDecompressionContext(lz4_);
@@ -42,9 +44,12 @@ ChunkDecompressor::~ChunkDecompressor() {
 }
 
 Status ChunkDecompressor::Decompress(const ChunkRecord& chunk, std::vector<uint8_t>* out) {
-  if (chunk.uncompressed_size > kMaxChunkBytes) {
+  if (chunk.uncompressed_size > max_uncompressed_bytes_) {
     return Status::Error("chunk uncompressed_size " + std::to_string(chunk.uncompressed_size) +
-                         " bytes is beyond 4 GiB");
+                         " bytes is beyond the limit of " +
+                         std::to_string(max_uncompressed_bytes_) +
+                         " bytes for one decompressed chunk (decode params "
+                         "max_decompressed_chunk_mib)");
   }
   if (chunk.compression != "" && chunk.compression != "lz4" && chunk.compression != "zstd") {
     return Status::Error("unknown chunk compression '" + chunk.compression +

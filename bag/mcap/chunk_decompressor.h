@@ -8,8 +8,9 @@
 // A declared size the compressed bytes cannot produce is refused before
 // anything is allocated: beyond 256 bytes per byte for lz4 or 32768 for
 // zstd, not the frame's own content size when it has one, or beyond the
-// zstd frame's blocks times their maximum size. Errors say what differed (the
-// caller adds file and chunk offset).
+// zstd frame's blocks times their maximum size, or beyond the decompressor's
+// max_uncompressed_bytes (decode params max_decompressed_chunk_mib). Errors
+// say what differed (the caller adds file and chunk offset).
 
 #include <cstddef>
 #include <cstdint>
@@ -26,7 +27,7 @@ namespace tiltcal::mcap {
 
 class ChunkDecompressor {
  public:
-  ChunkDecompressor();
+  explicit ChunkDecompressor(uint64_t max_uncompressed_bytes = uint64_t{256} << 20);
   ~ChunkDecompressor();
   ChunkDecompressor(const ChunkDecompressor&) = delete;
   ChunkDecompressor& operator=(const ChunkDecompressor&) = delete;
@@ -42,6 +43,7 @@ class ChunkDecompressor {
   Status Lz4(const ChunkRecord& chunk, uint8_t* dst);
   Status Zstd(const ChunkRecord& chunk, uint8_t* dst);
 
+  uint64_t max_uncompressed_bytes_;
   LZ4F_dctx_s* lz4_ = nullptr;
   ZSTD_DCtx_s* zstd_ = nullptr;
 };

@@ -10,10 +10,13 @@
 #include <cstring>
 #include <deque>
 #include <mutex>
+#include <new>
 #include <set>
 #include <thread>
 #include <tuple>
 #include <unordered_map>
+
+#include "common/io/input_file.h"
 
 namespace tiltcal::ros1 {
 
@@ -179,8 +182,15 @@ class BagReader::ChunkReadAhead {
         }
       }
       const uint32_t chunk = order_[next];
-      uint8_t* dst = buffer.Reserve(std::max<size_t>(reader_->chunks_[chunk].size, 1));
-      Status status = reader_->LoadChunkWith(chunk, &decompressor, &compressed, dst);
+      Status status;
+      try {  // an exception would end the process from this thread
+        uint8_t* dst = buffer.Reserve(std::max<size_t>(reader_->chunks_[chunk].size, 1));
+        status = reader_->LoadChunkWith(chunk, &decompressor, &compressed, dst);
+      } catch (const std::bad_alloc&) {
+        status = Status::Error(reader_->path_ + ": chunk at byte " +
+                               std::to_string(reader_->chunks_[chunk].pos) +
+                               ": out of memory decompressing it");
+      }
       const bool failed = !status.ok();
       {
         std::lock_guard<std::mutex> lock(mutex_);
@@ -341,12 +351,7 @@ Status BagReader::AddConnection(const RecordHeader& header, const uint8_t* data,
 
 Status BagReader::Open(const std::string& path) {
   path_ = path;
-  fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd_ < 0) return Status::Error(path + ": cannot open: " + std::strerror(errno));
-  struct stat st;
-  if (::fstat(fd_, &st) != 0) return Status::Error(path + ": cannot stat: " + std::strerror(errno));
-  if (!S_ISREG(st.st_mode)) return Status::Error(path + ": not a regular file");
-  file_size_ = static_cast<uint64_t>(st.st_size);
+  TILTCAL_RETURN_IF_ERROR(OpenInputFile(path, &fd_, &file_size_));
   if (file_size_ == 0) return Status::Error(path + ": empty file (0 bytes), not a ROS bag");
 
   // Version line.

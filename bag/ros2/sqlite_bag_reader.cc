@@ -4,13 +4,13 @@
 
 #include <algorithm>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <queue>
 #include <sstream>
 
 #include "bag/ros2/messages.h"
 #include "bag/ros2/rosbag2_metadata.h"
+#include "common/io/input_file.h"
 
 namespace tiltcal::ros2 {
 
@@ -21,9 +21,9 @@ namespace {
 constexpr char kMetadataFile[] = "metadata.yaml";
 constexpr char kRowPosition[] = "row";
 
-// "file:<path>?immutable=1" with the characters a URI path cannot hold
+// "file:<path>?<query>" with the characters a URI path cannot hold
 // percent-encoded.
-std::string ImmutableUri(const std::string& path) {
+std::string FileUri(const std::string& path, const char* query) {
   std::string uri = "file:";
   for (unsigned char c : path) {
     if (c == '%' || c == '?' || c == '#' || c < 0x20) {
@@ -35,18 +35,7 @@ std::string ImmutableUri(const std::string& path) {
       uri += static_cast<char>(c);
     }
   }
-  return uri + "?immutable=1";
-}
-
-// The text of metadata.yaml.
-Status ReadMetadataFile(const std::string& file, std::string* text) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) return Status::Error(file + ": cannot read");
-  std::ostringstream buffer;
-  buffer << in.rdbuf();  // an empty file leaves the text empty
-  if (in.bad()) return Status::Error(file + ": cannot read");
-  *text = buffer.str();
-  return Status::Ok();
+  return uri + "?" + query;
 }
 
 }  // namespace
@@ -76,7 +65,7 @@ class SqliteBagReader::Cursor {
 
   Status Start(const std::vector<int64_t>& topic_ids, const bag::MessageSelection& selection) {
     std::string sql = "SELECT topic_id, timestamp, id, data FROM messages WHERE timestamp >= ?1 "
-                      "AND timestamp < ?2";
+                      "AND timestamp < ?2 AND typeof(timestamp) = 'integer'";
     if (!selection.topics.empty()) {
       sql += " AND topic_id IN (";
       for (size_t i = 0; i < topic_ids.size(); ++i) {
@@ -141,15 +130,20 @@ SqliteBagReader::~SqliteBagReader() = default;
 Status SqliteBagReader::ListFiles(const std::string& path) {
   std::error_code ec;
   if (!fs::is_directory(path, ec)) {
-    if (!fs::is_regular_file(path, ec)) return Status::Error(path + ": no such file or folder");
+    if (!fs::exists(path, ec)) return Status::Error(path + ": no such file or folder");
+    TILTCAL_RETURN_IF_ERROR(CheckInputFile(path));
     files_ = {path};
     return Status::Ok();
   }
   const std::string metadata = (fs::path(path) / kMetadataFile).string();
-  if (fs::exists(metadata, ec)) {
-    std::string text;
-    TILTCAL_RETURN_IF_ERROR(ReadMetadataFile(metadata, &text));
-    const Rosbag2Metadata parsed = ParseRosbag2Metadata(text);
+  std::vector<std::string> in_folder;  // the .db3 files of the folder, by name
+  for (const fs::directory_entry& e : fs::directory_iterator(path, ec)) {
+    if (e.path().extension() == ".db3") in_folder.push_back(e.path().string());
+  }
+  std::sort(in_folder.begin(), in_folder.end());
+  if (fs::exists(fs::symlink_status(metadata, ec))) {
+    Rosbag2Metadata parsed;
+    TILTCAL_RETURN_IF_ERROR(ReadRosbag2Metadata(metadata, &parsed));
     const std::vector<std::string>& relative = parsed.relative_file_paths;
     const std::string& compression = parsed.compression_format;
     if (!compression.empty()) {
@@ -160,17 +154,28 @@ Status SqliteBagReader::ListFiles(const std::string& path) {
     if (relative.empty()) return Status::Error(metadata + ": no relative_file_paths");
     for (const std::string& r : relative) {
       const std::string file = (fs::path(path) / fs::path(r).filename()).string();
-      if (!fs::is_regular_file(file, ec)) {
+      if (!fs::exists(file, ec)) {
         return Status::Error(metadata + ": lists '" + r + "', which is not in " + path);
       }
+      TILTCAL_RETURN_IF_ERROR(CheckInputFile(file));
       files_.push_back(file);
+    }
+    std::vector<std::string> unlisted;
+    for (const std::string& file : in_folder) {
+      if (std::find(files_.begin(), files_.end(), file) == files_.end()) {
+        unlisted.push_back(fs::path(file).filename().string());
+      }
+    }
+    if (!unlisted.empty()) {
+      std::string names;
+      for (const std::string& name : unlisted) names += (names.empty() ? "" : ", ") + name;
+      warnings_.push_back(path + ": " + std::to_string(unlisted.size()) +
+                          " .db3 file(s) of the folder not listed in metadata.yaml, not read: " +
+                          names);
     }
     return Status::Ok();
   }
-  for (const fs::directory_entry& e : fs::directory_iterator(path, ec)) {
-    if (e.path().extension() == ".db3") files_.push_back(e.path().string());
-  }
-  std::sort(files_.begin(), files_.end());
+  files_ = in_folder;
   if (files_.empty()) return Status::Error(path + ": neither metadata.yaml nor .db3 files");
   return Status::Ok();
 }
@@ -197,11 +202,15 @@ Status SqliteBagReader::OpenDatabase(const std::string& file,
                                      std::map<std::string, bag::TopicInfo>* topics) {
   auto d = std::make_unique<Database>();
   d->file = file;
+  TILTCAL_RETURN_IF_ERROR(CheckInputFile(file));  // sqlite3 would block on a FIFO
   std::error_code ec;
   size_bytes_ += fs::file_size(file, ec);
-  if (sqlite3_open_v2(ImmutableUri(file).c_str(), &d->db,
+  // With a WAL beside it, part of the messages may be in the WAL alone: the
+  // database is opened read-only with its WAL (immutable would ignore it).
+  const bool has_wal = fs::exists(file + "-wal", ec);
+  if (sqlite3_open_v2(FileUri(file, has_wal ? "mode=ro" : "immutable=1").c_str(), &d->db,
                       SQLITE_OPEN_READONLY | SQLITE_OPEN_URI, nullptr) != SQLITE_OK) {
-    return d->Error("cannot open as sqlite3");
+    return d->Error(has_wal ? "cannot open as sqlite3 with its -wal file" : "cannot open as sqlite3");
   }
   TILTCAL_RETURN_IF_ERROR(ReadTopics(d.get(), topics));
   databases_.push_back(std::move(d));
@@ -235,14 +244,18 @@ Status SqliteBagReader::ReadTopics(Database* d, std::map<std::string, bag::Topic
     d->topic_names[id] = name;
   }
   if (rc != SQLITE_DONE) return d->Error("reading the topics table");
+  // Counts and time range of the rows with an integer timestamp; the
+  // others (NULL, text, real) are counted apart and left out.
   sqlite3_stmt* c = nullptr;
   if (sqlite3_prepare_v2(d->db,
-                         "SELECT topic_id, COUNT(*), MIN(timestamp), MAX(timestamp) FROM "
-                         "messages GROUP BY topic_id",
+                         "SELECT topic_id, typeof(timestamp) = 'integer', COUNT(*), "
+                         "MIN(timestamp), MAX(timestamp) FROM messages GROUP BY 1, 2",
                          -1, &c, nullptr) != SQLITE_OK) {
     return d->Error("not a rosbag2 sqlite3 file (no messages table)");
   }
   std::unique_ptr<sqlite3_stmt, int (*)(sqlite3_stmt*)> count_guard(c, sqlite3_finalize);
+  int64_t unusable = 0;
+  std::map<std::string, int64_t> unusable_by_topic;
   while ((rc = sqlite3_step(c)) == SQLITE_ROW) {
     const int64_t id = sqlite3_column_int64(c, 0);
     const auto name = d->topic_names.find(id);
@@ -250,11 +263,55 @@ Status SqliteBagReader::ReadTopics(Database* d, std::map<std::string, bag::Topic
       return Status::Error(d->file + ": messages of topic id " + std::to_string(id) +
                            ", which the topics table does not have");
     }
-    (*topics)[name->second].message_count += sqlite3_column_int64(c, 1);
-    start_ns_ = std::min<int64_t>(start_ns_, sqlite3_column_int64(c, 2));
-    end_ns_ = std::max<int64_t>(end_ns_, sqlite3_column_int64(c, 3));
+    const int64_t count = sqlite3_column_int64(c, 2);
+    if (sqlite3_column_int(c, 1) == 0) {
+      unusable += count;
+      unusable_by_topic[name->second] += count;
+      continue;
+    }
+    (*topics)[name->second].message_count += count;
+    start_ns_ = std::min<int64_t>(start_ns_, sqlite3_column_int64(c, 3));
+    end_ns_ = std::max<int64_t>(end_ns_, sqlite3_column_int64(c, 4));
   }
   if (rc != SQLITE_DONE) return d->Error("counting the messages");
+  if (start_ns_ < 0) {
+    sqlite3_stmt* n = nullptr;
+    int64_t row = 0;
+    if (sqlite3_prepare_v2(d->db,
+                           "SELECT id FROM messages WHERE typeof(timestamp) = 'integer' AND "
+                           "timestamp < 0 ORDER BY id LIMIT 1",
+                           -1, &n, nullptr) == SQLITE_OK &&
+        sqlite3_step(n) == SQLITE_ROW) {
+      row = sqlite3_column_int64(n, 0);
+    }
+    sqlite3_finalize(n);
+    return Status::Error(d->file + ": row " + std::to_string(row) +
+                         " has a negative timestamp (before 1970): rosbag2 record times are "
+                         "nanoseconds since the epoch, and messages are read in their order");
+  }
+  if (unusable > 0) {
+    // The first rows named, with what their timestamp is.
+    sqlite3_stmt* u = nullptr;
+    std::string rows;
+    if (sqlite3_prepare_v2(d->db,
+                           "SELECT id, typeof(timestamp) FROM messages WHERE typeof(timestamp) "
+                           "!= 'integer' ORDER BY id LIMIT 5",
+                           -1, &u, nullptr) == SQLITE_OK) {
+      while (sqlite3_step(u) == SQLITE_ROW) {
+        const unsigned char* type = sqlite3_column_text(u, 1);
+        rows += (rows.empty() ? "" : ", ") + std::to_string(sqlite3_column_int64(u, 0)) + " (" +
+                (type == nullptr ? "?" : reinterpret_cast<const char*>(type)) + ")";
+      }
+    }
+    sqlite3_finalize(u);
+    std::string by_topic;
+    for (const auto& [topic, count] : unusable_by_topic) {
+      by_topic += (by_topic.empty() ? "" : ", ") + topic + " " + std::to_string(count);
+    }
+    warnings_.push_back(d->file + ": " + std::to_string(unusable) +
+                        " message(s) without an integer timestamp left out (" + by_topic +
+                        "; rows " + rows + (unusable > 5 ? ", ..." : "") + ")");
+  }
   return Status::Ok();
 }
 

@@ -11,8 +11,16 @@
 // must agree). Messages come in record-time order across all files (ties in
 // file order, then by row id), read by one cursor per file: memory does not
 // grow with the bag. The files are opened read-only and immutable (no
-// journal, no lock). Compressed bags (compression_format in the metadata)
-// and serialization formats other than cdr are errors naming the file.
+// journal, no lock), except a file with a "-wal" file beside it (a recorder
+// stopped before its last checkpoint): it is opened read-only without
+// immutable, so that the messages still in the WAL are read too.
+// What is not read is said in warnings(), with counts and names: .db3 files
+// of the folder that metadata.yaml does not list, and rows whose timestamp
+// is not an integer (NULL, text, real; left out of the counts and the time
+// range too). A negative timestamp (before 1970) is an error naming the
+// row: the record-time order of such a bag is not the order of recording.
+// Compressed bags (compression_format in the metadata) and serialization
+// formats other than cdr are errors naming the file.
 
 #include <cstdint>
 #include <map>
@@ -44,6 +52,7 @@ class SqliteBagReader : public bag::MessageReader {
   uint64_t size_bytes() const override { return size_bytes_; }
   std::string format_name() const override { return "rosbag2 sqlite3"; }
   bool indexed() const override { return true; }
+  std::vector<std::string> warnings() const override { return warnings_; }
   const std::vector<bag::TopicInfo>& topics() const override { return topics_; }
   bool TimeRange(int64_t* start_ns, int64_t* end_ns) const override;
   Status ReadMessages(const bag::MessageSelection& selection,
@@ -62,6 +71,7 @@ class SqliteBagReader : public bag::MessageReader {
   std::vector<std::string> files_;
   std::vector<std::unique_ptr<Database>> databases_;
   std::vector<bag::TopicInfo> topics_;
+  std::vector<std::string> warnings_;
   uint64_t size_bytes_ = 0;
   int64_t start_ns_ = INT64_MAX;
   int64_t end_ns_ = INT64_MIN;

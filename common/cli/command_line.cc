@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstdlib>
+#include <exception>
 #include <iostream>
+#include <new>
 
 #include <fmt/format.h>
 
@@ -171,6 +173,18 @@ void CommandLine::AddExitCode(int code, const std::string& meaning) {
 int CommandLine::Finish(const Status& status) const {
   if (status.ok()) return kExitOk;
   std::cerr << tool_ << ": " << status.message() << "\n";
+  return kExitFailure;
+}
+
+int RunMain(const char* tool, int (*body)(int, char**), int argc, char** argv) {
+  try {
+    return body(argc, argv);
+  } catch (const std::bad_alloc&) {
+    std::cerr << tool << ": out of memory (std::bad_alloc); the input needs more memory than "
+                         "this machine gave the process\n";
+  } catch (const std::exception& e) {
+    std::cerr << tool << ": internal error: " << e.what() << "\n";
+  }
   return kExitFailure;
 }
 

@@ -44,6 +44,14 @@ inline constexpr int kExitCannotTell = 4;
 // one line "<tool>: <what is wrong> (see --help)" (exit kExitUsage).
 enum Requirement { kOptional, kRequired };
 
+// The body of every tool's main():
+//   int main(int argc, char** argv) { return cli::RunMain("tiltcal_x", Main, argc, argv); }
+// returns body(argc, argv). A std::bad_alloc thrown anywhere in it becomes
+// one line "<tool>: out of memory (...)" on stderr and kExitFailure, any
+// other exception "<tool>: internal error: <what>" and kExitFailure; the
+// stack is unwound first, so no temporary output is left behind.
+int RunMain(const char* tool, int (*body)(int, char**), int argc, char** argv);
+
 class CommandLine {
  public:
   CommandLine(std::string tool, std::string purpose);

@@ -1,5 +1,9 @@
 #include "common/io/record_stream.h"
 
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <limits>
 
@@ -7,6 +11,7 @@
 #include <google/protobuf/io/zero_copy_stream_impl.h>
 #include <google/protobuf/util/delimited_message_util.h>
 
+#include "common/io/input_file.h"
 #include "common/io/lz4_stream.h"
 #include "common/io/scan_encoder.h"
 #include "tiltcal/proto/scan.pb.h"
@@ -184,12 +189,17 @@ Status RecordReader::Open(const std::string& path, const std::string& expected_p
   path_ = path;
   num_read_ = 0;
   at_end_ = false;
-  impl_->file = std::fopen(path.c_str(), "rb");
+  // A FIFO or a device is refused before it is read (it could block or
+  // never end).
+  int fd = -1;
+  uint64_t size = 0;
+  TILTCAL_RETURN_IF_ERROR(OpenInputFile(path, &fd, &size));
+  impl_->file = ::fdopen(fd, "rb");
   if (impl_->file == nullptr) {
+    ::close(fd);
     return Status::Error(path + ": cannot open: " + std::strerror(errno));
   }
-  if (std::FILE* manifest = std::fopen(CommitManifestPath(path).c_str(), "rb")) {
-    std::fclose(manifest);
+  if (::access(CommitManifestPath(path).c_str(), F_OK) == 0) {  // exists (never opened)
     return Status::Error(path + ": its writer was interrupted while committing it with other "
                          "outputs (" + CommitManifestPath(path) +
                          " exists); rerun the stage that wrote it");

@@ -8,7 +8,9 @@
 #include "stages/calibrate/calibrate_params_validation.h"
 #include "stages/calibrate/verdict.h"
 
-int main(int argc, char** argv) {
+namespace {
+
+int Main(int argc, char** argv) {
   using tiltcal::cli::kRequired;
   tiltcal::cli::CommandLine cli("tiltcal_calibrate",
                                 "continuous-time LiDAR-IMU calibration: extrinsic, time offset, "
@@ -62,4 +64,10 @@ int main(int argc, char** argv) {
     return tiltcal::cli::kExitSuspect;
   }
   return tiltcal::cli::kExitOk;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return tiltcal::cli::RunMain("tiltcal_calibrate", Main, argc, argv);
 }

@@ -8,7 +8,9 @@
 #include "stages/dataset_calibration/default_params_text.h"
 #include "tiltcal/proto/dataset_params.pb.h"
 
-int main(int argc, char** argv) {
+namespace {
+
+int Main(int argc, char** argv) {
   tiltcal::cli::CommandLine cli(
       "tiltcal_dataset_calibration",
       "one extrinsic from the calibrations of a dataset's sequences (their information fused, "
@@ -41,4 +43,10 @@ int main(int argc, char** argv) {
     return tiltcal::cli::kExitSuspect;
   }
   return tiltcal::cli::kExitOk;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return tiltcal::cli::RunMain("tiltcal_dataset_calibration", Main, argc, argv);
 }

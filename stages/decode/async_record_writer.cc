@@ -1,5 +1,7 @@
 #include "stages/decode/async_record_writer.h"
 
+#include <new>
+
 namespace tiltcal {
 
 AsyncRecordWriter::AsyncRecordWriter(const google::protobuf::Message& prototype,
@@ -41,7 +43,12 @@ void AsyncRecordWriter::Work() {
     busy_ = true;
     const bool failed = !error_.ok() || stopping_;  // stopping before Close(): an error path
     lock.unlock();
-    Status status = failed ? Status::Ok() : writer_.Write(*record);
+    Status status;
+    try {  // an exception would end the process from this thread
+      if (!failed) status = writer_.Write(*record);
+    } catch (const std::bad_alloc&) {
+      status = Status::Error("out of memory writing a scan");
+    }
     lock.lock();
     busy_ = false;
     if (!status.ok() && error_.ok()) error_ = status;

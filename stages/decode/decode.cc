@@ -132,6 +132,7 @@ void PrintSummary(std::ostream* log, const DecodePaths& paths,
                         s.salvaged_messages, s.salvage_note.empty() ? "" : "; ",
                         s.salvage_note);
   }
+  for (const std::string& warning : s.bag_warnings) *log << "  WARNING: bag: " << warning << "\n";
   *log << TopicLine("imu  ", s.imu_topic, s.imu_messages, s.imu_written, s.imu_first_stamp_ns,
                     s.imu_last_stamp_ns,
                     fmt::format("{} duplicate + {} conflicting stamps", s.imu_duplicates_dropped,
@@ -216,7 +217,11 @@ Status OpenBag(const DecodePaths& paths, const proto::DecodeParams& params, cons
   bag::Ros1ChunkSettings ros1_chunks;
   ros1_chunks.cache_size = std::max<uint32_t>(params.chunk_cache_size(), 1);
   ros1_chunks.read_ahead = params.read_ahead_chunks();
-  TILTCAL_RETURN_IF_ERROR(bag::OpenBagInput(paths.bag, ros1_chunks, input));
+  bag::ReaderLimits limits;
+  if (params.max_decompressed_chunk_mib() > 0) {
+    limits.max_chunk_bytes = uint64_t{params.max_decompressed_chunk_mib()} << 20;
+  }
+  TILTCAL_RETURN_IF_ERROR(bag::OpenBagInput(paths.bag, ros1_chunks, input, limits));
   const bag::MessageReader* reader = input->get();
   s->bag_bytes = reader->size_bytes();
   s->bag_format = reader->format_name();
@@ -224,17 +229,27 @@ Status OpenBag(const DecodePaths& paths, const proto::DecodeParams& params, cons
   s->indexed = reader->indexed();
   s->salvaged_messages = reader->num_salvaged_messages();
   s->salvage_note = reader->salvage_note();
+  s->bag_warnings = reader->warnings();
+  // A topic missing because the reader left data out says so (one line).
+  std::string left_out;
+  for (const std::string& w : s->bag_warnings) left_out += "; " + w;
+  auto with_left_out = [&](const Status& status) {
+    if (status.ok() || left_out.empty()) return status;
+    return Status::Error(status.message() + " (the reader left data out" + left_out + ")");
+  };
   if (reader->TotalMessageCount() == 0) {
-    return Status::Error(paths.bag + ": the bag holds no messages" +
-                         (s->salvage_note.empty() ? "" : " (" + s->salvage_note + ")"));
+    return with_left_out(
+        Status::Error(paths.bag + ": the bag holds no messages" +
+                      (s->salvage_note.empty() ? "" : " (" + s->salvage_note + ")")));
   }
   const bag::SensorTypes types = bag::SensorTypesOf(*reader);
   std::string imu_type;
-  TILTCAL_RETURN_IF_ERROR(ChooseTopic(*reader, {types.imu}, params.imu_topic(), rig.imu_topic(),
-                                      "imu_topic", &s->imu_topic, &imu_type));
-  TILTCAL_RETURN_IF_ERROR(ChooseTopic(*reader, types.Lidar(), params.lidar_topic(),
-                                      rig.lidar_topic(), "lidar_topic", &s->lidar_topic,
-                                      &s->lidar_type));
+  TILTCAL_RETURN_IF_ERROR(with_left_out(ChooseTopic(*reader, {types.imu}, params.imu_topic(),
+                                                    rig.imu_topic(), "imu_topic",
+                                                    &s->imu_topic, &imu_type)));
+  TILTCAL_RETURN_IF_ERROR(with_left_out(ChooseTopic(*reader, types.Lidar(), params.lidar_topic(),
+                                                    rig.lidar_topic(), "lidar_topic",
+                                                    &s->lidar_topic, &s->lidar_type)));
   if (s->imu_topic == s->lidar_topic) {
     return Status::Error(paths.bag + ": imu and lidar topic are the same: " + s->imu_topic);
   }
@@ -350,6 +365,9 @@ Status Decode(const DecodePaths& paths, const proto::DecodeParams& params, std::
   proto::Provenance provenance =
       MakeProvenance("tiltcal_decode", params, input_paths, paths.command_line);
   *provenance.mutable_tf_static() = bag::ToProto(s.tf_static);
+  // What the reader left out of the bag, in both outputs.
+  if (!s.salvage_note.empty()) provenance.add_notes("bag salvaged: " + s.salvage_note);
+  for (const std::string& warning : s.bag_warnings) provenance.add_notes("bag: " + warning);
 
   // Scans are serialized, framed and written on a second thread, 4 scans in
   // flight.

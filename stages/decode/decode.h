@@ -34,6 +34,8 @@ struct DecodeSummary {
   bool indexed = true;
   int64_t salvaged_messages = 0;
   std::string salvage_note;
+  // What the bag reader left out, one line each (bag::MessageReader::warnings()).
+  std::vector<std::string> bag_warnings;
   int64_t imu_messages = 0;         // read from the bag (inside the window)
   int64_t imu_written = 0;
   int64_t imu_duplicates_dropped = 0;   // same stamp and same values

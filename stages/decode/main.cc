@@ -8,7 +8,9 @@
 #include "stages/decode/default_params_text.h"
 #include "tiltcal/proto/decode_params.pb.h"
 
-int main(int argc, char** argv) {
+namespace {
+
+int Main(int argc, char** argv) {
   tiltcal::cli::CommandLine cli(
       "tiltcal_decode",
       "decodes the IMU and LiDAR topics of a bag (ROS 1 with none / bz2 / lz4 chunks, indexed "
@@ -39,4 +41,10 @@ int main(int argc, char** argv) {
       paths.params, tiltcal::decode::DefaultParamsText(), &params);
   if (status.ok()) status = tiltcal::Run(paths, params, &std::cerr);
   return cli.Finish(status);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return tiltcal::cli::RunMain("tiltcal_decode", Main, argc, argv);
 }

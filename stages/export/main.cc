@@ -5,7 +5,9 @@
 #include "stages/export/export.h"
 #include "stages/export/formats.h"
 
-int main(int argc, char** argv) {
+namespace {
+
+int Main(int argc, char** argv) {
   using tiltcal::cli::kRequired;
   tiltcal::cli::CommandLine cli(
       "tiltcal_export",
@@ -40,4 +42,10 @@ int main(int argc, char** argv) {
   options.imu_frame = cli.Get("imu_frame");
   options.lidar_frame = cli.Get("lidar_frame");
   return cli.Finish(tiltcal::exporter::Run(paths, options, &std::cout));
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return tiltcal::cli::RunMain("tiltcal_export", Main, argc, argv);
 }

@@ -7,7 +7,9 @@
 #include "stages/gravity/gravity.h"
 #include "tiltcal/proto/gravity_params.pb.h"
 
-int main(int argc, char** argv) {
+namespace {
+
+int Main(int argc, char** argv) {
   using tiltcal::cli::kRequired;
   tiltcal::cli::CommandLine cli("tiltcal_gravity",
                                 "inclination and flat-ground gravity reference of a sequence");
@@ -36,4 +38,10 @@ int main(int argc, char** argv) {
       paths.params, tiltcal::gravity::DefaultParamsText(), &params);
   if (status.ok()) status = tiltcal::gravity::Run(paths, params, &std::cerr);
   return cli.Finish(status);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return tiltcal::cli::RunMain("tiltcal_gravity", Main, argc, argv);
 }

@@ -8,7 +8,9 @@
 #include "stages/ground/ground_stage.h"
 #include "tiltcal/proto/ground_params.pb.h"
 
-int main(int argc, char** argv) {
+namespace {
+
+int Main(int argc, char** argv) {
   using tiltcal::cli::kRequired;
   tiltcal::cli::CommandLine cli("tiltcal_ground",
                                 "deskews scans and fits one ground plane per scan");
@@ -37,4 +39,10 @@ int main(int argc, char** argv) {
       paths.params, tiltcal::ground::DefaultParamsText(), &params);
   if (status.ok()) status = tiltcal::ground::Run(paths, params, &std::cerr);
   return cli.Finish(status);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return tiltcal::cli::RunMain("tiltcal_ground", Main, argc, argv);
 }

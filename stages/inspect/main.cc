@@ -79,7 +79,9 @@ Status RunCommand(const CommandLine& cli, const std::string& command, const std:
 
 }  // namespace
 
-int main(int argc, char** argv) {
+namespace {
+
+int Main(int argc, char** argv) {
   CommandLine cli("tiltcal_inspect",
                   "looks into a bag before you calibrate (info --bag, check, rig) and into any "
                   "file of the pipeline (info, cat, csv, pcd)");
@@ -151,4 +153,10 @@ int main(int argc, char** argv) {
                                      : RunCommand(cli, command, cli.positional()[1]);
   if (status.ok()) status = FlushStdout();
   return cli.Finish(status);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return tiltcal::cli::RunMain("tiltcal_inspect", Main, argc, argv);
 }

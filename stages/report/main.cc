@@ -6,7 +6,9 @@
 #include "stages/report/default_params_text.h"
 #include "stages/report/report.h"
 
-int main(int argc, char** argv) {
+namespace {
+
+int Main(int argc, char** argv) {
   tiltcal::cli::CommandLine cli("tiltcal_report",
                                 "repeatability over the calibrations of a dataset (SO(3) mean, "
                                 "sigma per component, errors against a simulation truth) and the "
@@ -46,4 +48,10 @@ int main(int argc, char** argv) {
       cli.Get("params"), tiltcal::report::DefaultParamsText(), &params);
   if (!status.ok()) return cli.Finish(status);
   return cli.Finish(tiltcal::report::Run(paths, params, &std::cout));
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return tiltcal::cli::RunMain("tiltcal_report", Main, argc, argv);
 }

@@ -7,7 +7,9 @@
 #include "stages/simulate/simulate.h"
 #include "tiltcal/proto/simulate_params.pb.h"
 
-int main(int argc, char** argv) {
+namespace {
+
+int Main(int argc, char** argv) {
   tiltcal::cli::CommandLine cli(
       "tiltcal_simulate",
       "simulates a LiDAR-IMU rig on a tilted plane: a real ROS1 bag, the ground truth and "
@@ -36,4 +38,10 @@ int main(int argc, char** argv) {
     status = tiltcal::simulate::Run(paths, params, cli.GetSwitch("quiet") ? nullptr : &std::cerr);
   }
   return cli.Finish(status);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return tiltcal::cli::RunMain("tiltcal_simulate", Main, argc, argv);
 }

@@ -253,5 +253,44 @@ TEST(MergedMessageReader, TopicTypesMustAgreeAndRosVersionsMustNotMix) {
   }
 }
 
+// An empty ROS 1 file after the one with messages does not hide the mix:
+// the first file of each version that holds messages is named.
+TEST(MergedMessageReader, RosVersionsMixIsFoundWhenTheLastRos1FileIsEmpty) {
+  std::vector<std::unique_ptr<MessageReader>> files;
+  files.push_back(std::make_unique<FakeReader>(
+      "run/a_imu.bag", std::vector<TopicInfo>{{"/imu", "sensor_msgs/Imu", 0}},
+      std::vector<FakeMessage>{{"/imu", 1, "x"}}));
+  files.push_back(std::make_unique<FakeReader>(
+      "run/b_lidar.mcap", std::vector<TopicInfo>{{"/points", "sensor_msgs/msg/PointCloud2", 0}},
+      std::vector<FakeMessage>{{"/points", 2, "x"}}));
+  files.push_back(std::make_unique<FakeReader>("run/c_empty.bag", std::vector<TopicInfo>{},
+                                               std::vector<FakeMessage>{}));
+  MergedMessageReader reader;
+  const std::string message = reader.Open("run", std::move(files)).message();
+  EXPECT_NE(message.find("run/a_imu.bag holds ROS 1 messages and run/b_lidar.mcap ROS 2 ones"),
+            std::string::npos)
+      << message;
+}
+
+// The warnings of every file, in file order.
+TEST(MergedMessageReader, WarningsOfEveryFile) {
+  class Warns : public FakeReader {
+   public:
+    Warns(std::string path, std::string warning)
+        : FakeReader(std::move(path), kImuAndLidar, {{"/imu", 1, "x"}}),
+          warning_(std::move(warning)) {}
+    std::vector<std::string> warnings() const override { return {warning_}; }
+
+   private:
+    std::string warning_;
+  };
+  std::vector<std::unique_ptr<MessageReader>> files;
+  files.push_back(std::make_unique<Warns>("run/a.bag", "run/a.bag: one"));
+  files.push_back(std::make_unique<Warns>("run/b.bag", "run/b.bag: two"));
+  MergedMessageReader reader;
+  ASSERT_TRUE(reader.Open("run", std::move(files)).ok());
+  EXPECT_EQ(reader.warnings(), (std::vector<std::string>{"run/a.bag: one", "run/b.bag: two"}));
+}
+
 }  // namespace
 }  // namespace tiltcal::bag

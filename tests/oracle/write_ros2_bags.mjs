@@ -17,7 +17,7 @@
 //
 // Usage:
 //   node write_ros2_bags.mjs OUT --format=mcap|sqlite3 [--compression=none|lz4|zstd]
-//        [--no-summary] [--big-endian] [--encoding=cdr|ros1] [--split=N] [--messages=IN.jsonl]
+//        [--no-summary] [--no-chunks] [--big-endian] [--encoding=cdr|ros1] [--split=N] [--messages=IN.jsonl]
 //        [--expected=EXPECTED.txt]
 // OUT is the .mcap file, or the rosbag2 folder (metadata.yaml + OUT_i.db3; a
 // new .db3 every N messages with --split=N).
@@ -118,13 +118,14 @@ const ROS1_DEFINITIONS = {
 const ros1TypeOf = (type) => type.replace("/msg/", "/");
 
 function parseArgs(argv) {
-  const args = { out: null, format: "mcap", compression: "none", summary: true,
+  const args = { out: null, format: "mcap", compression: "none", summary: true, chunks: true,
                  bigEndian: false, encoding: "cdr", split: 0, messages: null, expected: null };
   for (const a of argv) {
     if (!a.startsWith("--")) args.out = a;
     else if (a.startsWith("--format=")) args.format = a.slice(9);
     else if (a.startsWith("--compression=")) args.compression = a.slice(14);
     else if (a === "--no-summary") args.summary = false;
+    else if (a === "--no-chunks") args.chunks = false;
     else if (a === "--big-endian") args.bigEndian = true;
     else if (a.startsWith("--encoding=")) args.encoding = a.slice(11);
     else if (a.startsWith("--split=")) args.split = Number(a.slice(8));
@@ -379,6 +380,7 @@ async function writeMcap(args, messages, serialize, onMessage) {
   const writer = new McapWriter({
     writable: new FileHandleWritable(handle),
     chunkSize: 64 * 1024,
+    useChunks: args.chunks,
     compressChunk,
     useStatistics: args.summary, useSummaryOffsets: args.summary, useChunkIndex: args.summary,
     useMessageIndex: args.summary, repeatSchemas: args.summary, repeatChannels: args.summary,

@@ -81,7 +81,7 @@ TEST(McapChunkDecompressor, DeclaredSizeBeyondTheCompressedBytesIsRefusedBeforeA
       // Within zstd's ratio, but not the size its frame header declares.
       {Chunk("zstd", zstd, 2 * records.size()), "frame declares 5000 bytes"},
   };
-  ChunkDecompressor decompressor;
+  ChunkDecompressor decompressor(uint64_t{1} << 30);  // a limit above the declared sizes
   std::vector<uint8_t> out;
   const double rss_before_mb = PeakRssMb();
   for (const Case& c : cases) {
