@@ -8,7 +8,9 @@
 #include "stages/calibrate/calibrate_params_validation.h"
 #include "stages/calibrate/initial_extrinsic.h"
 
-int main(int argc, char** argv) {
+namespace {
+
+int Main(int argc, char** argv) {
   using tiltcal::cli::kRequired;
   tiltcal::cli::CommandLine cli(
       "tiltcal_initial_extrinsic",
@@ -42,4 +44,10 @@ int main(int argc, char** argv) {
         paths, params, cli.GetSwitch("quiet") ? nullptr : &std::cerr, &rig);
   }
   return cli.Finish(status);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return tiltcal::cli::RunMain("tiltcal_initial_extrinsic", Main, argc, argv);
 }

@@ -8,7 +8,9 @@
 #include "stages/gravity/gravity_reference.h"
 #include "tiltcal/proto/gravity_params.pb.h"
 
-int main(int argc, char** argv) {
+namespace {
+
+int Main(int argc, char** argv) {
   tiltcal::cli::CommandLine cli(
       "tiltcal_gravity_reference",
       "a flat dataset's gravity reference g_f from its sequences' calibrations (g_a with the "
@@ -32,4 +34,10 @@ int main(int argc, char** argv) {
       paths.params, tiltcal::gravity::DefaultParamsText(), &params);
   if (status.ok()) status = tiltcal::gravity::RunGravityReference(paths, params, &std::cerr);
   return cli.Finish(status);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return tiltcal::cli::RunMain("tiltcal_gravity_reference", Main, argc, argv);
 }

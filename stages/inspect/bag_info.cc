@@ -213,6 +213,8 @@ Status ReadBagInfo(const std::string& path, BagInfo* info) {
     info->message_count += f.count;
   }
   if (!info->salvage_note.empty()) info->warnings.push_back("salvaged: " + info->salvage_note);
+  // What the reader left out (damaged records, unlisted files, bad rows).
+  for (const std::string& w : reader->warnings()) info->warnings.push_back("reader: " + w);
   if (info->duplicates_dropped > 0) {
     info->warnings.push_back(fmt::format(
         "{} messages held by two files of the folder (same topic, time and bytes) counted once",

@@ -9,7 +9,9 @@
 #include "stages/verify/default_params_text.h"
 #include "stages/verify/verify.h"
 
-int main(int argc, char** argv) {
+namespace {
+
+int Main(int argc, char** argv) {
   using tiltcal::cli::kRequired;
   tiltcal::cli::CommandLine cli(
       "tiltcal_verify",
@@ -67,4 +69,10 @@ int main(int argc, char** argv) {
     default:
       return tiltcal::cli::kExitCannotTell;
   }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return tiltcal::cli::RunMain("tiltcal_verify", Main, argc, argv);
 }
