@@ -10,6 +10,8 @@
 #   x180          the true rotation turned 180 deg about the IMU's x
 #   tf_static     no imu_from_lidar; the bag's /tf_static has the true extrinsic
 #   tf_static_off no imu_from_lidar; the bag's /tf_static is 2 deg and 5 cm off
+#   inspect_rig   the rig `tiltcal_inspect rig` drafts from the bag with /tf_static,
+#                 imu_height_m filled in
 # Prints one row per case: exit code, verdict, rotation (deg), translation
 # per axis (mm) and tau (ms) errors against the truth, seconds of make.
 #   bench/initial_extrinsic/rig_faults.sh [--build_dir=DIR] [--scratch=DIR] [--seed=N]
@@ -130,7 +132,13 @@ run() {
   rm -rf "$d"; mkdir -p "$d"
   cp "$SCRATCH/$kind.$bag.bag" "$d/seq.bag"
   cp "$SCRATCH/$kind.$bag.truth.txtpb" "$d/seq.truth.txtpb"
-  rig "$case" "$kind" | sed '/^gravity_reference:/d' > "$d/rig.txtpb"
+  if [ "$case" = inspect_rig ]; then
+    # The rig tiltcal_inspect rig drafts from the bag, with imu_height_m filled in.
+    "$BIN/tiltcal_inspect" rig --bag="$d/seq.bag" --out="$d/draft.txtpb" 2> /dev/null
+    sed 's/^# imu_height_m: 0.0$/imu_height_m: 0.3/' "$d/draft.txtpb" > "$d/rig.txtpb"
+  else
+    rig "$case" "$kind" | sed '/^gravity_reference:/d' > "$d/rig.txtpb"
+  fi
   [ -n "$ref" ] && echo "gravity_reference: \"$ref\"" >> "$d/rig.txtpb"
   local start=$SECONDS rc=0
   make -s -f "$SRC/Makefile.pipeline" DATASET="$d" BIN="$BIN" > "$d/make.log" 2>&1 || rc=$?
@@ -154,6 +162,8 @@ done
 run tilted_measured tilted plain measured ../flat_measured
 run flat_tf_static flat tf_true tf_static
 run tilted_tf_static tilted tf_true tf_static ../flat_measured
+run flat_inspect_rig flat tf_true inspect_rig
+run tilted_inspect_rig tilted tf_true inspect_rig ../flat_measured
 run flat_tf_static_off flat tf_off tf_static_off
 run tilted_tf_static_off tilted tf_off tf_static_off ../flat_measured
 for d in "$SCRATCH"/*_tf_static_off; do
