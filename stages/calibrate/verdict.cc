@@ -123,6 +123,15 @@ std::string WeakTranslationReason(const proto::ObservabilityDirection& d,
   const Eigen::Vector3d v(d.direction(3), d.direction(4), d.direction(5));
   const double rig_m = v.dot(ToEigen(r.rig_imu_from_lidar().translation()));
   const double est_m = v.dot(ToEigen(r.imu_from_lidar().translation()));
+  if (r.has_starting_extrinsic() && !r.starting_extrinsic().translation_known()) {
+    // No lever-arm guess: the prior is wide and at zero, so the value is the
+    // data's, weakly.
+    return fmt::format(
+        "translation along b ({:.2f}, {:.2f}, {:.2f}) weakly determined by the motion (no "
+        "lever-arm guess in the rig): {:.4f} m, sigma {:.4f} m; longer driving with turns "
+        "both ways, or imu_from_lidar in the rig, determines it",
+        v.x(), v.y(), v.z(), est_m, d.sigma());
+  }
   return fmt::format(
       "translation along b ({:.2f}, {:.2f}, {:.2f}) taken from the rig (prior): {:.4f} m there "
       "(rig {:.4f} m), sigma {:.4f} m",

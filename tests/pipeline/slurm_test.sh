@@ -48,11 +48,11 @@ make --no-print-directory -f "$SRC/Makefile.pipeline" DATASET="$DATA" BIN="$BIN"
 mv "$DATA" "$WORK/slurm_run"
 bash "$SRC/scripts/slurm_local_cluster.sh" stop "$CLUSTER"
 
-# One completed job per $(LAUNCH) recipe: four stages per sequence, then the
+# One completed job per $(LAUNCH) recipe: five stages per sequence, then the
 # dataset's calibration and its gravity reference (the daemons are stopped:
 # the job completion log is complete).
 expected=$(for s in seq_1 seq_2; do
-  printf '%s\n' tiltcal_decode tiltcal_ground tiltcal_gravity tiltcal_calibrate
+  printf '%s\n' tiltcal_decode tiltcal_initial_extrinsic tiltcal_ground tiltcal_gravity tiltcal_calibrate
 done; printf '%s\n' tiltcal_dataset_calibration tiltcal_gravity_reference)
 jobs_file=$CLUSTER/jobcomp.txt
 [ -s "$jobs_file" ] || fail "no job completion records in $jobs_file"

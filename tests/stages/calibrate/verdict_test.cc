@@ -112,6 +112,26 @@ TEST(VerdictTest, WeakTranslationIsNamedWithTheRigValue) {
       << reasons;
 }
 
+// Without a lever-arm guess (the sequence rig's starting extrinsic says the
+// translation is unknown) the weak value is the data's, not the rig's; the
+// start and /tf_static are notes printed with the verdict.
+TEST(VerdictTest, WeakTranslationWithoutAGuessIsTheMotionsAndNotesArePrinted) {
+  CalibrationResult r = CleanResult();
+  r.mutable_starting_extrinsic()->set_translation_known(false);
+  r.add_verdict_notes("starting extrinsic: no guess");
+  r.mutable_observability(5)->set_weak(true);
+  r.mutable_observability(5)->set_sigma(0.048);
+  const std::string reasons = Decide(&r);
+  EXPECT_EQ(r.verdict(), CalibrationResult::WEAK);
+  EXPECT_EQ(reasons.find("taken from the rig"), std::string::npos) << reasons;
+  EXPECT_NE(reasons.find("translation along b (0.00, 0.00, 1.00) weakly determined by the "
+                         "motion (no lever-arm guess in the rig): 0.3000 m, sigma 0.0480 m"),
+            std::string::npos)
+      << reasons;
+  EXPECT_NE(FormatVerdict(r, Params()).find("\n  note: starting extrinsic: no guess"),
+            std::string::npos);
+}
+
 TEST(VerdictTest, WeakRotationAndTimeOffsetAreNamed) {
   CalibrationResult r = CleanResult();
   r.mutable_observability(2)->set_weak(true);
