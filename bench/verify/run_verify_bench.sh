@@ -95,7 +95,7 @@ for seed in $SEEDS; do dirs+=("$CHECK/out/s$seed"); done
 run_verify() {  # run_verify REFERENCE OUT DIRS...: tiltcal_verify, exit 0/3/4 accepted
   local reference=$1 out=$2 status=0
   shift 2
-  "${NICE[@]}" "$BIN/tiltcal_verify" --reference="$reference" \
+  "${NICE[@]}" "$BIN/tiltcal_verify" --reference="$reference" --rig="$CHECK/rig.txtpb" \
     --out="$out" "$@" > "$out.table" 2> "$out.log" || status=$?
   case $status in 0|3|4) ;; *) cat "$out.log" >&2; exit 1 ;; esac
 }

@@ -67,9 +67,8 @@ std::string GravityReferenceFrom(const std::string& rig_path, const std::string&
 
 }  // namespace
 
-Status RunInitialExtrinsic(const InitialExtrinsicPaths& paths,
-                           const proto::CalibrateParams& params, std::ostream* log,
-                           proto::Rig* sequence_rig) {
+Status FindSequenceRig(const InitialExtrinsicPaths& paths, const proto::CalibrateParams& params,
+                       std::ostream* log, proto::Rig* sequence_rig) {
   proto::Rig rig;
   TILTCAL_RETURN_IF_ERROR(LoadRig(paths.rig, &rig));
   std::vector<imu::ImuReading> imu;
@@ -93,8 +92,9 @@ Status RunInitialExtrinsic(const InitialExtrinsicPaths& paths,
       imu, scans, guess ? std::optional<Eigen::Quaterniond>(guess->rotation) : std::nullopt,
       translation, params, &found);
   if (!status.ok()) {
-    return Status::Error("cannot find the extrinsic rotation from the motion: " +
-                         status.message());
+    const std::string message =
+        "cannot find the extrinsic rotation from the motion: " + status.message();
+    return status.not_determined() ? Status::NotDetermined(message) : Status::Error(message);
   }
   const double change_deg =
       guess ? Eigen::AngleAxisd(found.imu_from_lidar * guess->rotation.conjugate()).angle() *
@@ -126,6 +126,13 @@ Status RunInitialExtrinsic(const InitialExtrinsicPaths& paths,
   *sequence_rig->mutable_starting_extrinsic() = start;
   sequence_rig->set_gravity_reference(
       GravityReferenceFrom(paths.rig, paths.out, rig.gravity_reference()));
+  return Status::Ok();
+}
+
+Status RunInitialExtrinsic(const InitialExtrinsicPaths& paths,
+                           const proto::CalibrateParams& params, std::ostream* log,
+                           proto::Rig* sequence_rig) {
+  TILTCAL_RETURN_IF_ERROR(FindSequenceRig(paths, params, log, sequence_rig));
   return WriteTextProto(paths.out, *sequence_rig);
 }
 

@@ -28,8 +28,14 @@ struct InitialExtrinsicPaths {
   std::string out;    // the sequence's rig.txtpb
 };
 
-// Reads the inputs, finds the starting extrinsic and writes the sequence's
-// rig atomically; one progress line per step on *log (may be null).
+// Reads the inputs and finds the starting extrinsic: the sequence's rig in
+// *sequence_rig (its gravity_reference rewritten relative to paths.out's
+// folder), nothing written; one progress line per step on *log (may be
+// null). A motion that cannot decide is Status::NotDetermined.
+Status FindSequenceRig(const InitialExtrinsicPaths& paths, const proto::CalibrateParams& params,
+                       std::ostream* log, proto::Rig* sequence_rig);
+
+// FindSequenceRig, then the sequence's rig written atomically to paths.out.
 Status RunInitialExtrinsic(const InitialExtrinsicPaths& paths,
                            const proto::CalibrateParams& params, std::ostream* log,
                            proto::Rig* sequence_rig);

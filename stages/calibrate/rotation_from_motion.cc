@@ -74,7 +74,11 @@ Status FindImuFromLidarRotation(const std::vector<imu::ImuReading>& imu_samples,
   state.SetImuFromLidarTranslation(translation_guess);
 
   Eigen::Quaterniond c_bl = guess.value_or(Eigen::Quaterniond::Identity()).normalized();
-  const int pair_step = std::max(1, static_cast<int>(params.hand_eye().pair_step()));
+  // Rotation pairs as far apart in time as the initialisation's (hand_eye.pair_step
+  // registered scans), so that the turning check means the same in both.
+  const int pair_step = std::max(
+      1, static_cast<int>(std::lround(static_cast<double>(params.hand_eye().pair_step()) /
+                                      std::max<uint32_t>(options.scan_step(), 1))));
   for (uint32_t round = 0; round < options.max_rounds(); ++round) {
     RotationSearchRound r;
     // The first odometry uses neither the gyro's deskew nor its prediction:
@@ -100,7 +104,7 @@ Status FindImuFromLidarRotation(const std::vector<imu::ImuReading>& imu_samples,
     }
     result->turning = MeasureTurning(pairs, pair_times_s);
     const std::string missing = MissingTurning(result->turning, params.init());
-    if (!missing.empty()) return Status::Error(missing);
+    if (!missing.empty()) return Status::NotDetermined(missing);
 
     result->hand_eye = EstimateHandEyeRotation(pairs, params.hand_eye());
     Eigen::Quaterniond next;
@@ -122,7 +126,7 @@ Status FindImuFromLidarRotation(const std::vector<imu::ImuReading>& imu_samples,
                next;
         result->about_axis_decided = true;
       } else if (!guess.has_value()) {
-        return Status::Error(fmt::format(
+        return Status::NotDetermined(fmt::format(
             "the motion turns about one axis only (hand-eye excitation {:.4f} rad, at least "
             "hand_eye.min_excitation_rad = {} needed), and its horizontal accelerations "
             "(RMS {:.3f} m/s^2, at least init.min_check_acceleration_mps2 = {} needed) are "

@@ -60,8 +60,9 @@ struct RotationFromMotion {
 // acceleration check (zero when unknown: the check then ignores the lever
 // arm's centripetal accelerations). Errors: too little turning
 // (MissingTurning), no guess and accelerations too small to decide the
-// rotation about the motion's axis (the line names both and what to record),
-// no settling within rotation_search.max_rounds.
+// rotation about the motion's axis (the line names both and what to record)
+// — both Status::NotDetermined: the motion cannot decide — and no settling
+// within rotation_search.max_rounds.
 Status FindImuFromLidarRotation(const std::vector<imu::ImuReading>& imu_samples,
                                 const std::vector<LidarScan>& scans,
                                 const std::optional<Eigen::Quaterniond>& guess,

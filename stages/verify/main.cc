@@ -29,6 +29,7 @@ int Main(int argc, char** argv) {
   cli.AddFlag("calibrate_params",
               "input: the calibrate params the sequences are calibrated with (default: "
               "stages/calibrate/default_params.txtpb, compiled in)");
+  cli.AddFlag("rig", "input: the dataset's rig.txtpb", kRequired);
   cli.AddFlag("out", "output: verify.txtpb", kRequired);
   cli.AddExample(
       "tiltcal_verify --reference=vehicle7/calibration.txtpb "
@@ -45,6 +46,7 @@ int Main(int argc, char** argv) {
   tiltcal::verify::VerifyPaths paths;
   paths.sequence_dirs = cli.positional();
   paths.reference = cli.Get("reference");
+  paths.rig = cli.Get("rig");
   paths.params = cli.Get("params");
   paths.calibrate_params = cli.Get("calibrate_params");
   paths.out = cli.Get("out");

@@ -11,6 +11,7 @@
 #include "common/io/provenance.h"
 #include "common/io/text_proto.h"
 #include "stages/calibrate/calibrate.h"
+#include "stages/calibrate/initial_extrinsic.h"
 #include "stages/calibrate/map_sharpness.h"
 #include "stages/verify/reference_comparison.h"
 
@@ -68,6 +69,21 @@ Status VerifySequence(const std::string& dir, const VerifyPaths& paths,
   out->set_name(SequenceName(dir));
   if (log != nullptr) *log << "tiltcal_verify: " << out->name() << ": calibrating\n";
   const calibrate::CalibratePaths sequence = SequencePaths(dir);
+  if (!std::filesystem::exists(sequence.rig)) {
+    // The pipeline's tiltcal_initial_extrinsic failed: the same search says why.
+    proto::Rig unused;
+    const Status start = calibrate::FindSequenceRig(
+        {sequence.imu, sequence.scans, paths.rig, sequence.rig}, calibrate_params, nullptr,
+        &unused);
+    if (start.ok()) {
+      return Status::Error(sequence.rig +
+                           ": missing (tiltcal_initial_extrinsic writes it; run make first)");
+    }
+    if (!start.not_determined()) return start.WithContext(dir);
+    out->set_verdict(proto::VerifyResult::CANNOT_TELL);
+    out->add_reasons("cannot tell: the sequence cannot be calibrated: " + start.message());
+    return Status::Ok();
+  }
   calibrate::CalibrateInputs inputs;
   TILTCAL_RETURN_IF_ERROR(
       calibrate::ReadCalibrateInputs(sequence, calibrate_params, &inputs).WithContext(dir));
@@ -137,7 +153,7 @@ Status Run(const VerifyPaths& paths, const proto::VerifyParams& params,
   out.set_reference(paths.reference);
   *out.mutable_reference_imu_from_lidar() = reference.imu_from_lidar();
   out.set_reference_time_offset_s(reference.time_offset_s());
-  std::vector<InputPath> inputs = {{"reference", paths.reference}};
+  std::vector<InputPath> inputs = {{"reference", paths.reference}, {"rig", paths.rig}};
   if (!paths.params.empty()) inputs.push_back({"params", paths.params});
   if (!paths.calibrate_params.empty()) {
     inputs.push_back({"calibrate_params", paths.calibrate_params});
@@ -146,7 +162,7 @@ Status Run(const VerifyPaths& paths, const proto::VerifyParams& params,
     TILTCAL_RETURN_IF_ERROR(VerifySequence(dir, paths, params, calibrate_params, reference, log,
                                            out.add_sequences()));
     const calibrate::CalibratePaths sequence = SequencePaths(dir);
-    inputs.push_back({"rig", sequence.rig});
+    if (std::filesystem::exists(sequence.rig)) inputs.push_back({"sequence_rig", sequence.rig});
     inputs.push_back({"imu", sequence.imu});
     inputs.push_back({"scans", sequence.scans});
     if (!sequence.ground.empty()) inputs.push_back({"ground", sequence.ground});

@@ -27,6 +27,9 @@ struct VerifyPaths {
   // ground.binpb and gravity.txtpb (what tiltcal_calibrate reads).
   std::vector<std::string> sequence_dirs;
   std::string reference;         // the stored calibration.txtpb
+  // The dataset's rig.txtpb: for a sequence without its own rig.txtpb (the
+  // starting extrinsic not found), the search is run again for its reason.
+  std::string rig;
   std::string params;            // provenance only; empty: the defaults
   std::string calibrate_params;  // provenance only; empty: calibrate's defaults
   std::string out;               // out/verify.txtpb

@@ -163,10 +163,13 @@ for seconds in 5 6; do
     { cat "$WORK/straight.log"; fail "straight $seconds s: not CANNOT_TELL"; }
   grep -q "verify\] Error 4" "$WORK/straight.log" || fail "straight $seconds s: tiltcal_verify did not exit 4"
 done
-grep -q "cannot be calibrated: the motion cannot decide the extrinsic rotation: too little turning" \
+grep -qE "cannot be calibrated: (.*: )?the motion cannot decide the extrinsic rotation: too little turning" \
   "$WORK/straight_5/out/verify.txtpb" || fail "straight 5 s: calibrate's reason is not named"
-grep -qE "cannot tell: a rotation about b \(-?0\.0[0-9], -?0\.0[0-9], 1\.00\) below" \
-  "$WORK/straight_6/out/verify.txtpb" || fail "straight 6 s: the weak yaw is not named"
+# The 6 s drive is at the turning threshold: either the yaw is named weak or
+# the starting extrinsic's search finds too little turning (it does, 0.016
+# rad RMS per pair against 0.02); CANNOT_TELL names which.
+grep -qE "cannot tell: a rotation about b \(-?0\.0[0-9], -?0\.0[0-9], 1\.00\) below|cannot be calibrated: .*too little turning" \
+  "$WORK/straight_6/out/verify.txtpb" || fail "straight 6 s: neither the weak yaw nor the turning is named"
 
 if command -v chromium > /dev/null; then
   dom=$(chromium --headless --no-sandbox --disable-gpu --no-first-run \
