@@ -1,5 +1,7 @@
 #include "bag/ros2/rosbag2_metadata.h"
 
+#include "bag/ros2/yaml_scalar.h"
+
 #include <unistd.h>
 
 #include <cerrno>
@@ -12,18 +14,9 @@ namespace tiltcal::ros2 {
 
 namespace {
 
-std::string Trim(const std::string& s) {
-  const size_t begin = s.find_first_not_of(" \t\r");
-  if (begin == std::string::npos) return "";
-  return s.substr(begin, s.find_last_not_of(" \t\r") + 1 - begin);
-}
-
-std::string Unquote(const std::string& s) {
-  if (s.size() >= 2 && (s.front() == '"' || s.front() == '\'') && s.back() == s.front()) {
-    return s.substr(1, s.size() - 2);
-  }
-  return s;
-}
+// The scalar rules shared with the other metadata.yaml reader.
+std::string Trim(const std::string& s) { return TrimYamlSpace(s); }
+std::string Unquote(const std::string& s) { return UnquoteYamlScalar(s); }
 
 }  // namespace
 

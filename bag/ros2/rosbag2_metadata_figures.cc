@@ -1,5 +1,7 @@
 #include "bag/ros2/rosbag2_metadata_figures.h"
 
+#include "bag/ros2/yaml_scalar.h"
+
 #include <cerrno>
 #include <cstdlib>
 #include <sstream>
@@ -10,18 +12,9 @@ namespace {
 
 constexpr char kRootKey[] = "rosbag2_bagfile_information";
 
-std::string Trim(const std::string& s) {
-  const size_t begin = s.find_first_not_of(" \t\r");
-  if (begin == std::string::npos) return "";
-  return s.substr(begin, s.find_last_not_of(" \t\r") + 1 - begin);
-}
-
-std::string Unquote(const std::string& s) {
-  if (s.size() >= 2 && (s.front() == '"' || s.front() == '\'') && s.back() == s.front()) {
-    return s.substr(1, s.size() - 2);
-  }
-  return s;
-}
+// The scalar rules shared with the other metadata.yaml reader.
+std::string Trim(const std::string& s) { return TrimYamlSpace(s); }
+std::string Unquote(const std::string& s) { return UnquoteYamlScalar(s); }
 
 // The key of "key: value" (unquoted), its value (unquoted) and whether it
 // opens a block (nothing after the colon); false when the line is no

@@ -17,19 +17,8 @@ mkdir -p "$GOOD" "$BAD" "$OUT"
 die() { echo "FAIL: $*" >&2; exit 1; }
 
 # ---- valid inputs ----
-sed -E -e "s/^duration_s: .*/duration_s: 3/" \
-  "$SRC/stages/simulate/scenarios/flat_vlp16.txtpb" > "$GOOD/scenario.txtpb"
-"$BIN/tiltcal_simulate" --params="$GOOD/scenario.txtpb" --out_bag="$GOOD/seq.bag" \
-  --out_truth="$GOOD/truth.txtpb" --out_rig="$GOOD/rig.txtpb" 2> "$WORK/log" ||
-  { cat "$WORK/log"; die "simulate"; }
-"$BIN/tiltcal_decode" --bag="$GOOD/seq.bag" --rig="$GOOD/rig.txtpb" --out_imu="$GOOD/imu.binpb" \
-  --out_scans="$GOOD/scans.binpb.lz4" 2> "$WORK/log" || { cat "$WORK/log"; die "decode"; }
-"$BIN/tiltcal_ground" --imu="$GOOD/imu.binpb" --scans="$GOOD/scans.binpb.lz4" \
-  --rig="$GOOD/rig.txtpb" --out_ground="$GOOD/ground.binpb" 2> "$WORK/log" ||
-  { cat "$WORK/log"; die "ground"; }
-"$BIN/tiltcal_gravity" --imu="$GOOD/imu.binpb" --ground="$GOOD/ground.binpb" \
-  --rig="$GOOD/rig.txtpb" --out="$GOOD/gravity.txtpb" 2> "$WORK/log" ||
-  { cat "$WORK/log"; die "gravity"; }
+source "$(dirname "$0")/valid_inputs.sh"
+make_valid_inputs "$BIN" "$SRC" "$GOOD" "$WORK/log" || die "the valid inputs"
 # A calibration answer as calibrate writes it (the truth's extrinsic and τ).
 grep -A12 "^imu_from_lidar" "$GOOD/truth.txtpb" | sed -n '1,/^}/p' > "$GOOD/calibration.txtpb"
 grep "^time_offset_s" "$GOOD/truth.txtpb" >> "$GOOD/calibration.txtpb"

@@ -17,19 +17,8 @@ mkdir -p "$GOOD" "$OUT"
 die() { echo "FAIL: $*" >&2; exit 1; }
 
 # ---- valid inputs: a 3 s simulated sequence through decode and ground ----
-sed -E -e "s/^duration_s: .*/duration_s: 3/" \
-  "$SRC/stages/simulate/scenarios/flat_vlp16.txtpb" > "$GOOD/scenario.txtpb"
-"$BIN/tiltcal_simulate" --params="$GOOD/scenario.txtpb" --out_bag="$GOOD/seq.bag" \
-  --out_truth="$GOOD/truth.txtpb" --out_rig="$GOOD/rig.txtpb" 2> "$WORK/log" ||
-  { cat "$WORK/log"; die "simulate"; }
-"$BIN/tiltcal_decode" --bag="$GOOD/seq.bag" --rig="$GOOD/rig.txtpb" --out_imu="$GOOD/imu.binpb" \
-  --out_scans="$GOOD/scans.binpb.lz4" 2> "$WORK/log" || { cat "$WORK/log"; die "decode"; }
-"$BIN/tiltcal_ground" --imu="$GOOD/imu.binpb" --scans="$GOOD/scans.binpb.lz4" \
-  --rig="$GOOD/rig.txtpb" --out_ground="$GOOD/ground.binpb" 2> "$WORK/log" ||
-  { cat "$WORK/log"; die "ground"; }
-"$BIN/tiltcal_gravity" --imu="$GOOD/imu.binpb" --ground="$GOOD/ground.binpb" \
-  --rig="$GOOD/rig.txtpb" --out="$GOOD/gravity.txtpb" 2> "$WORK/log" ||
-  { cat "$WORK/log"; die "gravity"; }
+source "$(dirname "$0")/valid_inputs.sh"
+make_valid_inputs "$BIN" "$SRC" "$GOOD" "$WORK/log" || die "the valid inputs"
 
 # ---- special files ----
 FIFO=$WORK/fifo.bag
