@@ -1,24 +1,15 @@
 #include "bag/ros2/rosbag2_metadata.h"
 
-#include "bag/ros2/yaml_scalar.h"
-
 #include <unistd.h>
 
 #include <cerrno>
 #include <cstring>
 #include <sstream>
 
+#include "bag/ros2/yaml_scalar.h"
 #include "common/io/input_file.h"
 
 namespace tiltcal::ros2 {
-
-namespace {
-
-// The scalar rules shared with the other metadata.yaml reader.
-std::string Trim(const std::string& s) { return TrimYamlSpace(s); }
-std::string Unquote(const std::string& s) { return UnquoteYamlScalar(s); }
-
-}  // namespace
 
 Rosbag2Metadata ParseRosbag2Metadata(const std::string& text) {
   Rosbag2Metadata metadata;
@@ -26,14 +17,14 @@ Rosbag2Metadata ParseRosbag2Metadata(const std::string& text) {
   std::string line;
   bool in_list = false;
   while (std::getline(in, line)) {
-    const std::string t = Trim(line);
+    const std::string t = TrimYamlSpace(line);
     if (in_list && t.rfind("- ", 0) == 0) {
-      metadata.relative_file_paths.push_back(Unquote(Trim(t.substr(2))));
+      metadata.relative_file_paths.push_back(UnquoteYamlScalar(TrimYamlSpace(t.substr(2))));
       continue;
     }
     in_list = false;
     if (t.rfind("relative_file_paths:", 0) == 0) {
-      const std::string rest = Trim(t.substr(20));
+      const std::string rest = TrimYamlSpace(t.substr(20));
       if (rest.empty()) {
         in_list = true;
       } else if (rest.front() == '[' && rest.back() == ']') {
@@ -41,16 +32,16 @@ Rosbag2Metadata ParseRosbag2Metadata(const std::string& text) {
         for (char c : rest.substr(1, rest.size() - 2) + ",") {
           if (c != ',') {
             item += c;
-          } else if (!Trim(item).empty()) {
-            metadata.relative_file_paths.push_back(Unquote(Trim(item)));
+          } else if (!TrimYamlSpace(item).empty()) {
+            metadata.relative_file_paths.push_back(UnquoteYamlScalar(TrimYamlSpace(item)));
             item.clear();
           }
         }
       }
     } else if (t.rfind("storage_identifier:", 0) == 0) {
-      metadata.storage_identifier = Unquote(Trim(t.substr(19)));
+      metadata.storage_identifier = UnquoteYamlScalar(TrimYamlSpace(t.substr(19)));
     } else if (t.rfind("compression_format:", 0) == 0) {
-      metadata.compression_format = Unquote(Trim(t.substr(19)));
+      metadata.compression_format = UnquoteYamlScalar(TrimYamlSpace(t.substr(19)));
     }
   }
   return metadata;

@@ -1,20 +1,16 @@
 #include "bag/ros2/rosbag2_metadata_figures.h"
 
-#include "bag/ros2/yaml_scalar.h"
-
 #include <cerrno>
 #include <cstdlib>
 #include <sstream>
 #include <utility>
 
+#include "bag/ros2/yaml_scalar.h"
+
 namespace tiltcal::ros2 {
 namespace {
 
 constexpr char kRootKey[] = "rosbag2_bagfile_information";
-
-// The scalar rules shared with the other metadata.yaml reader.
-std::string Trim(const std::string& s) { return TrimYamlSpace(s); }
-std::string Unquote(const std::string& s) { return UnquoteYamlScalar(s); }
 
 // The key of "key: value" (unquoted), its value (unquoted) and whether it
 // opens a block (nothing after the colon); false when the line is no
@@ -29,10 +25,10 @@ bool SplitEntry(const std::string& t, std::string* key, std::string* value, bool
     colon = t.find(':');
   }
   if (colon == std::string::npos || (colon + 1 < t.size() && t[colon + 1] != ' ')) return false;
-  *key = Unquote(Trim(t.substr(0, colon)));
-  const std::string raw = Trim(t.substr(colon + 1));
+  *key = UnquoteYamlScalar(TrimYamlSpace(t.substr(0, colon)));
+  const std::string raw = TrimYamlSpace(t.substr(colon + 1));
   *block = raw.empty();
-  *value = Unquote(raw);
+  *value = UnquoteYamlScalar(raw);
   return true;
 }
 
@@ -104,7 +100,7 @@ Rosbag2Figures ParseRosbag2Figures(const std::string& text) {
   for (std::string line; std::getline(in, line);) {
     size_t indent = line.find_first_not_of(' ');
     if (indent == std::string::npos) continue;
-    std::string t = Trim(line.substr(indent));
+    std::string t = TrimYamlSpace(line.substr(indent));
     if (t.empty() || t[0] == '#') continue;
     if (t.rfind("- ", 0) == 0 || t == "-") {
       // A list item: it belongs to the innermost block above its dash; its
@@ -112,8 +108,8 @@ Rosbag2Figures ParseRosbag2Figures(const std::string& text) {
       while (!blocks.empty() && blocks.back().first >= indent) blocks.pop_back();
       builder.StartItem(block_path());
       const std::string rest = t.size() > 1 ? t.substr(2) : "";
-      indent += 2 + (rest.size() - Trim(rest).size());
-      t = Trim(rest);
+      indent += 2 + (rest.size() - TrimYamlSpace(rest).size());
+      t = TrimYamlSpace(rest);
       if (t.empty()) continue;
     }
     std::string key, value;
