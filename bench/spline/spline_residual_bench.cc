@@ -54,6 +54,9 @@ struct State {
   Eigen::Vector3d p[4];
   Eigen::Vector3d gyro_bias{0.001, -0.002, 0.0005};
   Eigen::Vector3d accel_bias{0.02, 0.01, -0.03};
+  // IMU triad errors (row-major; the accelerometer's lower triangular).
+  double gyro_triad_errors[9] = {0.004, 0.001, -0.002, 0.0, -0.003, 0.001, 0.002, -0.001, 0.005};
+  double accel_triad_errors[9] = {-0.004, 0, 0, 0.002, 0.003, 0, -0.001, 0.002, 0.001};
   Eigen::Vector3d gravity_dir{0.01, -0.02, -1.0};
   Eigen::Quaterniond q_bl;
   Eigen::Vector3d r_b_lb{0.1, -0.05, 0.3};
@@ -74,11 +77,12 @@ struct State {
 
   std::vector<double*> Gyro() {
     return {q[0].coeffs().data(), q[1].coeffs().data(), q[2].coeffs().data(), q[3].coeffs().data(),
-            gyro_bias.data()};
+            gyro_bias.data(), gyro_triad_errors};
   }
   std::vector<double*> Accel() {
     return {q[0].coeffs().data(), q[1].coeffs().data(), q[2].coeffs().data(), q[3].coeffs().data(),
-            p[0].data(), p[1].data(), p[2].data(), p[3].data(), gravity_dir.data(), accel_bias.data()};
+            p[0].data(), p[1].data(), p[2].data(), p[3].data(), gravity_dir.data(), accel_bias.data(),
+            accel_triad_errors};
   }
   std::vector<double*> Plane() {
     return {q[0].coeffs().data(), q[1].coeffs().data(), q[2].coeffs().data(), q[3].coeffs().data(),
@@ -210,6 +214,7 @@ void BM_LmIterations(benchmark::State& bm) {
       traj.SetPositionKnot(i, truth.PositionKnot(i) + 0.02 * Eigen::Vector3d(n(rng), n(rng), n(rng)));
     }
     Eigen::Vector3d gyro_bias = Eigen::Vector3d::Zero(), accel_bias = Eigen::Vector3d::Zero();
+    double gyro_triad_errors[9] = {}, accel_triad_errors[9] = {};  // held at zero
     Eigen::Vector3d gravity_dir(0.0, 0.0, -1.0);
     Eigen::Quaterniond q_bl = geometry::BoxPlus(q_bl_true, Eigen::Vector3d(0.02, -0.02, 0.03));
     Eigen::Vector3d r_b = r_b_true + Eigen::Vector3d(0.03, -0.02, 0.02);
@@ -254,10 +259,13 @@ void BM_LmIterations(benchmark::State& bm) {
         accel = new testing::AccelTwinT<true>::AutoDiff(
             new testing::AccelTwinT<true>{w.u, grid.inv_dt(), 0.05, gravity_norm, f});
       }
-      problem.AddResidualBlock(gyro, nullptr, q[0], q[1], q[2], q[3], gyro_bias.data());
+      problem.AddResidualBlock(gyro, nullptr, q[0], q[1], q[2], q[3], gyro_bias.data(),
+                               gyro_triad_errors);
       problem.AddResidualBlock(accel, nullptr, q[0], q[1], q[2], q[3], x[0], x[1], x[2], x[3],
-                               gravity_dir.data(), accel_bias.data());
+                               gravity_dir.data(), accel_bias.data(), accel_triad_errors);
     }
+    problem.SetParameterBlockConstant(gyro_triad_errors);
+    problem.SetParameterBlockConstant(accel_triad_errors);
     for (int k = 0; k < num_planes; ++k) {
       const double t_lidar = 0.05 + uni(rng) * (duration - 0.1);
       spline::KnotWindow w;

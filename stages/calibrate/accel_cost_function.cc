@@ -1,6 +1,7 @@
 #include "stages/calibrate/accel_cost_function.h"
 
 #include "common/geometry/so3.h"
+#include "common/imu/triad_errors.h"
 #include "common/spline/cubic_basis.h"
 #include "common/spline/so3_spline.h"
 #include "stages/calibrate/jacobian_writer.h"
@@ -36,19 +37,22 @@ bool AccelCostFunction::Evaluate(double const* const* parameters, double* residu
   const Eigen::Vector3d specific_force_b = ct * specific_force_a;
 
   Eigen::Map<Eigen::Vector3d> r(residuals);
-  r = inv_sigma_ * (specific_force_b + bias - measured_mps2_);
+  const Eigen::Matrix3d sensor =
+      Eigen::Matrix3d::Identity() + imu::TriadErrorsMatrix(parameters[10]);  // I + E_a
+  r = inv_sigma_ * (sensor * specific_force_b + bias - measured_mps2_);
 
   if (jacobians == nullptr) return true;
+  const Eigen::Matrix3d sensor_scaled = inv_sigma_ * sensor;
   if (rotation_jacobians) {
     // (C Exp(eps))^T f = C^T f + [C^T f]_x eps.
-    const Eigen::Matrix3d d_r_d_eps = inv_sigma_ * geometry::Hat(specific_force_b);
+    const Eigen::Matrix3d d_r_d_eps = sensor_scaled * geometry::Hat(specific_force_b);
     for (int i = 0; i < 4; ++i) {
       if (jacobians[i] == nullptr) continue;
       const Eigen::Matrix3d jt = d_r_d_eps * s.rotation_jacobian[i];
       WriteQuaternionJacobian<3>(jt, parameters[i], jacobians[i]);
     }
   }
-  const Eigen::Matrix3d ct_scaled = inv_sigma_ * ct;
+  const Eigen::Matrix3d ct_scaled = sensor_scaled * ct;
   for (int j = 0; j < 4; ++j) {
     if (jacobians[4 + j] != nullptr) {
       WriteJacobian<3, 3>(position_weights_[j] * ct_scaled, jacobians[4 + j]);
@@ -59,6 +63,10 @@ bool AccelCostFunction::Evaluate(double const* const* parameters, double* residu
   }
   if (jacobians[9] != nullptr) {
     WriteJacobian<3, 3>(inv_sigma_ * Eigen::Matrix3d::Identity(), jacobians[9]);
+  }
+  if (jacobians[10] != nullptr) {
+    WriteJacobian<3, imu::kTriadErrorsSize>(inv_sigma_ * imu::TriadErrorsJacobian(specific_force_b),
+                                           jacobians[10]);
   }
   return true;
 }

@@ -21,6 +21,7 @@
 #include "common/io/text_proto.h"
 #include "stages/calibrate/covariance_report.h"
 #include "stages/calibrate/ground_residuals.h"
+#include "stages/calibrate/imu_intrinsics.h"
 #include "stages/calibrate/initialisation.h"
 #include "stages/calibrate/lidar_association.h"
 #include "stages/calibrate/map_export.h"
@@ -189,6 +190,11 @@ struct OuterLoop {
   double last_trust_region_radius = 0.0;
   // How far the last round moved C_bl (deg), r_b^{lb} (m) and tau (s).
   double moved_deg = 0.0, moved_m = 0.0, moved_s = 0.0;
+  // The last score test of the IMU intrinsics (imu_intrinsics.h), the
+  // round after which it ran (0: none) and whether it found them.
+  ImuIntrinsicsScore intrinsics_score;
+  int intrinsics_score_round = 0;
+  bool intrinsics_found = false;
 };
 
 // What every outer round uses and does not change.
@@ -319,16 +325,105 @@ void FillSolverReport(const OuterLoop& loop, proto::CalibrationResult* result) {
   solver->set_last_outer_time_offset_change_s(loop.moved_s);
 }
 
+// The score test of the IMU intrinsics on the last round's problem (they
+// are held there), logged with what it points to.
+Status TestImuIntrinsics(const proto::CalibrateParams& params, CalibrationState* state,
+                         OuterLoop* loop, std::ostream* log) {
+  const proto::ImuIntrinsicsParams& intrinsics = params.imu_intrinsics();
+  TILTCAL_RETURN_IF_ERROR(ScoreTestImuIntrinsics(loop->problem->problem(), state, intrinsics,
+                                                 static_cast<int>(params.num_threads()),
+                                                 &loop->intrinsics_score));
+  const ImuIntrinsicsScore& score = loop->intrinsics_score;
+  loop->intrinsics_score_round = loop->rounds;
+  loop->intrinsics_found = score.chi2 > intrinsics.min_score_chi2();
+  const proto::ImuTriadEstimate gyro = DescribeTriad(score.gyro_triad_errors, {}, {});
+  Log(log, fmt::format("outer {}: IMU intrinsics score {:.1f} over {} (variance factor {:.2f}, "
+                       "limit {:.1f}): {}; they point to gyro scale ({:.0f}, {:.0f}, {:.0f}) ppm",
+                       loop->rounds, score.chi2, score.dof, score.sigma0_squared,
+                       intrinsics.min_score_chi2(),
+                       loop->intrinsics_found ? "found" : "not found", gyro.scale_ppm().x(),
+                       gyro.scale_ppm().y(), gyro.scale_ppm().z()));
+  return Status::Ok();
+}
+
+// The IMU intrinsics' report: estimated values with the sigmas of their
+// marginal covariance (15x15, may be empty), or the score test's one-step
+// values.
+void FillImuIntrinsics(const proto::ImuIntrinsicsParams& params, const OuterLoop& loop,
+                       bool estimated, const CalibrationState& state,
+                       const Eigen::MatrixXd& covariance, proto::CalibrationResult* result) {
+  proto::ImuIntrinsicsReport* report = result->mutable_imu_intrinsics();
+  report->set_mode(proto::ImuIntrinsicsParams::Mode_Name(params.mode()));
+  report->set_estimated(estimated);
+  report->set_score_round(loop.intrinsics_score_round);
+  if (loop.intrinsics_score_round > 0) {
+    report->set_score_chi2(loop.intrinsics_score.chi2);
+    report->set_score_dof(loop.intrinsics_score.dof);
+    report->set_found(loop.intrinsics_found);
+  }
+  if (estimated) {
+    const bool has_covariance = covariance.rows() == 15;
+    *report->mutable_gyro() =
+        DescribeTriad(state.gyro_triad_errors, GyroErrorEntries(),
+                      has_covariance ? Eigen::MatrixXd(covariance.topLeftCorner(9, 9))
+                                     : Eigen::MatrixXd());
+    *report->mutable_accel() =
+        DescribeTriad(state.accel_triad_errors, AccelErrorEntries(),
+                      has_covariance ? Eigen::MatrixXd(covariance.bottomRightCorner(6, 6))
+                                     : Eigen::MatrixXd());
+    for (std::string& name : UndeterminedIntrinsics(covariance, params)) {
+      report->add_undetermined(std::move(name));
+    }
+  } else if (loop.intrinsics_score_round > 0) {
+    *report->mutable_gyro() = DescribeTriad(loop.intrinsics_score.gyro_triad_errors, {}, {});
+    *report->mutable_accel() = DescribeTriad(loop.intrinsics_score.accel_triad_errors, {}, {});
+  }
+}
+
+// The estimated IMU intrinsics as a verdict note (and on stderr): values,
+// sigmas and what the motion left at the prior.
+void AddImuIntrinsicsNote(proto::CalibrationResult* result, std::ostream* log) {
+  const proto::ImuIntrinsicsReport& k = result->imu_intrinsics();
+  if (!k.estimated()) return;
+  auto triad = [](const proto::ImuTriadEstimate& t) {
+    return fmt::format("scale ({:.0f}, {:.0f}, {:.0f}) +- ({:.0f}, {:.0f}, {:.0f}) ppm, "
+                       "misalignment ({:.3f}, {:.3f}, {:.3f}) +- ({:.3f}, {:.3f}, {:.3f}) deg",
+                       t.scale_ppm().x(), t.scale_ppm().y(), t.scale_ppm().z(),
+                       t.scale_sigma_ppm().x(), t.scale_sigma_ppm().y(), t.scale_sigma_ppm().z(),
+                       t.misalignment_deg().x(), t.misalignment_deg().y(),
+                       t.misalignment_deg().z(), t.misalignment_sigma_deg().x(),
+                       t.misalignment_sigma_deg().y(), t.misalignment_sigma_deg().z());
+  };
+  std::string line = "IMU intrinsics estimated (imu_intrinsics.mode " + k.mode();
+  if (k.score_round() > 0) {
+    line += fmt::format(": score {:.0f} over {} after round {}", k.score_chi2(), k.score_dof(),
+                        k.score_round());
+  }
+  line += "): gyroscope " + triad(k.gyro()) + "; accelerometer " + triad(k.accel());
+  if (k.undetermined_size() > 0) {
+    line += "; not determined by this motion (held near the prior): ";
+    for (int i = 0; i < k.undetermined_size(); ++i) {
+      line += (i > 0 ? ", " : "") + k.undetermined(i);
+    }
+  }
+  result->add_verdict_notes(line);
+  Log(log, line);
+}
+
 // Covariance and observability on the last problem (the extrinsic and tau do
 // not depend on the world gauge).
+// *intrinsics_covariance: that of the IMU intrinsics when they are estimated
+// (covariance_report.h), else empty.
 void FillCovariance(const CalibrateInputs& inputs, const proto::CalibrateParams& params,
                     CalibrationProblem* problem, CalibrationState* state,
-                    proto::CalibrationResult* result) {
+                    proto::CalibrationResult* result, Eigen::MatrixXd* intrinsics_covariance) {
   const auto start = Clock::now();
+  intrinsics_covariance->resize(0, 0);
   if (params.observability().compute_covariance()) {
     Matrix7d cov;
     Status cs = ComputeExtrinsicCovariance(problem->problem(), state, params.observability(),
-                                           static_cast<int>(params.num_threads()), &cov);
+                                           static_cast<int>(params.num_threads()), &cov,
+                                           intrinsics_covariance);
     if (cs.ok()) {
       const VarianceFactor factor = ComputeVarianceFactor(problem->problem());
       result->set_variance_factor(factor.sigma0_squared);
@@ -539,11 +634,31 @@ Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& pa
   problem_options.translation_prior_axis_b = init.rotation_axis_b;
   result->set_translation_prior_sigma_m(problem_options.translation_prior_sigma_m);
   *result->mutable_translation_prior_axis_b() = ToProto(init.rotation_axis_b.normalized());
+  // IMU intrinsics (imu_intrinsics.h): ON from the first round; AUTO from
+  // the round after a score test finds them; OFF never, tested at the end.
+  const proto::ImuIntrinsicsParams& intrinsics = params.imu_intrinsics();
+  problem_options.estimate_imu_intrinsics = intrinsics.mode() == proto::ImuIntrinsicsParams::ON;
+  problem_options.intrinsics_scale_prior_sigma = intrinsics.scale_prior_ppm() * 1e-6;
+  problem_options.intrinsics_misalignment_prior_sigma_rad =
+      intrinsics.misalignment_prior_deg() * M_PI / 180.0;
   OuterLoop loop;
   bool settled = false;
-  const int max_rounds = static_cast<int>(params.outer_loop().iterations());
+  int max_rounds = static_cast<int>(params.outer_loop().iterations());
   while (loop.rounds < max_rounds && !settled) {
     TILTCAL_RETURN_IF_ERROR(RunOuterRound(setup, &state, &loop, &settled, log));
+    if (intrinsics.mode() == proto::ImuIntrinsicsParams::AUTO &&
+        !problem_options.estimate_imu_intrinsics) {
+      TILTCAL_RETURN_IF_ERROR(TestImuIntrinsics(params, &state, &loop, log));
+      if (loop.intrinsics_found) {
+        // At least one round with them.
+        problem_options.estimate_imu_intrinsics = true;
+        settled = false;
+        max_rounds = std::max(max_rounds, loop.rounds + 1);
+      }
+    }
+  }
+  if (intrinsics.mode() == proto::ImuIntrinsicsParams::OFF) {
+    TILTCAL_RETURN_IF_ERROR(TestImuIntrinsics(params, &state, &loop, log));
   }
   TILTCAL_RETURN_IF_ERROR(CheckSolveUsable(loop.summary));
   FillSolverReport(loop, result);
@@ -552,8 +667,12 @@ Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& pa
   std::future<MapSharpnessPair> sharpness =
       std::async(params.num_threads() > 1 ? std::launch::async : std::launch::deferred,
                  MeasureBothMapSharpnesses, std::cref(inputs), std::cref(params), std::cref(state));
-  FillCovariance(inputs, params, loop.problem.get(), &state, result);
+  Eigen::MatrixXd intrinsics_covariance;
+  FillCovariance(inputs, params, loop.problem.get(), &state, result, &intrinsics_covariance);
+  FillImuIntrinsics(intrinsics, loop, problem_options.estimate_imu_intrinsics, state,
+                    intrinsics_covariance, result);
   FillVerdictFacts(inputs, params, init, loop.problem.get(), state, sharpness.get(), result);
+  AddImuIntrinsicsNote(result, log);
   loop.problem.reset();
 
   ReexpressInFirstImuFrame(&state);

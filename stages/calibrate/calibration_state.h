@@ -25,6 +25,13 @@
 //                                ceres::SphereManifold<3>;
 //   gyro_bias.values[i]          3 doubles, b_g over segment i, rad/s;
 //   accel_bias.values[i]         3 doubles, b_a over segment i, m/s^2.
+//   gyro_triad_errors            9 doubles, E_g row-major, and
+//   accel_triad_errors           9 doubles, E_a row-major: the triads' scale
+//                                and axis errors (common/imu/triad_errors.h);
+//                                held constant (at zero unless a caller set
+//                                them) when the IMU intrinsics are not
+//                                estimated; E_a's upper entries always at 0
+//                                (ceres::SubsetManifold).
 //                                Both biases are piecewise constant in time
 //                                (bias_segments.h): a real IMU's biases
 //                                wander: a constant b_a would bend the
@@ -71,6 +78,8 @@ struct CalibrationState {
   double gravity_norm_mps2 = 9.81;                           // |g_a|, fixed
   BiasSegments gyro_bias;   // b_g, rad/s
   BiasSegments accel_bias;  // b_a, m/s^2
+  std::array<double, 9> gyro_triad_errors{};   // E_g (measured = (I + E_g) true)
+  std::array<double, 9> accel_triad_errors{};  // E_a, lower triangular
 
   // Splits b_g and b_a into segments of gyro_segment_s and accel_segment_s
   // over the spline (0 = one segment), each at its current mean. Call before

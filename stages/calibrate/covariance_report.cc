@@ -36,8 +36,25 @@ MotionAxis PrincipalRotationAxis(const std::vector<imu::ImuReading>& samples,
 
 Status ComputeExtrinsicCovariance(ceres::Problem* problem, CalibrationState* state,
                                   const proto::ObservabilityParams& params, int num_threads,
-                                  Matrix7d* covariance) {
+                                  Matrix7d* covariance, Eigen::MatrixXd* intrinsics_covariance) {
   covariance->setZero();
+  if (intrinsics_covariance != nullptr) intrinsics_covariance->resize(0, 0);
+  // The triad errors, marginalised last (before the 7) when asked for
+  // and free.
+  std::vector<double*> intrinsics;
+  int intrinsics_size = 0;
+  if (intrinsics_covariance != nullptr) {
+    for (double* b : {state->gyro_triad_errors.data(), state->accel_triad_errors.data()}) {
+      if (problem->HasParameterBlock(b) && !problem->IsParameterBlockConstant(b)) {
+        intrinsics.push_back(b);
+        intrinsics_size += problem->ParameterBlockTangentSize(b);
+      }
+    }
+    if (intrinsics_size != 15) {
+      intrinsics.clear();
+      intrinsics_size = 0;
+    }
+  }
   // The 7 tangent parameters in covariance order; a constant block (e.g. tau
   // with a zero bound) keeps zero rows and columns.
   struct Group {
@@ -54,10 +71,13 @@ Status ComputeExtrinsicCovariance(ceres::Problem* problem, CalibrationState* sta
   for (double* b : blocks) {
     const bool calibration = std::any_of(std::begin(groups), std::end(groups),
                                          [b](const Group& g) { return g.block == b; });
-    if (!calibration && !problem->IsParameterBlockConstant(b)) ordered.push_back(b);
+    const bool last = calibration || std::find(intrinsics.begin(), intrinsics.end(), b) !=
+                                         intrinsics.end();
+    if (!last && !problem->IsParameterBlockConstant(b)) ordered.push_back(b);
   }
+  ordered.insert(ordered.end(), intrinsics.begin(), intrinsics.end());
+  int k = intrinsics_size;
   std::vector<const Group*> free_groups;
-  int k = 0;
   for (const Group& g : groups) {
     if (!problem->HasParameterBlock(g.block)) {
       return Status::Error("covariance: the extrinsic / time offset is not in the problem");
@@ -67,7 +87,9 @@ Status ComputeExtrinsicCovariance(ceres::Problem* problem, CalibrationState* sta
     free_groups.push_back(&g);
     k += g.size;
   }
-  if (k == 0) return Status::Error("covariance: the extrinsic and time offset are held constant");
+  if (k == intrinsics_size) {
+    return Status::Error("covariance: the extrinsic and time offset are held constant");
+  }
 
   ceres::Problem::EvaluateOptions options;
   options.parameter_blocks = ordered;
@@ -83,9 +105,12 @@ Status ComputeExtrinsicCovariance(ceres::Problem* problem, CalibrationState* sta
   Eigen::MatrixXd marginal;
   TILTCAL_RETURN_IF_ERROR(
       MarginalCovarianceOfLastColumns(jacobian, k, params.min_relative_pivot(), &marginal));
-  int row = 0;
+  if (intrinsics_size > 0) {
+    *intrinsics_covariance = marginal.topLeftCorner(intrinsics_size, intrinsics_size);
+  }
+  int row = intrinsics_size;
   for (const Group* gi : free_groups) {
-    int col = 0;
+    int col = intrinsics_size;
     for (const Group* gj : free_groups) {
       covariance->block(gi->offset, gj->offset, gi->size, gj->size) =
           marginal.block(row, col, gi->size, gj->size);

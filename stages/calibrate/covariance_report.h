@@ -55,9 +55,14 @@ MotionAxis PrincipalRotationAxis(const std::vector<imu::ImuReading>& samples,
 // zero rows and columns). Errors (rank deficiency, failure of the
 // factorisation) are returned as Status for the report; they are data, not a
 // failure of the stage.
+// With intrinsics_covariance and the IMU triad errors free in the problem,
+// they are marginalised last as well and their covariance (15x15, tangent:
+// E_g's 9 entries, then E_a's 6 lower-triangular ones row by row)
+// is returned there; otherwise it is left empty.
 Status ComputeExtrinsicCovariance(ceres::Problem* problem, CalibrationState* state,
                                   const proto::ObservabilityParams& params, int num_threads,
-                                  Matrix7d* covariance);
+                                  Matrix7d* covariance,
+                                  Eigen::MatrixXd* intrinsics_covariance = nullptr);
 
 // A-posteriori variance factor of the weighted least-squares problem at its
 // current parameters: sigma0^2 = 2 F / (m - n), F the cost with the robust

@@ -2,13 +2,18 @@
 #define TILTCAL_STAGES_CALIBRATE_GYRO_COST_FUNCTION_H_
 
 // Gyroscope residual of one IMU sample at IMU time t (docs/design.md §6):
-//   r = (omega_b(t) + b_g - omega_m) / sigma_g          (3, dimensionless)
-// omega_b(t): body angular velocity of the SO(3) spline C_ab (Sommer recursion).
+//   r = ((I + E_g) omega_b(t) + b_g - omega_m) / sigma_g     (3, dimensionless)
+// omega_b(t): body angular velocity of the SO(3) spline C_ab (Sommer recursion);
+// E_g: the gyroscope triad's scale and axis errors (common/imu/triad_errors.h),
+// a full 3x3 matrix: scale, misalignment and the triad's small rotation
+// against the accelerometer's, which defines b.
 //
 // Parameter blocks, in order:
 //   0..3  rotation knots s..s+3: unit quaternions, 4 doubles (x, y, z, w),
 //         spline::RightQuaternionManifold (right perturbation);
-//   4     gyro bias b_g, 3 doubles, rad/s.
+//   4     gyro bias b_g, 3 doubles, rad/s;
+//   5     gyro errors E_g, 9 doubles row-major (held constant when the IMU
+//         intrinsics are not estimated).
 // The IMU time is not optimised, so (s, u) are fixed at construction.
 // Analytic Jacobians; robust losses are the problem builder's business.
 
@@ -20,7 +25,7 @@
 
 namespace tiltcal::calibrate {
 
-class GyroCostFunction final : public ceres::SizedCostFunction<3, 4, 4, 4, 4, 3> {
+class GyroCostFunction final : public ceres::SizedCostFunction<3, 4, 4, 4, 4, 3, 9> {
  public:
   // window: knots and u of the IMU time on the grid (UniformKnotGrid::Locate).
   GyroCostFunction(const spline::KnotWindow& window, double inv_dt,

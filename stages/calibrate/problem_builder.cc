@@ -12,6 +12,7 @@
 #include "stages/calibrate/interval_manifold.h"
 #include "stages/calibrate/point_to_plane_cost_function.h"
 #include "stages/calibrate/stacked_cost_function.h"
+#include "stages/calibrate/triad_errors_prior_cost_function.h"
 
 namespace tiltcal::calibrate {
 namespace {
@@ -74,6 +75,8 @@ CalibrationProblem::CalibrationProblem(CalibrationState* state,
   p.AddParameterBlock(state_->time_offset_s, 1);
   p.AddParameterBlock(state_->gravity_direction, 3, &sphere_manifold_);
   for (double* b : state_->BiasBlocks()) p.AddParameterBlock(b, 3);
+  p.AddParameterBlock(state_->gyro_triad_errors.data(), 9);
+  p.AddParameterBlock(state_->accel_triad_errors.data(), 9, &lower_triangular_manifold_);
 
   // tau bounds around the binning value; tau clamped into them.
   const double bound = std::abs(options_.time_offset_bound_s);
@@ -109,6 +112,17 @@ CalibrationProblem::CalibrationProblem(CalibrationState* state,
       }
     }
   }
+  for (double* k : {state_->gyro_triad_errors.data(), state_->accel_triad_errors.data()}) {
+    if (!options_.estimate_imu_intrinsics) {
+      p.SetParameterBlockConstant(k);
+      continue;
+    }
+    p.AddResidualBlock(
+        new TriadErrorsPriorCostFunction(options_.intrinsics_scale_prior_sigma,
+                                             options_.intrinsics_misalignment_prior_sigma_rad),
+        nullptr, k);
+    ++counts_.prior_residuals;
+  }
   if (options_.translation_prior_sigma_m > 0.0 && options_.estimate_extrinsic) {
     p.AddResidualBlock(new TranslationPriorCost(options_.translation_prior_m,
                                                 options_.translation_prior_sigma_m,
@@ -143,7 +157,8 @@ void CalibrationProblem::AddImuResiduals(const std::vector<imu::ImuReading>& sam
                                        imu_noise_.gyro_sigma_radps());
       std::vector<double*> blocks = {traj.rotation_knot(k), traj.rotation_knot(k + 1),
                                      traj.rotation_knot(k + 2), traj.rotation_knot(k + 3),
-                                     state_->gyro_bias.Block(s.time_s)};
+                                     state_->gyro_bias.Block(s.time_s),
+                                     state_->gyro_triad_errors.data()};
       gyro_rows.Add(row, std::move(blocks));
       ++counts_.gyro_residuals;
       MarkKnots(k, false);
@@ -155,7 +170,7 @@ void CalibrationProblem::AddImuResiduals(const std::vector<imu::ImuReading>& sam
           traj.rotation_knot(k), traj.rotation_knot(k + 1), traj.rotation_knot(k + 2),
           traj.rotation_knot(k + 3), traj.position_knot(k), traj.position_knot(k + 1),
           traj.position_knot(k + 2), traj.position_knot(k + 3), state_->gravity_direction,
-          state_->accel_bias.Block(s.time_s)};
+          state_->accel_bias.Block(s.time_s), state_->accel_triad_errors.data()};
       accel_rows.Add(row, std::move(blocks));
       ++counts_.accel_residuals;
       MarkKnots(k, true);
@@ -227,7 +242,8 @@ void CalibrationProblem::RemoveUnusedKnots() {
   std::vector<ceres::ResidualBlockId> users;
   std::vector<double*> blocks = state_->BiasBlocks();
   for (double* b : {state_->imu_from_lidar_rotation, state_->imu_from_lidar_translation,
-                    state_->time_offset_s, state_->gravity_direction}) {
+                    state_->time_offset_s, state_->gravity_direction,
+                    state_->gyro_triad_errors.data(), state_->accel_triad_errors.data()}) {
     blocks.push_back(b);
   }
   for (double* block : blocks) {

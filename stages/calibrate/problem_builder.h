@@ -32,6 +32,12 @@
 // (ImuNoiseParams gyro_bias_random_walk_radps2_sqrthz,
 // accel_bias_random_walk_mps3_sqrthz; 0 = untied).
 //
+// IMU intrinsics (docs/design.md §6): the gyro and accelerometer triad
+// errors E_g, E_a (calibration_state.h) are in every IMU row; E_a's
+// upper triangle is held at zero by a ceres::SubsetManifold. Held constant
+// unless estimate_imu_intrinsics; then each has a prior at zero
+// (triad_errors_prior_cost_function.h, counted in prior_residuals).
+//
 // Optional prior on r_b^{lb} (translation_prior_sigma_m > 0): one residual
 // (r_b^{lb} - r_prior) / sigma (3), or, with a unit translation_prior_axis_b,
 // only its component along that axis, a^T (r_b^{lb} - r_prior) / sigma (the
@@ -55,6 +61,7 @@
 #include <vector>
 
 #include <ceres/loss_function.h>
+#include <ceres/manifold.h>
 #include <ceres/problem.h>
 #include <ceres/solver.h>
 #include <ceres/sphere_manifold.h>
@@ -94,6 +101,11 @@ struct ProblemOptions {
   bool estimate_time_offset = true;
   bool estimate_gravity = true;
   bool estimate_biases = true;
+  bool estimate_imu_intrinsics = false;
+  // Prior sigmas of the triad errors when they are estimated: scale (a
+  // fraction) and misalignment (rad).
+  double intrinsics_scale_prior_sigma = 0.0;
+  double intrinsics_misalignment_prior_sigma_rad = 0.0;
   // Gauge by holding rotation knot 0 and position knot 0 (see above). Off
   // when fixed map planes already pin the world frame.
   bool fix_first_knots = true;
@@ -163,6 +175,8 @@ class CalibrationProblem {
   ProblemOptions options_;
   spline::RightQuaternionManifold quaternion_manifold_;
   ceres::SphereManifold<3> sphere_manifold_;
+  // E_a lower triangular: its entries (0, 1), (0, 2), (1, 2) held.
+  ceres::SubsetManifold lower_triangular_manifold_{9, {1, 2, 5}};
   std::unique_ptr<IntervalManifold> time_offset_manifold_;  // tau in its bounds
   std::unique_ptr<ceres::LossFunction> lidar_loss_;
   std::unique_ptr<ceres::Problem> problem_;

@@ -117,6 +117,22 @@ void CheckStaticStart(const proto::CalibrationResult& r, const proto::VerdictPar
   }
 }
 
+void CheckImuIntrinsics(const proto::CalibrationResult& r, Findings* f) {
+  const proto::ImuIntrinsicsReport& k = r.imu_intrinsics();
+  if (!k.found() || k.estimated()) return;
+  const proto::ImuTriadEstimate& g = k.gyro();
+  const proto::ImuTriadEstimate& a = k.accel();
+  f->suspect.push_back(fmt::format(
+      "the IMU's scale and axis errors show in the residuals but were held at zero "
+      "(imu_intrinsics.mode {}): score {:.0f} over {} degrees of freedom; they point to gyroscope "
+      "scale ({:.0f}, {:.0f}, {:.0f}) ppm, accelerometer scale ({:.0f}, {:.0f}, {:.0f}) ppm and "
+      "misalignment ({:.2f}, {:.2f}, {:.2f}) deg; the extrinsic and tau absorb them: calibrate "
+      "with imu_intrinsics.mode AUTO",
+      k.mode(), k.score_chi2(), k.score_dof(), g.scale_ppm().x(), g.scale_ppm().y(),
+      g.scale_ppm().z(), a.scale_ppm().x(), a.scale_ppm().y(), a.scale_ppm().z(),
+      a.misalignment_deg().x(), a.misalignment_deg().y(), a.misalignment_deg().z()));
+}
+
 // Translation direction d (frame b): the rig's and the estimate's component.
 std::string WeakTranslationReason(const proto::ObservabilityDirection& d,
                                   const proto::CalibrationResult& r) {
@@ -194,6 +210,7 @@ void DecideVerdict(const proto::VerdictParams& params, proto::CalibrationResult*
   CheckMap(*result, params, &f);
   CheckHandEye(*result, params, &f);
   CheckStaticStart(*result, params, &f);
+  CheckImuIntrinsics(*result, &f);
   CheckWeakDirections(*result, &f);
   result->clear_verdict_reasons();
   if (!f.suspect.empty()) {

@@ -19,7 +19,9 @@
 //   - hand-eye C_bl and the final C_bl more than
 //     max_hand_eye_disagreement_deg apart;
 //   - no static start, or fewer than min_static_samples averaged
-//     (require_static_start).
+//     (require_static_start);
+//   - the IMU intrinsics' score test found them but they were not
+//     estimated (imu_intrinsics.found and not estimated: mode OFF).
 // WEAK: no SUSPECT rule fired and the observability report marks directions
 // weak; each is named with the value the rig (prior) gives it.
 // OK otherwise. SUSPECT reasons come first, then the WEAK ones.

@@ -44,24 +44,33 @@ void LoadVectors(const T* const p0, const T* const p1, const T* const p2, const 
   for (int i = 0; i < 4; ++i) out[i] = Eigen::Map<const Eigen::Matrix<T, 3, 1>>(ptr[i]);
 }
 
-// r = (omega_b(t) + b_g - omega_m) / sigma.
+// The reading of an imperfect triad, (I + E) v, E 3x3 row-major.
+template <typename T>
+Eigen::Matrix<T, 3, 1> TriadReading(const T* const e, const Eigen::Matrix<T, 3, 1>& v) {
+  Eigen::Matrix<T, 3, 1> out;
+  for (int r = 0; r < 3; ++r) out[r] = v[r] + e[3 * r] * v[0] + e[3 * r + 1] * v[1] + e[3 * r + 2] * v[2];
+  return out;
+}
+
+// r = ((I + E_g) omega_b(t) + b_g - omega_m) / sigma.
 template <bool kSommer>
 struct GyroTwinT {
   double u, inv_dt, sigma;
   Eigen::Vector3d measured;
   template <typename T>
   bool operator()(const T* const q0, const T* const q1, const T* const q2, const T* const q3,
-                  const T* const bias, T* residual) const {
+                  const T* const bias, const T* const errors, T* residual) const {
     Eigen::Quaternion<T> q[4];
     LoadQuaternions(q0, q1, q2, q3, q);
     const auto s = EvaluateSo3<kSommer>(q, T(u), inv_dt);
-    for (int r = 0; r < 3; ++r) residual[r] = (s.omega[r] + bias[r] - T(measured[r])) / sigma;
+    const Eigen::Matrix<T, 3, 1> omega = TriadReading(errors, Eigen::Matrix<T, 3, 1>(s.omega));
+    for (int r = 0; r < 3; ++r) residual[r] = (omega[r] + bias[r] - T(measured[r])) / sigma;
     return true;
   }
-  using AutoDiff = ceres::AutoDiffCostFunction<GyroTwinT, 3, 4, 4, 4, 4, 3>;
+  using AutoDiff = ceres::AutoDiffCostFunction<GyroTwinT, 3, 4, 4, 4, 4, 3, 9>;
 };
 
-// r = (C^T (p'' - g_norm n_g) + b_a - f_m) / sigma.
+// r = ((I + E_a) C^T (p'' - g_norm n_g) + b_a - f_m) / sigma.
 template <bool kSommer>
 struct AccelTwinT {
   double u, inv_dt, sigma, gravity_norm;
@@ -69,7 +78,8 @@ struct AccelTwinT {
   template <typename T>
   bool operator()(const T* const q0, const T* const q1, const T* const q2, const T* const q3,
                   const T* const p0, const T* const p1, const T* const p2, const T* const p3,
-                  const T* const gravity_dir, const T* const bias, T* residual) const {
+                  const T* const gravity_dir, const T* const bias, const T* const errors,
+                  T* residual) const {
     Eigen::Quaternion<T> q[4];
     Eigen::Matrix<T, 3, 1> p[4];
     LoadQuaternions(q0, q1, q2, q3, q);
@@ -78,10 +88,11 @@ struct AccelTwinT {
     const auto ps = ReferenceR3<T>(p, T(u), inv_dt);
     const Eigen::Matrix<T, 3, 1> g = Eigen::Map<const Eigen::Matrix<T, 3, 1>>(gravity_dir) * T(gravity_norm);
     const Eigen::Matrix<T, 3, 1> f = s.q.conjugate() * (ps.acceleration - g);
-    for (int r = 0; r < 3; ++r) residual[r] = (f[r] + bias[r] - T(measured[r])) / sigma;
+    const Eigen::Matrix<T, 3, 1> reading = TriadReading(errors, f);
+    for (int r = 0; r < 3; ++r) residual[r] = (reading[r] + bias[r] - T(measured[r])) / sigma;
     return true;
   }
-  using AutoDiff = ceres::AutoDiffCostFunction<AccelTwinT, 3, 4, 4, 4, 4, 3, 3, 3, 3, 3, 3>;
+  using AutoDiff = ceres::AutoDiffCostFunction<AccelTwinT, 3, 4, 4, 4, 4, 3, 3, 3, 3, 3, 3, 9>;
 };
 
 // p_a = C(t_j + tau) (C_bl p_l + r_b) + r_a(t_j + tau), frozen segment,

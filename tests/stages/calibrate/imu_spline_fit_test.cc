@@ -13,6 +13,7 @@
 // with windows binned from the current tau and re-binned once (the outer
 // iteration the stage performs).
 
+#include <array>
 #include <cmath>
 #include <memory>
 #include <random>
@@ -93,6 +94,7 @@ TEST(ImuSplineFitTest, RecoversKnownTrajectoryFromGyroAndAccel) {
   spline::SplineTrajectory traj(grid);  // identity / zero knots
   Eigen::Vector3d gravity_dir(0.0, 0.0, -1.0);
   Eigen::Vector3d gyro_bias = Eigen::Vector3d::Zero(), accel_bias = Eigen::Vector3d::Zero();
+  std::array<double, 9> gyro_triad_errors{}, accel_triad_errors{};  // ideal triads, held
   const Eigen::Vector3d g_a = gravity_norm * gravity_dir;
 
   ceres::Problem::Options problem_options;
@@ -116,11 +118,13 @@ TEST(ImuSplineFitTest, RecoversKnownTrajectoryFromGyroAndAccel) {
     }
     const Eigen::Vector3d f_b = Truth::Rotation(t).transpose() * (Truth::Acceleration(t) - g_a);
     problem.AddResidualBlock(new GyroCostFunction(w, grid.inv_dt(), Truth::Omega(t), 0.01), nullptr,
-                             q[0], q[1], q[2], q[3], gyro_bias.data());
+                             q[0], q[1], q[2], q[3], gyro_bias.data(), gyro_triad_errors.data());
     problem.AddResidualBlock(new AccelCostFunction(w, grid.inv_dt(), f_b, 0.05, gravity_norm), nullptr,
                              q[0], q[1], q[2], q[3], p[0], p[1], p[2], p[3], gravity_dir.data(),
-                             accel_bias.data());
+                             accel_bias.data(), accel_triad_errors.data());
   }
+  problem.SetParameterBlockConstant(gyro_triad_errors.data());
+  problem.SetParameterBlockConstant(accel_triad_errors.data());
   problem.SetParameterBlockConstant(gyro_bias.data());
   problem.SetParameterBlockConstant(accel_bias.data());
   problem.SetParameterBlockConstant(gravity_dir.data());

@@ -75,6 +75,7 @@ TEST(ResidualTimeSeries, ResidualBlocksAreDatedByTheirSplineSegment) {
     std::vector<double*> blocks;
     for (int k = 0; k < 4; ++k) blocks.push_back(state.trajectory.rotation_knot(w.first_knot + k));
     blocks.push_back(state.gyro_bias.values[0].data());
+    blocks.push_back(state.gyro_triad_errors.data());
     problem.AddResidualBlock(
         new GyroCostFunction(w, 1.0 / grid.dt_s(), Eigen::Vector3d::Constant(measured), sigma),
         nullptr, blocks);

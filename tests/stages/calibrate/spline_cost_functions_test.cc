@@ -42,6 +42,8 @@ struct State {
   Eigen::Quaterniond q[5];
   Eigen::Vector3d p[5];
   Eigen::Vector3d gyro_bias, accel_bias, gravity_dir, r_b_lb;
+  // IMU triad errors E (row-major), a consumer IMU's size (~1 %).
+  Eigen::Matrix<double, 9, 1> gyro_triad_errors, accel_triad_errors;
   Eigen::Quaterniond q_bl;
   double tau = 0.0;
 };
@@ -59,6 +61,10 @@ State RandomState(std::mt19937* rng, double dt) {
   }
   s.gyro_bias = v(0.01);
   s.accel_bias = v(0.1);
+  for (auto* k : {&s.gyro_triad_errors, &s.accel_triad_errors}) {
+    for (int i = 0; i < 9; ++i) (*k)[i] = 0.01 * n(*rng);
+  }
+  for (int i : {1, 2, 5}) s.accel_triad_errors[i] = 0.0;  // lower triangular
   s.gravity_dir = (Eigen::Vector3d(0, 0, -1) + v(0.1)).normalized();
   s.r_b_lb = v(0.5);
   s.q_bl = ExpQuaternion(v(1.0));
@@ -82,9 +88,9 @@ TEST(GyroCostFunctionTest, MatchesAutodiffTwinAndNumericDifferences) {
       testing::GyroTwinT<true>::AutoDiff sommer(new testing::GyroTwinT<true>{u, 1.0 / dt, sigma, measured});
       std::vector<double*> params = {s.q[0].coeffs().data(), s.q[1].coeffs().data(),
                                      s.q[2].coeffs().data(), s.q[3].coeffs().data(),
-                                     s.gyro_bias.data()};
+                                     s.gyro_bias.data(), s.gyro_triad_errors.data()};
       const std::vector<Block> blocks = {Block::kQuaternion, Block::kQuaternion, Block::kQuaternion,
-                                         Block::kQuaternion, Block::kEuclidean};
+                                         Block::kQuaternion, Block::kEuclidean, Block::kEuclidean};
       const std::string label = "dt " + std::to_string(dt) + " u " + std::to_string(u);
       testing::ExpectSameTangentJacobians(analytic, twin, params, blocks, 1e-9, label);
       testing::ExpectSameTangentJacobians(analytic, sommer, params, blocks, 1e-9, label + " sommer");
@@ -141,11 +147,11 @@ TEST(AccelCostFunctionTest, MatchesAutodiffTwinAndNumericDifferences) {
           s.q[0].coeffs().data(), s.q[1].coeffs().data(), s.q[2].coeffs().data(),
           s.q[3].coeffs().data(), s.p[0].data(),          s.p[1].data(),
           s.p[2].data(),          s.p[3].data(),          s.gravity_dir.data(),
-          s.accel_bias.data()};
+          s.accel_bias.data(),    s.accel_triad_errors.data()};
       const std::vector<Block> blocks = {Block::kQuaternion, Block::kQuaternion, Block::kQuaternion,
                                          Block::kQuaternion, Block::kEuclidean,  Block::kEuclidean,
                                          Block::kEuclidean,  Block::kEuclidean,  Block::kSphere,
-                                         Block::kEuclidean};
+                                         Block::kEuclidean,  Block::kEuclidean};
       const std::string label = "dt " + std::to_string(dt) + " u " + std::to_string(u);
       testing::ExpectSameTangentJacobians(analytic, twin, params, blocks, 1e-9, label);
       testing::ExpectSameTangentJacobians(analytic, sommer, params, blocks, 1e-9, label + " sommer");

@@ -1,0 +1,127 @@
+#!/usr/bin/env bash
+# A consumer-grade IMU, measured: the demo's 40 s Husky-like sequence (IMU
+# upside down), flat and tilted (8 deg pitch, 3 deg roll, g_f from the flat
+# sequence of the same seed), with gyroscope and accelerometer scale errors
+# drawn up to SCALE ppm and axis misalignments up to MIS deg per seed
+# (SimTriadErrors), calibrated by `make -f Makefile.pipeline` as one-bag
+# datasets with the simulator's rig, once with imu_intrinsics.mode AUTO (the
+# default params) and once with OFF.
+# Prints one row per seed, ground and mode: exit code, verdict, rotation
+# (deg), translation per axis (mm) and tau (ms) errors against the truth,
+# whether the intrinsics were estimated, the score, the gyro z scale and
+# the accelerometer's x/y scales found against the truth's (ppm), seconds of
+# make.
+#   bench/calibrate/run_imu_faults_bench.sh [--build_dir=DIR] [--scratch=DIR]
+#       [--seeds=101,102,103] [--scale_ppm=10000] [--misalignment_deg=0.5]
+set -euo pipefail
+SRC=$(cd "$(dirname "$0")/../.." && pwd)
+BUILD=$SRC/build
+SCRATCH=""
+SEEDS=101,102,103
+SCALE=10000
+MIS=0.5
+for arg in "$@"; do
+  case "$arg" in
+    --build_dir=*) BUILD=${arg#*=} ;;
+    --scratch=*) SCRATCH=${arg#*=} ;;
+    --seeds=*) SEEDS=${arg#*=} ;;
+    --scale_ppm=*) SCALE=${arg#*=} ;;
+    --misalignment_deg=*) MIS=${arg#*=} ;;
+    --help) sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    *) echo "unknown argument $arg (see --help)" >&2; exit 2 ;;
+  esac
+done
+BIN=$(cd "$BUILD" && pwd)/bin
+[ -x "$BIN/tiltcal_calibrate" ] || { echo "no $BIN/tiltcal_calibrate: build first" >&2; exit 1; }
+if [ -z "$SCRATCH" ]; then SCRATCH=$(mktemp -d); trap 'rm -rf "$SCRATCH"' EXIT; fi
+mkdir -p "$SCRATCH"
+PY=/usr/bin/python3
+
+# scenario KIND SEED: the demo's Husky scenario with a consumer IMU.
+scenario() {
+  local kind=$1 seed=$2 pitch=0 roll=0
+  [ "$kind" = tilted ] && { pitch=8; roll=3; }
+  sed -E -e "s/^seed: .*/seed: $seed/" -e "s/^duration_s: .*/duration_s: 40/" \
+    -e "s/^ground_pitch_deg: .*/ground_pitch_deg: $pitch/" \
+    -e "s/^ground_roll_deg: .*/ground_roll_deg: $roll/" \
+    "$SRC/stages/simulate/scenarios/tilted_husky_vlp16.txtpb"
+  echo "faults {"
+  echo "  gyro_intrinsics { scale_max_ppm: $SCALE misalignment_max_deg: $MIS }"
+  echo "  accel_intrinsics { scale_max_ppm: $SCALE misalignment_max_deg: $MIS }"
+  echo "}"
+}
+
+# report CALIBRATION TRUTH: the row's numbers.
+report() {
+  "$PY" - "$1" "$2" <<'PYEOF'
+import math, os, sys
+sys.path.insert(0, os.path.join(os.environ['SRC'], 'bench/calibrate'))
+from calibration_errors import parse
+def first(d, *path):
+    for k in path:
+        if not isinstance(d, dict) or k not in d: return None
+        d = d[k][0] if isinstance(d[k], list) else d[k]
+    return d
+cal = parse(open(sys.argv[1]).read())
+truth = parse(open(sys.argv[2]).read())
+def pose(d):
+    t = first(d, 'imu_from_lidar')
+    q = [float(first(t, 'rotation', k) or 0) for k in 'wxyz']
+    r = [float(first(t, 'translation', k) or 0) for k in 'xyz']
+    return q, r
+(q1, r1), (q2, r2) = pose(cal), pose(truth)
+d = abs(sum(a * b for a, b in zip(q1, q2)))
+rot = 2 * math.degrees(math.acos(min(1.0, d)))
+tau = (float(first(cal, 'time_offset_s') or 0) - float(first(truth, 'time_offset_s') or 0)) * 1e3
+k = first(cal, 'imu_intrinsics') or {}
+est = first(k, 'estimated') == 'true'
+score = float(first(k, 'score_chi2') or 0)
+def scale(d, triad, axis):
+    return float(first(d, triad, 'scale_ppm', axis) or 0)
+gz = scale(k, 'gyro', 'z'); tgz = scale(truth, 'gyro_intrinsics', 'z')
+ax = scale(k, 'accel', 'x'); tax = scale(truth, 'accel_intrinsics', 'x')
+ay = scale(k, 'accel', 'y'); tay = scale(truth, 'accel_intrinsics', 'y')
+print('%.3f  %6.1f %6.1f %6.1f  %6.2f  %-3s %8.0f  %6.0f/%6.0f  %6.0f/%6.0f  %6.0f/%6.0f' % (
+    rot, *[(a - b) * 1e3 for a, b in zip(r1, r2)], tau, 'yes' if est else 'no', score,
+    gz, tgz, ax, tax, ay, tay))
+PYEOF
+}
+
+# run NAME SCENARIO_BAG MODE [GRAVITY_REFERENCE]
+run() {
+  local name=$1 bag=$2 mode=$3 ref=${4:-}
+  local d=$SCRATCH/$name
+  rm -rf "$d"; mkdir -p "$d/params"
+  cp "$SCRATCH/$bag.bag" "$d/seq.bag"
+  sed '/^gravity_reference:/d' "$SCRATCH/$bag.rig.txtpb" > "$d/rig.txtpb"
+  [ -n "$ref" ] && echo "gravity_reference: \"$ref\"" >> "$d/rig.txtpb"
+  sed "s/^  mode: AUTO$/  mode: $mode/" "$SRC/stages/calibrate/default_params.txtpb" \
+    > "$d/params/calibrate.txtpb"
+  local start=$SECONDS rc=0
+  make -s -f "$SRC/Makefile.pipeline" DATASET="$d" BIN="$BIN" > "$d/make.log" 2>&1 || rc=$?
+  local cal=$d/out/seq/calibration.txtpb
+  [ -f "$cal" ] || cal=$d/out/seq/calibration.suspect.txtpb
+  if [ -f "$cal" ]; then
+    printf '%-5s %-7s %-5s rc %d  %-8s %s  %3d s\n' "${name%%_*}" "${bag%%.*}" "$mode" "$rc" \
+      "$(sed -n 's/^verdict: //p' "$cal")" "$(report "$cal" "$SCRATCH/$bag.truth.txtpb")" \
+      $((SECONDS - start))
+  else
+    printf '%-5s %-7s %-5s rc %d  no calibration: %s\n' "${name%%_*}" "${bag%%.*}" "$mode" "$rc" \
+      "$(grep -m1 -E 'error|Error|refus' "$d/make.log" | cut -c1-160)"
+  fi
+}
+
+export SRC
+echo "seed  ground  mode  exit  verdict  rot_deg  dx_mm  dy_mm  dz_mm  tau_ms  est  score  gyro_z/truth  acc_x/truth  acc_y/truth  make"
+for seed in ${SEEDS//,/ }; do
+  for kind in flat tilted; do
+    scenario $kind "$seed" > "$SCRATCH/$kind.$seed.scenario.txtpb"
+    "$BIN/tiltcal_simulate" --params="$SCRATCH/$kind.$seed.scenario.txtpb" \
+      --out_bag="$SCRATCH/$kind.$seed.bag" --out_truth="$SCRATCH/$kind.$seed.truth.txtpb" \
+      --out_rig="$SCRATCH/$kind.$seed.rig.txtpb" 2> /dev/null
+  done
+  for mode in AUTO OFF; do
+    run "${seed}_flat_$mode" "flat.$seed" $mode
+    run "${seed}_tilted_$mode" "tilted.$seed" $mode "../${seed}_flat_AUTO"
+  done
+done
