@@ -13,14 +13,14 @@
 namespace tiltcal::calibrate {
 namespace {
 
-constexpr double kRadToDeg = 180.0 / M_PI;
+constexpr double kIntrinsicsDegPerRad = 180.0 / M_PI;
 
 // Row-major indices of the 3 x 3 entries; E_a's upper triangle (1, 2, 5) is
 // held by the problem's manifold.
 const std::vector<int> kGyroEntries = {0, 1, 2, 3, 4, 5, 6, 7, 8};
 const std::vector<int> kAccelEntries = {0, 3, 4, 6, 7, 8};
 
-std::string EntryName(const char* triad, int entry) {
+std::string IntrinsicEntryName(const char* triad, int entry) {
   static const char* const kAxis[] = {"x", "y", "z"};
   const int row = entry / 3;
   const int col = entry % 3;
@@ -34,7 +34,7 @@ const std::vector<int>& GyroErrorEntries() { return kGyroEntries; }
 const std::vector<int>& AccelErrorEntries() { return kAccelEntries; }
 
 double IntrinsicPriorSigma(int row, int col, const proto::ImuIntrinsicsParams& params) {
-  return row == col ? params.scale_prior_ppm() * 1e-6 : params.misalignment_prior_deg() / kRadToDeg;
+  return row == col ? params.scale_prior_ppm() * 1e-6 : params.misalignment_prior_deg() / kIntrinsicsDegPerRad;
 }
 
 Status ScoreTestImuIntrinsics(ceres::Problem* problem, CalibrationState* state,
@@ -117,9 +117,9 @@ proto::ImuTriadEstimate DescribeTriad(const std::array<double, 9>& errors,
   *out.mutable_scale_ppm() = ToProto(Eigen::Vector3d((t.diagonal().array() - 1.0) * 1e6));
   *out.mutable_scale_sigma_ppm() = ToProto(Eigen::Vector3d(sigma.diagonal() * 1e6));
   *out.mutable_misalignment_deg() =
-      ToProto(Eigen::Vector3d(t(1, 0), t(2, 0), t(2, 1)) * kRadToDeg);
+      ToProto(Eigen::Vector3d(t(1, 0), t(2, 0), t(2, 1)) * kIntrinsicsDegPerRad);
   *out.mutable_misalignment_sigma_deg() =
-      ToProto(Eigen::Vector3d(sigma(1, 0), sigma(2, 0), sigma(2, 1)) * kRadToDeg);
+      ToProto(Eigen::Vector3d(sigma(1, 0), sigma(2, 0), sigma(2, 1)) * kIntrinsicsDegPerRad);
   for (int i = 0; i < 3; ++i) {
     for (int j = 0; j < 3; ++j) {
       out.add_measured_from_true(t(i, j));
@@ -141,7 +141,7 @@ std::vector<std::string> UndeterminedIntrinsics(const Eigen::MatrixXd& covarianc
       const double prior = IntrinsicPriorSigma(entry / 3, entry % 3, params);
       const double sigma = std::sqrt(std::max(covariance(column, column), 0.0));
       if (sigma > params.undetermined_sigma_fraction() * prior) {
-        out.push_back(EntryName(triad, entry));
+        out.push_back(IntrinsicEntryName(triad, entry));
       }
       ++column;
     }
