@@ -347,7 +347,7 @@ Status TestImuIntrinsics(const proto::CalibrateParams& params, CalibrationState*
 }
 
 // The IMU intrinsics' report: estimated values with the sigmas of their
-// marginal covariance (15x15, may be empty), or the score test's one-step
+// marginal covariance (12x12, may be empty), or the score test's one-step
 // values.
 void FillImuIntrinsics(const proto::ImuIntrinsicsParams& params, const OuterLoop& loop,
                        bool estimated, const CalibrationState& state,
@@ -362,10 +362,10 @@ void FillImuIntrinsics(const proto::ImuIntrinsicsParams& params, const OuterLoop
     report->set_found(loop.intrinsics_found);
   }
   if (estimated) {
-    const bool has_covariance = covariance.rows() == 15;
+    const bool has_covariance = covariance.rows() == 12;
     *report->mutable_gyro() =
         DescribeTriad(state.gyro_triad_errors, GyroErrorEntries(),
-                      has_covariance ? Eigen::MatrixXd(covariance.topLeftCorner(9, 9))
+                      has_covariance ? Eigen::MatrixXd(covariance.topLeftCorner(6, 6))
                                      : Eigen::MatrixXd());
     *report->mutable_accel() =
         DescribeTriad(state.accel_triad_errors, AccelErrorEntries(),

@@ -50,7 +50,7 @@ Status ComputeExtrinsicCovariance(ceres::Problem* problem, CalibrationState* sta
         intrinsics_size += problem->ParameterBlockTangentSize(b);
       }
     }
-    if (intrinsics_size != 15) {
+    if (intrinsics_size != 12) {
       intrinsics.clear();
       intrinsics_size = 0;
     }

@@ -56,8 +56,8 @@ MotionAxis PrincipalRotationAxis(const std::vector<imu::ImuReading>& samples,
 // factorisation) are returned as Status for the report; they are data, not a
 // failure of the stage.
 // With intrinsics_covariance and the IMU triad errors free in the problem,
-// they are marginalised last as well and their covariance (15x15, tangent:
-// E_g's 9 entries, then E_a's 6 lower-triangular ones row by row)
+// they are marginalised last as well and their covariance (12x12, tangent:
+// E_g's 6 lower-triangular entries row by row, then E_a's)
 // is returned there; otherwise it is left empty.
 Status ComputeExtrinsicCovariance(ceres::Problem* problem, CalibrationState* state,
                                   const proto::ObservabilityParams& params, int num_threads,

@@ -4,9 +4,8 @@
 // Gyroscope residual of one IMU sample at IMU time t (docs/design.md §6):
 //   r = ((I + E_g) omega_b(t) + b_g - omega_m) / sigma_g     (3, dimensionless)
 // omega_b(t): body angular velocity of the SO(3) spline C_ab (Sommer recursion);
-// E_g: the gyroscope triad's scale and axis errors (common/imu/triad_errors.h),
-// a full 3x3 matrix: scale, misalignment and the triad's small rotation
-// against the accelerometer's, which defines b.
+// E_g: the gyroscope triad's scale and axis errors (common/imu/triad_errors.h;
+// the problem holds its upper triangle at zero, docs/design.md §6).
 //
 // Parameter blocks, in order:
 //   0..3  rotation knots s..s+3: unit quaternions, 4 doubles (x, y, z, w),

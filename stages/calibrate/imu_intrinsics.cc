@@ -15,9 +15,9 @@ namespace {
 
 constexpr double kIntrinsicsDegPerRad = 180.0 / M_PI;
 
-// Row-major indices of the 3 x 3 entries; E_a's upper triangle (1, 2, 5) is
-// held by the problem's manifold.
-const std::vector<int> kGyroEntries = {0, 1, 2, 3, 4, 5, 6, 7, 8};
+// Row-major indices of the 3 x 3 entries; the upper triangles (1, 2, 5)
+// are held by the problem's manifold.
+const std::vector<int> kGyroEntries = {0, 3, 4, 6, 7, 8};
 const std::vector<int> kAccelEntries = {0, 3, 4, 6, 7, 8};
 
 std::string IntrinsicEntryName(const char* triad, int entry) {
@@ -72,7 +72,7 @@ Status ScoreTestImuIntrinsics(ceres::Problem* problem, CalibrationState* state,
     return Status::Error("IMU intrinsics score test: the IMU residuals could not be evaluated");
   }
 
-  // H = J^T J + P over the 15 free entries.
+  // H = J^T J + P over the free entries.
   Eigen::MatrixXd h = Eigen::MatrixXd::Zero(n, n);
   for (int row = 0; row < jacobian.num_rows; ++row) {
     for (int a = jacobian.rows[row]; a < jacobian.rows[row + 1]; ++a) {

@@ -8,12 +8,13 @@
 // accel_cost_function.h), with priors (problem_builder.h).
 //
 // Score test of E_g = E_a = 0 (both held constant in the problem): with J
-// the weighted Jacobian of all residuals with respect to the 15 free entries
-// (E_g's 9, E_a's 6 lower-triangular), r the weighted residuals, P the
+// the weighted Jacobian of all residuals with respect to the 12 free entries
+// (the 6 lower-triangular ones of E_g, then of E_a), r the weighted
+// residuals, P the
 // priors' information (diag 1 / sigma^2 of the prior) and sigma0^2 the
 // variance factor of the solution (covariance_report.h),
 //   g = J^T r,   H = J^T J + P,   chi2 = g^T H^-1 g / sigma0^2,
-// about chi-square with 15 degrees of freedom when the IMU is ideal. The
+// about chi-square with 12 degrees of freedom when the IMU is ideal. The
 // other parameters are held in J, not marginalised: their information only
 // lowers the statistic, so the test is conservative. -H^-1 g is the one-step
 // estimate of the errors (what the residuals point to).
@@ -37,7 +38,7 @@ struct ImuIntrinsicsScore {
   double chi2 = 0.0;  // divided by sigma0^2
   int dof = 0;
   double sigma0_squared = 1.0;
-  // The one-step estimate, 9 doubles each (E_a's upper triangle 0).
+  // The one-step estimate, 9 doubles each (upper triangles 0).
   std::array<double, 9> gyro_triad_errors{};
   std::array<double, 9> accel_triad_errors{};
 };
@@ -55,8 +56,8 @@ proto::ImuTriadEstimate DescribeTriad(const std::array<double, 9>& errors,
                                       const std::vector<int>& free,
                                       const Eigen::MatrixXd& covariance);
 
-// The entries of the estimated errors whose sigma (from the 15x15
-// covariance of ComputeExtrinsicCovariance) is above
+// The entries of the estimated errors whose sigma (from the
+// covariance of ComputeExtrinsicCovariance, kFreeIntrinsicEntries square) is above
 // params.undetermined_sigma_fraction of their prior, named e.g.
 // "gyroscope z scale", "accelerometer y axis towards x".
 std::vector<std::string> UndeterminedIntrinsics(const Eigen::MatrixXd& covariance,

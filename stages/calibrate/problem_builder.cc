@@ -75,7 +75,7 @@ CalibrationProblem::CalibrationProblem(CalibrationState* state,
   p.AddParameterBlock(state_->time_offset_s, 1);
   p.AddParameterBlock(state_->gravity_direction, 3, &sphere_manifold_);
   for (double* b : state_->BiasBlocks()) p.AddParameterBlock(b, 3);
-  p.AddParameterBlock(state_->gyro_triad_errors.data(), 9);
+  p.AddParameterBlock(state_->gyro_triad_errors.data(), 9, &lower_triangular_manifold_);
   p.AddParameterBlock(state_->accel_triad_errors.data(), 9, &lower_triangular_manifold_);
 
   // tau bounds around the binning value; tau clamped into them.

@@ -33,8 +33,8 @@
 // accel_bias_random_walk_mps3_sqrthz; 0 = untied).
 //
 // IMU intrinsics (docs/design.md §6): the gyro and accelerometer triad
-// errors E_g, E_a (calibration_state.h) are in every IMU row; E_a's
-// upper triangle is held at zero by a ceres::SubsetManifold. Held constant
+// errors E_g, E_a (calibration_state.h) are in every IMU row; their
+// upper triangles are held at zero by a ceres::SubsetManifold. Held constant
 // unless estimate_imu_intrinsics; then each has a prior at zero
 // (triad_errors_prior_cost_function.h, counted in prior_residuals).
 //
@@ -175,7 +175,7 @@ class CalibrationProblem {
   ProblemOptions options_;
   spline::RightQuaternionManifold quaternion_manifold_;
   ceres::SphereManifold<3> sphere_manifold_;
-  // E_a lower triangular: its entries (0, 1), (0, 2), (1, 2) held.
+  // E_g, E_a lower triangular: entries (0, 1), (0, 2), (1, 2) held.
   ceres::SubsetManifold lower_triangular_manifold_{9, {1, 2, 5}};
   std::unique_ptr<IntervalManifold> time_offset_manifold_;  // tau in its bounds
   std::unique_ptr<ceres::LossFunction> lidar_loss_;
