@@ -66,7 +66,7 @@ sed -e 's/write_gravity_flat: false/write_gravity_flat: true/' \
 [ -n "$SEED" ] && sed -i -e "s/^seed: .*/seed: $SEED/" "$scenario"
 sed -e "s/^num_threads: .*/num_threads: $THREADS/" "$PARAMS" > "$W/calibrate_params.txtpb"
 if [ "$GROUND" = off ]; then
-  sed -i -e "s/mode: AUTO/mode: OFF/; s/mode: ON/mode: OFF/" "$W/calibrate_params.txtpb"
+  sed -i -E -e "/^  (flat|dist|incl|up) \{/ s/mode: (AUTO|ON)/mode: OFF/" "$W/calibrate_params.txtpb"
 fi
 
 now() { date +%s.%N; }

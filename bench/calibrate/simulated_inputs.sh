@@ -30,9 +30,10 @@ simulate_inputs() {
 # calibrate_params IN OUT THREADS [GROUND]: IN with num_threads THREADS and
 # every ground residual OFF, or as IN sets them when GROUND is 1.
 calibrate_params() {
-  local ground_off="s/mode: AUTO/mode: OFF/; s/mode: ON/mode: OFF/"
+  # Only the ground residuals' lines: imu_intrinsics has a mode too.
+  local ground_off="/^  (flat|dist|incl|up) \{/ s/mode: (AUTO|ON)/mode: OFF/"
   [ "${4:-0}" = 1 ] && ground_off=""
-  sed -e "s/^num_threads: .*/num_threads: $3/" -e "$ground_off" "$1" > "$2"
+  sed -E -e "s/^num_threads: .*/num_threads: $3/" -e "$ground_off" "$1" > "$2"
 }
 
 # steal_ticks: CPU time the hypervisor gave to other guests since boot, in

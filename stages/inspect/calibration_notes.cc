@@ -1,11 +1,40 @@
 #include "stages/inspect/calibration_notes.h"
 
+#include <algorithm>
 #include <cmath>
+#include <string>
+#include <vector>
 
 #include <fmt/format.h>
 
 namespace tiltcal::inspect {
 namespace {
+
+// Vibration the calibration's white-noise model does not hold
+// (ImuCheckParams.vibration_*).
+void AddVibrationNote(const proto::CheckParams& params, const ImuFindings& imu,
+                      std::vector<std::string>* notes) {
+  const imu::ImuVibration& v = imu.vibration;
+  const proto::ImuCheckParams& p = params.imu();
+  if (!imu.gyro_vibrates && !imu.accel_vibrates) return;
+  const double gyro_ratio = v.gyro.rms.maxCoeff() / p.gyro_noise_radps();
+  const double accel_ratio = v.accel.rms.maxCoeff() / p.accel_noise_mps2();
+  auto peak = [&](const imu::TriadVibration& t) {
+    return t.peak_frequency_hz > 0.0 ? fmt::format(", peak {:.1f} Hz", t.peak_frequency_hz)
+                                     : std::string();
+  };
+  notes->push_back(fmt::format(
+      "IMU vibration above the motion's band (as sampled at {:.0f} Hz; above {:.0f} Hz it shows "
+      "aliased): accelerometer RMS up to {:.3f} m/s² ({:.0f} × the {:g} m/s² white noise the "
+      "calibration assumes{}), gyro up to {:.4f} rad/s ({:.0f} × {:g} rad/s{}). The calibration's "
+      "IMU residuals will be far above its noise model and the result SUSPECT{}: damp the IMU's "
+      "mount, or set imu_noise.accel_sigma_mps2 and gyro_sigma_radps in params/calibrate.txtpb "
+      "to about these RMS (the IMU then counts for less and the result may be WEAK)",
+      v.sample_rate_hz, 0.5 * v.sample_rate_hz, v.accel.rms.maxCoeff(), accel_ratio,
+      p.accel_noise_mps2(), peak(v.accel), v.gyro.rms.maxCoeff(), gyro_ratio,
+      p.gyro_noise_radps(), peak(v.gyro),
+      imu.static_start.found ? "" : "; it also hides the static start"));
+}
 
 void AddImuNotes(const proto::CheckParams& params, CheckFindings* f) {
   const ImuFindings& imu = f->imu;
@@ -44,6 +73,7 @@ void AddImuNotes(const proto::CheckParams& params, CheckFindings* f) {
                     "sorts the samples by stamp",
                     imu.stamps.num_backwards));
   }
+  AddVibrationNote(params, imu, &notes);
   const ImuExcitation& e = imu.excitation;
   if (imu.stamps.count >= 2 && imu.accel.unit &&
       e.rotation_speed_p95_radps < params.imu().min_rotation_radps()) {
@@ -111,6 +141,19 @@ void AddClockNotes(const proto::CheckParams& params, CheckFindings* f) {
         "{:+.3f} s (τ ≈ {:.3f} s); set the calibrate params' init.coarse_time_offset_window_s to cover it",
         params.clock().time_offset_window_s(), c.stamp_offset_difference_s,
         -c.stamp_offset_difference_s));
+  }
+  const double max_drift_s = params.clock().max_time_offset_drift_s();
+  if (c.rate_measured && c.time_offset_drift_s > max_drift_s &&
+      std::abs(c.lidar_rate_vs_imu_ppm) > 3.0 * c.lidar_rate_vs_imu_sigma_ppm) {
+    const double rate = std::abs(c.lidar_rate_vs_imu_ppm) * 1e-6;
+    f->notes.push_back(fmt::format(
+        "the LiDAR clock runs {:+.1f} ± {:.1f} ppm against the IMU's (their stamps against the "
+        "record times): τ drifts by {:.2f} ms over the {:.1f} s of overlap, and the calibration "
+        "fits one τ for the whole sequence (its ends off by about half that); τ stays within "
+        "{:.1f} ms only over {:.0f} s: synchronise the clocks (PTP, GPS PPS) or calibrate shorter "
+        "recordings",
+        c.lidar_rate_vs_imu_ppm, c.lidar_rate_vs_imu_sigma_ppm, 1e3 * c.time_offset_drift_s,
+        c.overlap_s, 1e3 * max_drift_s, max_drift_s / rate));
   }
 }
 

@@ -28,6 +28,13 @@ Status CheckParamsAreValid(const proto::CheckParams& params) {
             "imu.min_rotation_radps ({:g}) must be below imu.max_vehicle_turn_rate_radps ({:g})",
             params.imu().min_rotation_radps(), params.imu().max_vehicle_turn_rate_radps()));
   }
+  if (params.imu().gyro_noise_radps() <= 0.0 || params.imu().accel_noise_mps2() <= 0.0) {
+    return Status::Error("imu.gyro_noise_radps and imu.accel_noise_mps2 must be positive");
+  }
+  if (params.imu().vibration_cutoff_hz() * params.imu().vibration_filter_span_s() < 1.0) {
+    return Status::Error(
+        "imu.vibration_filter_span_s must hold at least one period of imu.vibration_cutoff_hz");
+  }
   return Status::Ok();
 }
 

@@ -101,6 +101,19 @@ void AnalyseImu(const BagSurvey& survey, const proto::CheckParams& params, Check
   excitation.lateral_accel_hysteresis_mps2 = params.excitation().lateral_accel_hysteresis_mps2();
   imu.excitation =
       MeasureImuExcitation(readings, gyro_bias, imu.specific_force_at_rest_mps2, excitation);
+  imu::VibrationOptions vibration;
+  vibration.cutoff_hz = params.imu().vibration_cutoff_hz();
+  vibration.filter_span_s = params.imu().vibration_filter_span_s();
+  vibration.spectrum_segment_s = params.imu().vibration_spectrum_segment_s();
+  vibration.max_segments = static_cast<int>(params.imu().vibration_max_segments());
+  imu.vibration = imu::MeasureImuVibration(readings, vibration);
+  const proto::ImuCheckParams& p = params.imu();
+  if (imu.vibration.num_samples > 0) {
+    imu.gyro_vibrates =
+        imu.vibration.gyro.rms.maxCoeff() > p.vibration_factor() * p.gyro_noise_radps();
+    imu.accel_vibrates =
+        imu.vibration.accel.rms.maxCoeff() > p.vibration_factor() * p.accel_noise_mps2();
+  }
 }
 
 ScanGeometryOptions ToScanGeometryOptions(const proto::LidarCheckParams& p) {
@@ -177,6 +190,16 @@ void AnalyseClock(const BagSurvey& survey, const proto::CheckParams& params, Che
         1e-9 * i.first_ns, 1e-9 * i.last_ns, 1e-9 * l.first_ns, 1e-9 * l.last_ns,
         c.overlap_s < 0.0 ? fmt::format("do not overlap (apart by {:.3f} s)", -c.overlap_s)
                           : fmt::format("overlap only {:.3f} s", c.overlap_s)));
+  }
+  const double window_s = params.clock().rate_window_s();
+  c.imu_rate = EstimateClockRate(survey.imu_stamp_ns, survey.imu_record_ns, window_s);
+  c.lidar_rate = EstimateClockRate(survey.scan_stamp_ns, survey.scan_record_ns, window_s);
+  c.rate_measured = c.imu_rate.measured && c.lidar_rate.measured &&
+                    !(c.imu_rate.stamps_are_record && c.lidar_rate.stamps_are_record);
+  if (c.rate_measured) {
+    c.lidar_rate_vs_imu_ppm = c.lidar_rate.rate_ppm - c.imu_rate.rate_ppm;
+    c.lidar_rate_vs_imu_sigma_ppm = std::hypot(c.lidar_rate.sigma_ppm, c.imu_rate.sigma_ppm);
+    c.time_offset_drift_s = std::abs(c.lidar_rate_vs_imu_ppm) * 1e-6 * std::max(c.overlap_s, 0.0);
   }
 }
 

@@ -9,7 +9,9 @@
 
 #include "common/imu/imu_units.h"
 #include "common/imu/static_detection.h"
+#include "common/imu/vibration.h"
 #include "stages/inspect/bag_survey.h"
+#include "stages/inspect/clock_rate.h"
 #include "stages/inspect/excitation.h"
 #include "stages/inspect/stamp_statistics.h"
 #include "tiltcal/proto/check_params.pb.h"
@@ -27,6 +29,10 @@ struct ImuFindings {
   imu::StaticInterval static_start;  // SI; times from the first IMU stamp
   Eigen::Vector3d specific_force_at_rest_mps2 = Eigen::Vector3d::Zero();
   ImuExcitation excitation;
+  imu::ImuVibration vibration;  // SI units
+  // A high-passed RMS above ImuCheckParams.vibration_factor times the
+  // calibration's white-noise σ on some axis of the triad.
+  bool gyro_vibrates = false, accel_vibrates = false;
   double stamp_minus_record_s = 0.0;  // median header stamp − record time
 };
 
@@ -51,6 +57,13 @@ struct ClockFindings {
   // streams received promptly, τ ≈ −this (a LiDAR stamp t_l happened at IMU
   // time t_l + τ).
   double stamp_offset_difference_s = 0.0;
+  // Each stream's stamp clock against the record times, and the LiDAR's
+  // against the IMU's: rate_ppm > 0 the LiDAR clock runs fast, τ changes by
+  // −rate · 1e-6 per second (a LiDAR stamp reads later and later).
+  ClockRate imu_rate, lidar_rate;
+  bool rate_measured = false;
+  double lidar_rate_vs_imu_ppm = 0.0, lidar_rate_vs_imu_sigma_ppm = 0.0;
+  double time_offset_drift_s = 0.0;  // |rate| · 1e-6 · overlap
 };
 
 // Everything the check says. `problems` make the bag uncalibratable (exit

@@ -47,6 +47,19 @@ void WriteImu(const CheckFindings& f, std::ostream& out) {
   Line(out, "gyro",
        fmt::format("{} ({:g}th percentile |ω| {:.3f} as published)",
                    imu::UnitName(imu.gyro_unit), imu.gyro.percentile, imu.gyro.rate_at_percentile));
+  const imu::ImuVibration& v = imu.vibration;
+  if (v.num_samples > 0) {
+    Line(out, "above the motion's band",
+         fmt::format("gyro RMS {:.4f} {:.4f} {:.4f} rad/s{}; accel RMS {:.3f} {:.3f} {:.3f} m/s²{}",
+                     v.gyro.rms.x(), v.gyro.rms.y(), v.gyro.rms.z(),
+                     imu.gyro_vibrates && v.gyro.peak_frequency_hz > 0.0
+                         ? fmt::format(" (vibration, peak {:.1f} Hz)", v.gyro.peak_frequency_hz)
+                         : std::string(),
+                     v.accel.rms.x(), v.accel.rms.y(), v.accel.rms.z(),
+                     imu.accel_vibrates && v.accel.peak_frequency_hz > 0.0
+                         ? fmt::format(" (vibration, peak {:.1f} Hz)", v.accel.peak_frequency_hz)
+                         : std::string()));
+  }
   const imu::StaticInterval& st = imu.static_start;
   Line(out, "static start",
        st.found ? fmt::format("yes, {:.2f} s (gyro bias {:.4f} {:.4f} {:.4f} rad/s)",
@@ -98,6 +111,14 @@ void WriteClock(const CheckFindings& f, std::ostream& out) {
   Line(out, "stamp − record time",
        fmt::format("IMU {:+.4f} s, LiDAR {:+.4f} s (medians)", f.imu.stamp_minus_record_s,
                    f.lidar.stamp_minus_record_s));
+  const ClockFindings& c = f.clock;
+  Line(out, "LiDAR clock vs IMU's",
+       c.rate_measured
+           ? fmt::format("{:+.1f} ± {:.1f} ppm (stamps against the record times; τ drifts "
+                         "{:.2f} ms over the overlap)",
+                         c.lidar_rate_vs_imu_ppm, c.lidar_rate_vs_imu_sigma_ppm,
+                         1e3 * c.time_offset_drift_s)
+           : std::string("not measurable (the record times are the stamps, or too short)"));
 }
 
 void WriteExcitation(const CheckFindings& f, std::ostream& out) {

@@ -296,6 +296,10 @@ int64_t Scenario::LidarStampNs(int64_t true_rel_ns) const {
   return imu_start_stamp_ns + true_rel_ns + drift_ns - time_offset_ns;
 }
 
+int64_t Scenario::LidarRecordNs(int64_t true_rel_ns) const {
+  return imu_start_stamp_ns + true_rel_ns - time_offset_ns;
+}
+
 Status BuildScenario(const proto::SimulateParams& params, Scenario* scenario) {
   TILTCAL_RETURN_IF_ERROR(SimFaultParamsAreValid(params.faults(), params.duration_s()));
   const TrajectoryConfig tc = MakeTrajectoryConfig(params);
@@ -607,9 +611,10 @@ class ScanWriter {
         const int k = first + j;
         if (!scenario_.scan_kept[static_cast<size_t>(k)]) continue;
         const int64_t stamp = StampNs(scans_[j]);
+        const int64_t record = scenario_.LidarRecordNs(scans_[j].stamp_true_ns);
         if (!ok_[j]) return Status::Error("scan " + std::to_string(k) + ": stamp is not a ROS time");
-        TILTCAL_RETURN_IF_ERROR(imu->WriteUpTo(stamp, imu_conn, writer));
-        TILTCAL_RETURN_IF_ERROR(writer->Write(lidar_conn, stamp, messages_[j]));
+        TILTCAL_RETURN_IF_ERROR(imu->WriteUpTo(record, imu_conn, writer));
+        TILTCAL_RETURN_IF_ERROR(writer->Write(lidar_conn, record, messages_[j]));
         summary->num_points += scans_[j].num_valid;
         FillTruthScan(scenario_, frames, scans_[j], scenario_.imu_start_stamp_ns, stamp,
                       truth->add_scans());

@@ -62,6 +62,9 @@ struct Scenario {
   // The LiDAR-clock stamp of true time `true_rel_ns` (ns since the first IMU
   // sample): imu_start_stamp_ns + t + round(t · drift_ppm · 1e-6) − τ.
   int64_t LidarStampNs(int64_t true_rel_ns) const;
+  // The bag's record time of that sweep: the recorder's clock, which is the
+  // IMU's: LidarStampNs without the drift term (the stamp when no drift).
+  int64_t LidarRecordNs(int64_t true_rel_ns) const;
 };
 // Checks the params beyond their schema bounds (ranges, room size, sensor
 // above the ground, stamps representable, the faults: fault_params.h) and

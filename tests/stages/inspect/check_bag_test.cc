@@ -2,9 +2,11 @@
 // (tiltcal_simulate's library), and copies of it rewritten to carry the
 // faults of real recordings (IMU in g and deg/s, holes and repeated stamps,
 // no static start, no rotation, no LiDAR topic, LiDAR stamps on another
-// clock). Each asserts the numbers, the statements and the verdict; the
+// clock), and a simulation with a vibrating IMU, a drifting LiDAR clock
+// and dropped scans. Each asserts the numbers, the statements and the verdict; the
 // command-line tests assert the exit codes.
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -42,7 +44,8 @@ constexpr int64_t kImuSamples = 2001;  // 200 Hz, both ends included
 // small enough to turn both ways once (6 m by 3 m at 1.5 m/s).
 class SimulatedBag {
  public:
-  SimulatedBag() {
+  // faults: SimFaultParams in text format ("" = none).
+  explicit SimulatedBag(const std::string& faults = "") {
     proto::SimulateParams scenario;
     const Status read = ReadTextProto(
         testing::SourceDir() + "/stages/simulate/scenarios/short_test_vlp16.txtpb", &scenario);
@@ -53,6 +56,8 @@ class SimulatedBag {
     scenario.mutable_trajectory()->set_length_m(6.0);
     scenario.mutable_trajectory()->set_width_m(3.0);
     scenario.set_num_threads(2);
+    const Status parsed = ParseTextProto(faults, "faults", scenario.mutable_faults());
+    EXPECT_TRUE(parsed.ok()) << parsed.message();
     simulate::SimulatePaths paths;
     paths.out_bag = dir_.File("run.bag");
     paths.out_truth = dir_.File("truth.txtpb");
@@ -211,6 +216,15 @@ TEST(CheckBag, CleanSimulatedSequence) {
   EXPECT_EQ(f.lidar.stamps.first_ns, first_scan_ns);
   EXPECT_NEAR(f.clock.overlap_s, 1e-9 * (last_scan_ns - first_scan_ns), 1e-9);
   EXPECT_TRUE(f.problems.empty());
+  // No vibration: the high-passed readings are the white noise above 12 Hz
+  // (accelerometer 1e-3 m/s^2/sqrt(Hz): 0.013 m/s^2), not the body's sway.
+  EXPECT_FALSE(f.imu.gyro_vibrates);
+  EXPECT_FALSE(f.imu.accel_vibrates);
+  EXPECT_LT(f.imu.vibration.accel.rms.maxCoeff(), 0.02);
+  EXPECT_LT(f.imu.vibration.gyro.rms.maxCoeff(), 0.004);
+  // The simulator's record times are the stamps: no clock rate to measure.
+  EXPECT_FALSE(f.clock.rate_measured);
+  EXPECT_FALSE(AnyContains(f.notes, "vibration"));
   // The report.
   EXPECT_TRUE(Contains(run.report, "  samples                  2001\n")) << run.report;
   EXPECT_TRUE(Contains(run.report, "  rate                     200.00 Hz")) << run.report;
@@ -220,6 +234,41 @@ TEST(CheckBag, CleanSimulatedSequence) {
   EXPECT_TRUE(Contains(run.report, "stamps at the end of the sweep")) << run.report;
   EXPECT_TRUE(Contains(run.report, "  ring                     ring UINT16")) << run.report;
   EXPECT_TRUE(Contains(run.report, "\nverdict: can be calibrated\n")) << run.report;
+}
+
+// Engine vibration at 37 Hz (1.5 m/s², 0.05 rad/s per axis, also during the
+// static start), a LiDAR clock 100 ppm fast against the IMU's (1 ms of τ
+// over the 10 s) and 10 % of the scans dropped: each is measured and said.
+TEST(CheckBag, VibrationClockDriftAndDroppedScansAreMeasuredAndSaid) {
+  const SimulatedBag sim(
+      "imu_vibration { frequency_hz: 37 accel_amplitude_mps2: 1.5 gyro_amplitude_radps: 0.05 } "
+      "lidar_clock_drift_ppm: 100 lidar_drop_fraction: 0.1");
+  const CheckRun run = Check(sim.bag(), sim.rig());
+  ASSERT_TRUE(run.status.ok()) << run.status.message() << "\n" << run.report;
+  const CheckFindings& f = run.findings;
+  // A sinusoid of amplitude A has RMS A / sqrt(2); the noise adds in quadrature.
+  EXPECT_TRUE(f.imu.gyro_vibrates);
+  EXPECT_TRUE(f.imu.accel_vibrates);
+  for (int axis = 0; axis < 3; ++axis) {
+    EXPECT_NEAR(f.imu.vibration.accel.rms[axis], 1.5 / std::sqrt(2.0), 0.05);
+    EXPECT_NEAR(f.imu.vibration.gyro.rms[axis], 0.05 / std::sqrt(2.0), 0.003);
+  }
+  EXPECT_NEAR(f.imu.vibration.accel.peak_frequency_hz, 37.0, 0.5);
+  EXPECT_NEAR(f.imu.vibration.gyro.peak_frequency_hz, 37.0, 0.5);
+  EXPECT_TRUE(AnyContains(f.notes, "IMU vibration above the motion's band")) << run.report;
+  EXPECT_TRUE(Contains(run.report, "(vibration, peak 37.0 Hz)")) << run.report;
+  // The drift: LiDAR stamps against the record times (the IMU's clock).
+  ASSERT_TRUE(f.clock.rate_measured);
+  EXPECT_NEAR(f.clock.lidar_rate_vs_imu_ppm, 100.0, 2.0);
+  EXPECT_LT(f.clock.lidar_rate_vs_imu_sigma_ppm, 2.0);
+  EXPECT_NEAR(f.clock.time_offset_drift_s, 100e-6 * f.clock.overlap_s, 1e-5);
+  EXPECT_TRUE(AnyContains(f.notes, "ppm against the IMU's")) << run.report;
+  // The dropped scans are gaps: one per missing run of scans.
+  const int dropped = static_cast<int>(std::lround(10.0 * kDurationS)) - sim.truth().scans_size();
+  ASSERT_GT(dropped, 0);
+  EXPECT_GT(f.lidar.stamps.num_gaps, 0);
+  EXPECT_NEAR(static_cast<double>(f.lidar.stamps.num_missing), dropped, 1.0);
+  EXPECT_TRUE(AnyContains(f.notes, "scan(s) dropped")) << run.report;
 }
 
 TEST(CheckBag, ImuInGAndDegreesPerSecondIsDetectedAndWillBeConverted) {

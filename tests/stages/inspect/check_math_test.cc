@@ -2,6 +2,7 @@
 // changes, excitation, scan geometry and the params rules.
 #include <cmath>
 #include <cstring>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -10,6 +11,7 @@
 #include "bag/ros1/message_encoding.h"
 #include "bag/ros1/messages.h"
 #include "stages/inspect/check.h"
+#include "stages/inspect/clock_rate.h"
 #include "stages/inspect/default_params_text.h"
 #include "stages/inspect/excitation.h"
 #include "stages/inspect/point_cloud_sample.h"
@@ -19,6 +21,46 @@
 
 namespace tiltcal::inspect {
 namespace {
+
+// 60 s of 10 Hz messages received with a delay of 2 ms plus an exponential
+// queueing delay (mean 3 ms) on a recorder whose clock the stamps run
+// `ppm` fast against.
+void DriftingStamps(double ppm, std::vector<int64_t>* stamps, std::vector<int64_t>* records) {
+  std::mt19937 rng(3);
+  std::exponential_distribution<double> queueing(1.0 / 0.003);
+  for (int i = 0; i < 600; ++i) {
+    const double t = 0.1 * i;
+    const double delay = 0.002 + queueing(rng);
+    stamps->push_back(1'000'000'000'000LL + std::llround(1e9 * t * (1.0 + ppm * 1e-6)));
+    records->push_back(1'000'000'000'000LL + std::llround(1e9 * (t + delay)));
+  }
+}
+
+TEST(ClockRate, SlopeOfStampMinusRecordInPpm) {
+  for (const double ppm : {0.0, 50.0, -120.0}) {
+    std::vector<int64_t> stamps, records;
+    DriftingStamps(ppm, &stamps, &records);
+    const ClockRate r = EstimateClockRate(stamps, records, 5.0);
+    ASSERT_TRUE(r.measured);
+    EXPECT_FALSE(r.stamps_are_record);
+    EXPECT_EQ(r.windows, 12);
+    // The queueing delay's medians scatter by about 0.3 ms per window:
+    // sigma ~ 0.3e-3 / sqrt(sum (t - mean)^2) ~ 5 ppm.
+    EXPECT_NEAR(r.rate_ppm, ppm, 3.0 * r.sigma_ppm + 1.0) << ppm;
+    EXPECT_LT(r.sigma_ppm, 10.0);
+  }
+}
+
+TEST(ClockRate, StampsThatAreTheRecordTimesAndTooFewWindows) {
+  std::vector<int64_t> stamps;
+  for (int i = 0; i < 100; ++i) stamps.push_back(1'000'000'000LL * i);
+  const ClockRate same = EstimateClockRate(stamps, stamps, 5.0);
+  EXPECT_TRUE(same.stamps_are_record);
+  EXPECT_TRUE(same.measured);
+  EXPECT_EQ(same.rate_ppm, 0.0);
+  const ClockRate short_one = EstimateClockRate(stamps, stamps, 50.0);  // 2 windows
+  EXPECT_FALSE(short_one.measured);
+}
 
 TEST(StampStatistics, RateJitterGapsDuplicatesAndBackwards) {
   // 100 Hz with a 50 ms hole after 1.00 s, one repeated and one backward stamp.
