@@ -6,10 +6,28 @@
 namespace tiltcal::imu {
 namespace {
 
-// A sample interval longer than this many median intervals is a gap.
-constexpr double kGapFactor = 1.5;
-
 using Vector6d = Eigen::Matrix<double, 6, 1>;
+
+// Gyro (0..2) and accelerometer (3..5) of one reading.
+Vector6d Stack(const ImuReading& r) {
+  Vector6d v;
+  v << r.angular_velocity_radps, r.linear_acceleration_mps2;
+  return v;
+}
+
+ImuReading FromStack(double time_s, const Vector6d& v) {
+  ImuReading r;
+  r.time_s = time_s;
+  r.angular_velocity_radps = v.head<3>();
+  r.linear_acceleration_mps2 = v.tail<3>();
+  return r;
+}
+
+// One high-passed grid sample and its index on the grid.
+struct HighPassed {
+  size_t index;
+  Vector6d value;
+};
 
 double MedianInterval(const std::vector<ImuReading>& r) {
   std::vector<double> d;
@@ -19,73 +37,85 @@ double MedianInterval(const std::vector<ImuReading>& r) {
   return d[d.size() / 2];
 }
 
-// Gyro (0..2) and accelerometer (3..5) of one reading.
-Vector6d Stack(const ImuReading& r) {
-  Vector6d v;
-  v << r.angular_velocity_radps, r.linear_acceleration_mps2;
-  return v;
+}  // namespace
+
+ImuGrid ResampleImu(const std::vector<ImuReading>& r, double max_gap_s) {
+  ImuGrid grid;
+  if (r.size() < 2) return grid;
+  const double dt = MedianInterval(r);
+  if (!(dt > 0.0)) return grid;
+  grid.start_s = r.front().time_s;
+  grid.interval_s = dt;
+  const auto n = static_cast<size_t>(std::floor((r.back().time_s - r.front().time_s) / dt)) + 1;
+  grid.samples.resize(n);
+  size_t j = 0;  // r[j] <= t < r[j + 1]
+  for (size_t k = 0; k < n; ++k) {
+    const double t = grid.start_s + static_cast<double>(k) * dt;
+    while (j + 2 < r.size() && r[j + 1].time_s <= t) ++j;
+    const ImuReading& a = r[j];
+    const ImuReading& b = r[j + 1];
+    const double span = b.time_s - a.time_s;
+    if (span > max_gap_s || t < a.time_s || t > b.time_s) continue;
+    const double u = (t - a.time_s) / span;
+    grid.samples[k] = FromStack(t, (1.0 - u) * Stack(a) + u * Stack(b));
+  }
+  return grid;
 }
 
-// One high-passed sample and its index in the readings.
-struct HighPassed {
-  size_t index;
-  Vector6d value;
-};
-
-// The low-pass: a windowed sinc of cut-off fc over ±half samples,
-//   h_k = 2 fc dt sinc(2 fc k dt) w_k,  w_k Blackman over the span,
-// normalised to sum 1 (unit gain at 0 Hz).
-std::vector<double> LowPassKernel(double cutoff_hz, double dt, int half) {
-  std::vector<double> h(static_cast<size_t>(2 * half + 1));
+ImuGrid LowPassImu(const ImuGrid& grid, double cutoff_hz, double span_s) {
+  ImuGrid out = grid;
+  std::fill(out.samples.begin(), out.samples.end(), std::nullopt);
+  if (!(grid.interval_s > 0.0) || !(cutoff_hz > 0.0) || !(span_s > 0.0)) return out;
+  const int half = std::max(1, static_cast<int>(std::floor(0.5 * span_s / grid.interval_s)));
+  std::vector<double> taps(static_cast<size_t>(2 * half + 1));
   double sum = 0.0;
   for (int k = -half; k <= half; ++k) {
-    const double x = 2.0 * cutoff_hz * dt * k;
+    const double tau = k * grid.interval_s;
+    const double x = 2.0 * cutoff_hz * tau;
     const double sinc = k == 0 ? 1.0 : std::sin(M_PI * x) / (M_PI * x);
-    const double u = static_cast<double>(k + half) / (2.0 * half);
-    const double blackman = 0.42 - 0.5 * std::cos(2.0 * M_PI * u) + 0.08 * std::cos(4.0 * M_PI * u);
-    h[static_cast<size_t>(k + half)] = sinc * blackman;
-    sum += sinc * blackman;
+    const double u = 2.0 * M_PI * tau / span_s;
+    taps[static_cast<size_t>(k + half)] = sinc * (0.42 + 0.5 * std::cos(u) + 0.08 * std::cos(2.0 * u));
+    sum += taps[static_cast<size_t>(k + half)];
   }
-  for (double& v : h) v /= sum;
-  return h;
-}
-
-// Each reading minus its low-pass, where the readings i - half .. i + half
-// exist and hold no gap (an interval above max_interval_s).
-std::vector<HighPassed> HighPass(const std::vector<ImuReading>& r, const VibrationOptions& o,
-                                 double dt) {
-  const int half = std::max(1, static_cast<int>(std::lround(0.5 * o.filter_span_s / dt)));
-  const std::vector<double> h = LowPassKernel(o.cutoff_hz, dt, half);
-  // gaps_before[i]: gaps among the intervals ending at readings 1 .. i.
-  std::vector<int> gaps_before(r.size(), 0);
-  for (size_t i = 1; i < r.size(); ++i) {
-    gaps_before[i] = gaps_before[i - 1] + (r[i].time_s - r[i - 1].time_s > kGapFactor * dt ? 1 : 0);
-  }
-  std::vector<HighPassed> out;
-  const auto n = static_cast<long>(r.size());
-  for (long i = half; i + half < n; ++i) {
-    if (gaps_before[static_cast<size_t>(i + half)] != gaps_before[static_cast<size_t>(i - half)]) continue;
+  for (double& t : taps) t /= sum;
+  // missing_before[k]: grid samples without a value among 0 .. k - 1.
+  const size_t n = grid.samples.size();
+  std::vector<size_t> missing_before(n + 1, 0);
+  for (size_t k = 0; k < n; ++k) missing_before[k + 1] = missing_before[k] + (grid.samples[k] ? 0 : 1);
+  const auto h = static_cast<size_t>(half);
+  for (size_t k = h; k + h < n; ++k) {
+    if (missing_before[k + h + 1] != missing_before[k - h]) continue;
     Vector6d low = Vector6d::Zero();
-    for (int k = -half; k <= half; ++k) {
-      low += h[static_cast<size_t>(k + half)] * Stack(r[static_cast<size_t>(i + k)]);
-    }
-    out.push_back({static_cast<size_t>(i), Stack(r[static_cast<size_t>(i)]) - low});
+    for (size_t m = 0; m < taps.size(); ++m) low += taps[m] * Stack(*grid.samples[k - h + m]);
+    out.samples[k] = FromStack(grid.samples[k]->time_s, low);
   }
   return out;
 }
 
-}  // namespace
+std::vector<ImuReading> LowPassAndDecimateImu(const std::vector<ImuReading>& readings,
+                                              const LowPassOptions& options, int step) {
+  const ImuGrid low =
+      LowPassImu(ResampleImu(readings, options.max_gap_s), options.cutoff_hz, options.span_s);
+  std::vector<ImuReading> out;
+  const auto s = static_cast<size_t>(std::max(step, 1));
+  for (size_t k = 0; k < low.samples.size(); k += s) {
+    if (low.samples[k]) out.push_back(*low.samples[k]);
+  }
+  return out;
+}
 
 ImuVibration MeasureImuVibration(const std::vector<ImuReading>& readings,
                                  const VibrationOptions& options) {
   ImuVibration out;
-  if (readings.size() < 8 || !(options.cutoff_hz > 0.0) || !(options.filter_span_s > 0.0)) {
-    return out;
-  }
-  const double dt = MedianInterval(readings);
-  if (!(dt > 0.0)) return out;
+  const ImuGrid grid = ResampleImu(readings, options.low_pass.max_gap_s);
+  if (!(grid.interval_s > 0.0)) return out;
+  const double dt = grid.interval_s;
   out.sample_rate_hz = 1.0 / dt;
-  const std::vector<HighPassed> hp = HighPass(readings, options, dt);
+  const ImuGrid low = LowPassImu(grid, options.low_pass.cutoff_hz, options.low_pass.span_s);
+  std::vector<HighPassed> hp;
+  for (size_t k = 0; k < grid.samples.size(); ++k) {
+    if (low.samples[k]) hp.push_back({k, Stack(*grid.samples[k]) - Stack(*low.samples[k])});
+  }
   out.num_samples = static_cast<int>(hp.size());
   if (hp.empty()) return out;
   Vector6d sum2 = Vector6d::Zero();
@@ -94,15 +124,13 @@ ImuVibration MeasureImuVibration(const std::vector<ImuReading>& readings,
   out.gyro.rms = rms.head<3>();
   out.accel.rms = rms.tail<3>();
 
-  // Segments of consecutive high-passed samples (consecutive readings, no gap).
+  // Segments of length consecutive high-passed grid samples.
   const int length = static_cast<int>(std::lround(options.spectrum_segment_s / dt));
   if (length < 8) return out;
   std::vector<size_t> starts;
   for (size_t s = 0; s + static_cast<size_t>(length) <= hp.size();) {
     const size_t e = s + static_cast<size_t>(length) - 1;
-    if (hp[e].index - hp[s].index == static_cast<size_t>(length) - 1 &&
-        readings[hp[e].index].time_s - readings[hp[s].index].time_s <=
-            kGapFactor * dt * (length - 1)) {
+    if (hp[e].index - hp[s].index == static_cast<size_t>(length) - 1) {
       starts.push_back(s);
       s += static_cast<size_t>(length);
     } else {
@@ -110,46 +138,48 @@ ImuVibration MeasureImuVibration(const std::vector<ImuReading>& readings,
     }
   }
   if (starts.empty()) return out;
-  const size_t keep = std::min(starts.size(), static_cast<size_t>(std::max(1, options.max_segments)));
-  std::vector<size_t> chosen;
-  for (size_t k = 0; k < keep; ++k) chosen.push_back(starts[k * starts.size() / keep]);
-  out.num_segments = static_cast<int>(chosen.size());
+  const size_t keep =
+      std::min(starts.size(), static_cast<size_t>(std::max(1, options.max_segments)));
+  out.num_segments = static_cast<int>(keep);
 
   // Hann window and the DFT's twiddles, bins 1 .. length / 2.
-  std::vector<double> hann(static_cast<size_t>(length)), cosine(static_cast<size_t>(length)),
-      sine(static_cast<size_t>(length));
-  for (int n = 0; n < length; ++n) {
-    hann[static_cast<size_t>(n)] = 0.5 - 0.5 * std::cos(2.0 * M_PI * n / length);
-    cosine[static_cast<size_t>(n)] = std::cos(2.0 * M_PI * n / length);
-    sine[static_cast<size_t>(n)] = std::sin(2.0 * M_PI * n / length);
+  const auto n_len = static_cast<size_t>(length);
+  std::vector<double> hann(n_len), cosine(n_len), sine(n_len);
+  for (size_t n = 0; n < n_len; ++n) {
+    const double a = 2.0 * M_PI * static_cast<double>(n) / length;
+    hann[n] = 0.5 - 0.5 * std::cos(a);
+    cosine[n] = std::cos(a);
+    sine[n] = std::sin(a);
   }
-  const int bins = length / 2;
-  std::vector<double> gyro_power(static_cast<size_t>(bins) + 1, 0.0),
-      accel_power(static_cast<size_t>(bins) + 1, 0.0);
-  for (size_t s : chosen) {
-    for (int k = 1; k <= bins; ++k) {
-      Vector6d re = Vector6d::Zero();
-      Vector6d im = Vector6d::Zero();
-      for (int n = 0; n < length; ++n) {
-        const auto phase = static_cast<size_t>((static_cast<long>(k) * n) % length);
-        const Vector6d x = hann[static_cast<size_t>(n)] * hp[s + static_cast<size_t>(n)].value;
+  const size_t bins = n_len / 2;
+  std::vector<double> gyro_power(bins + 1, 0.0), accel_power(bins + 1, 0.0);
+  for (size_t k_seg = 0; k_seg < keep; ++k_seg) {
+    const size_t s = starts[k_seg * starts.size() / keep];
+    for (size_t k = 1; k <= bins; ++k) {
+      Vector6d re = Vector6d::Zero(), im = Vector6d::Zero();
+      for (size_t n = 0; n < n_len; ++n) {
+        const size_t phase = (k * n) % n_len;
+        const Vector6d x = hann[n] * hp[s + n].value;
         re += cosine[phase] * x;
         im -= sine[phase] * x;
       }
       const Vector6d p = re.cwiseAbs2() + im.cwiseAbs2();
-      gyro_power[static_cast<size_t>(k)] += p.head<3>().sum();
-      accel_power[static_cast<size_t>(k)] += p.tail<3>().sum();
+      gyro_power[k] += p.head<3>().sum();
+      accel_power[k] += p.tail<3>().sum();
     }
   }
   // The strongest bin above the cut-off.
   const double bin_hz = 1.0 / (length * dt);
-  const int first = std::max(1, static_cast<int>(std::ceil(options.cutoff_hz / bin_hz)));
-  for (auto [power, triad] : {std::pair{&gyro_power, &out.gyro}, std::pair{&accel_power, &out.accel}}) {
-    int best = first;
-    for (int k = first; k <= bins; ++k) {
-      if ((*power)[static_cast<size_t>(k)] > (*power)[static_cast<size_t>(best)]) best = k;
+  const auto first =
+      std::max<size_t>(1, static_cast<size_t>(std::ceil(options.low_pass.cutoff_hz / bin_hz)));
+  for (auto [power, triad] :
+       {std::pair{&gyro_power, &out.gyro}, std::pair{&accel_power, &out.accel}}) {
+    if (first > bins) break;
+    size_t best = first;
+    for (size_t k = first; k <= bins; ++k) {
+      if ((*power)[k] > (*power)[best]) best = k;
     }
-    triad->peak_frequency_hz = best <= bins ? best * bin_hz : 0.0;
+    triad->peak_frequency_hz = static_cast<double>(best) * bin_hz;
   }
   return out;
 }

@@ -102,8 +102,9 @@ void AnalyseImu(const BagSurvey& survey, const proto::CheckParams& params, Check
   imu.excitation =
       MeasureImuExcitation(readings, gyro_bias, imu.specific_force_at_rest_mps2, excitation);
   imu::VibrationOptions vibration;
-  vibration.cutoff_hz = params.imu().vibration_cutoff_hz();
-  vibration.filter_span_s = params.imu().vibration_filter_span_s();
+  vibration.low_pass.cutoff_hz = params.imu().vibration_cutoff_hz();
+  vibration.low_pass.span_s = params.imu().vibration_filter_span_s();
+  vibration.low_pass.max_gap_s = params.imu().vibration_max_gap_s();
   vibration.spectrum_segment_s = params.imu().vibration_spectrum_segment_s();
   vibration.max_segments = static_cast<int>(params.imu().vibration_max_segments());
   imu.vibration = imu::MeasureImuVibration(readings, vibration);
