@@ -1,43 +1,64 @@
 #!/usr/bin/env bash
-# A consumer-grade IMU, measured: the demo's 40 s Husky-like sequence (IMU
+# The IMUs users have, measured: the demo's 40 s Husky-like sequence (IMU
 # upside down), flat and tilted (8 deg pitch, 3 deg roll, g_f from the flat
-# sequence of the same seed), with gyroscope and accelerometer scale errors
-# drawn up to SCALE ppm and axis misalignments up to MIS deg per seed
-# (SimTriadErrors), calibrated by `make -f Makefile.pipeline` as one-bag
-# datasets with the simulator's rig, once with imu_intrinsics.mode AUTO (the
-# default params) and once with OFF.
+# sequence of the same seed), with one fault per run:
+#   consumer        gyroscope and accelerometer scale errors drawn up to
+#                   SCALE ppm and axis misalignments up to MIS deg per seed
+#                   (SimTriadErrors); compared: imu_intrinsics AUTO / OFF
+#   vibration       engine vibration while moving (SimImuVibration,
+#                   WHILE_MOVING) of HZ, ACCEL m/s^2 and GYRO rad/s per axis;
+#                   compared: imu_vibration AUTO / OFF
+#   idle_vibration  the same, also during the static start (ALWAYS)
+# Each sequence is calibrated by `make -f Makefile.pipeline` as a one-bag
+# dataset with the simulator's rig, once with the defaults (AUTO) and once
+# with the fault's params block OFF.
 # Prints one row per seed, ground and mode: exit code, verdict, rotation
 # (deg), translation per axis (mm) and tau (ms) errors against the truth,
 # whether the intrinsics were estimated, the score, the gyro z scale and
-# the accelerometer's x/y scales found against the truth's (ppm), seconds of
-# make.
+# the accelerometer's x/y scales found against the truth's (ppm), whether
+# the IMU was low-pass filtered (and thinned by m), seconds of make.
 #   bench/calibrate/run_imu_faults_bench.sh [--build_dir=DIR] [--scratch=DIR]
-#       [--seeds=101,102,103] [--scale_ppm=10000] [--misalignment_deg=0.5]
+#       [--seeds=101,102,103] [--fault=consumer] [--scale_ppm=10000]
+#       [--misalignment_deg=0.5] [--vibration_hz=37] [--vibration_accel=1.5]
+#       [--vibration_gyro=0.05]
 set -euo pipefail
 SRC=$(cd "$(dirname "$0")/../.." && pwd)
 BUILD=$SRC/build
 SCRATCH=""
 SEEDS=101,102,103
+FAULT=consumer
 SCALE=10000
 MIS=0.5
+HZ=37
+ACCEL=1.5
+GYRO=0.05
 for arg in "$@"; do
   case "$arg" in
     --build_dir=*) BUILD=${arg#*=} ;;
     --scratch=*) SCRATCH=${arg#*=} ;;
     --seeds=*) SEEDS=${arg#*=} ;;
+    --fault=*) FAULT=${arg#*=} ;;
     --scale_ppm=*) SCALE=${arg#*=} ;;
     --misalignment_deg=*) MIS=${arg#*=} ;;
-    --help) sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --vibration_hz=*) HZ=${arg#*=} ;;
+    --vibration_accel=*) ACCEL=${arg#*=} ;;
+    --vibration_gyro=*) GYRO=${arg#*=} ;;
+    --help) sed -n '2,24p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "unknown argument $arg (see --help)" >&2; exit 2 ;;
   esac
 done
+case "$FAULT" in
+  consumer) BLOCK=imu_intrinsics ;;
+  vibration|idle_vibration) BLOCK=imu_vibration ;;
+  *) echo "unknown fault $FAULT (see --help)" >&2; exit 2 ;;
+esac
 BIN=$(cd "$BUILD" && pwd)/bin
 [ -x "$BIN/tiltcal_calibrate" ] || { echo "no $BIN/tiltcal_calibrate: build first" >&2; exit 1; }
 if [ -z "$SCRATCH" ]; then SCRATCH=$(mktemp -d); trap 'rm -rf "$SCRATCH"' EXIT; fi
 mkdir -p "$SCRATCH"
 PY=/usr/bin/python3
 
-# scenario KIND SEED: the demo's Husky scenario with a consumer IMU.
+# scenario KIND SEED: the demo's Husky scenario with the fault.
 scenario() {
   local kind=$1 seed=$2 pitch=0 roll=0
   [ "$kind" = tilted ] && { pitch=8; roll=3; }
@@ -46,8 +67,16 @@ scenario() {
     -e "s/^ground_roll_deg: .*/ground_roll_deg: $roll/" \
     "$SRC/stages/simulate/scenarios/tilted_husky_vlp16.txtpb"
   echo "faults {"
-  echo "  gyro_intrinsics { scale_max_ppm: $SCALE misalignment_max_deg: $MIS }"
-  echo "  accel_intrinsics { scale_max_ppm: $SCALE misalignment_max_deg: $MIS }"
+  case "$FAULT" in
+    consumer)
+      echo "  gyro_intrinsics { scale_max_ppm: $SCALE misalignment_max_deg: $MIS }"
+      echo "  accel_intrinsics { scale_max_ppm: $SCALE misalignment_max_deg: $MIS }" ;;
+    vibration|idle_vibration)
+      local when=WHILE_MOVING
+      [ "$FAULT" = idle_vibration ] && when=ALWAYS
+      echo "  imu_vibration { frequency_hz: $HZ accel_amplitude_mps2: $ACCEL"
+      echo "    gyro_amplitude_radps: $GYRO when: $when }" ;;
+  esac
   echo "}"
 }
 
@@ -81,9 +110,11 @@ def scale(d, triad, axis):
 gz = scale(k, 'gyro', 'z'); tgz = scale(truth, 'gyro_intrinsics', 'z')
 ax = scale(k, 'accel', 'x'); tax = scale(truth, 'accel_intrinsics', 'x')
 ay = scale(k, 'accel', 'y'); tay = scale(truth, 'accel_intrinsics', 'y')
-print('%.3f  %6.1f %6.1f %6.1f  %6.2f  %-3s %8.0f  %6.0f/%6.0f  %6.0f/%6.0f  %6.0f/%6.0f' % (
+v = first(cal, 'imu_vibration') or {}
+filtered = 'm=%d' % int(float(first(v, 'decimation'))) if first(v, 'filtered') == 'true' else 'no'
+print('%.3f  %6.1f %6.1f %6.1f  %6.2f  %-3s %8.0f  %6.0f/%6.0f  %6.0f/%6.0f  %6.0f/%6.0f  %-4s' % (
     rot, *[(a - b) * 1e3 for a, b in zip(r1, r2)], tau, 'yes' if est else 'no', score,
-    gz, tgz, ax, tax, ay, tay))
+    gz, tgz, ax, tax, ay, tay, filtered))
 PYEOF
 }
 
@@ -95,8 +126,8 @@ run() {
   cp "$SCRATCH/$bag.bag" "$d/seq.bag"
   sed '/^gravity_reference:/d' "$SCRATCH/$bag.rig.txtpb" > "$d/rig.txtpb"
   [ -n "$ref" ] && echo "gravity_reference: \"$ref\"" >> "$d/rig.txtpb"
-  sed "s/^  mode: AUTO$/  mode: $mode/" "$SRC/stages/calibrate/default_params.txtpb" \
-    > "$d/params/calibrate.txtpb"
+  sed -E "/^$BLOCK \{/,/^\}/ s/^  mode: AUTO$/  mode: $mode/" \
+    "$SRC/stages/calibrate/default_params.txtpb" > "$d/params/calibrate.txtpb"
   local start=$SECONDS rc=0
   make -s -f "$SRC/Makefile.pipeline" DATASET="$d" BIN="$BIN" > "$d/make.log" 2>&1 || rc=$?
   local cal=$d/out/seq/calibration.txtpb
@@ -112,7 +143,8 @@ run() {
 }
 
 export SRC
-echo "seed  ground  mode  exit  verdict  rot_deg  dx_mm  dy_mm  dz_mm  tau_ms  est  score  gyro_z/truth  acc_x/truth  acc_y/truth  make"
+echo "fault $FAULT; mode: $BLOCK.mode"
+echo "seed  ground  mode  exit  verdict  rot_deg  dx_mm  dy_mm  dz_mm  tau_ms  est  score  gyro_z/truth  acc_x/truth  acc_y/truth  filtered  make"
 for seed in ${SEEDS//,/ }; do
   for kind in flat tilted; do
     scenario $kind "$seed" > "$SCRATCH/$kind.$seed.scenario.txtpb"

@@ -22,6 +22,7 @@
 #include "stages/calibrate/covariance_report.h"
 #include "stages/calibrate/ground_residuals.h"
 #include "stages/calibrate/imu_intrinsics.h"
+#include "stages/calibrate/imu_vibration.h"
 #include "stages/calibrate/initialisation.h"
 #include "stages/calibrate/lidar_association.h"
 #include "stages/calibrate/map_export.h"
@@ -565,7 +566,7 @@ void FillVerdictFacts(const CalibrateInputs& inputs, const proto::CalibrateParam
         180.0 / M_PI);
   }
   result->set_static_start(init.imu.from_static_start);
-  result->set_static_samples(init.imu.num_samples_averaged);
+  result->set_static_samples(init.imu.num_samples_averaged * inputs.imu_decimation);
   FillStartingExtrinsicNotes(inputs.rig, state, result);
   AddTiming("verdict_facts", Seconds(start), result);
   AddTiming("map_sharpness", sharpness.seconds, result);
@@ -700,6 +701,13 @@ Status Run(const CalibratePaths& paths, const proto::CalibrateParams& params, st
   CalibrationState final_state(
       spline::UniformKnotGrid::ForDuration(0.0, 1.0, params.spline().knot_spacing_s()));
   proto::CalibrateParams used = params;
+  proto::ImuVibrationReport vibration;
+  TILTCAL_RETURN_IF_ERROR(HandleImuVibration(params.imu_vibration(), &inputs.imu,
+                                             used.mutable_imu_noise(), &vibration)
+                              .WithContext(paths.imu));
+  inputs.imu_decimation = vibration.decimation();
+  const std::string vibration_note = DescribeImuVibration(vibration);
+  if (!vibration_note.empty()) Log(log, vibration_note);
   if (inputs.rig.has_starting_extrinsic() &&
       !inputs.rig.starting_extrinsic().translation_known()) {
     used.set_extrinsic_translation_prior_sigma_m(params.unknown_translation_prior_sigma_m());
@@ -707,6 +715,8 @@ Status Run(const CalibratePaths& paths, const proto::CalibrateParams& params, st
                          params.unknown_translation_prior_sigma_m()));
   }
   TILTCAL_RETURN_IF_ERROR(Calibrate(inputs, used, &result, &final_state, log));
+  *result.mutable_imu_vibration() = vibration;
+  if (!vibration_note.empty()) result.add_verdict_notes(vibration_note);
   TILTCAL_RETURN_IF_ERROR(WriteMaps(paths, params, inputs, final_state, log));
   proto::PhaseTiming* t = result.add_timings();
   t->set_phase("read_inputs");

@@ -61,6 +61,9 @@ struct CalibrateInputs {
   bool has_gravity = false;
   proto::GravityReference gravity;
   proto::Rig rig;
+  // The IMU readings were thinned to every imu_decimation-th sample
+  // (imu_vibration.h); 1 when not.
+  int imu_decimation = 1;
 };
 
 // Reads and checks the inputs (errors name the file and record).

@@ -97,6 +97,14 @@ Status ValidateVerdictParams(const proto::VerdictParams& params) {
   return MustBePositive(params.large_translation_m(), "verdict.large_translation_m");
 }
 
+Status ValidateImuVibrationParams(const proto::ImuVibrationParams& params) {
+  if (params.cutoff_hz() * params.filter_span_s() < 1.0) {
+    return Status::Error(
+        "imu_vibration.filter_span_s must hold at least one period of imu_vibration.cutoff_hz");
+  }
+  return Status::Ok();
+}
+
 Status ValidateCalibrateParams(const proto::CalibrateParams& params) {
   TILTCAL_RETURN_IF_ERROR(ValidateImuNoiseParams(params.imu_noise()));
   TILTCAL_RETURN_IF_ERROR(ValidateLidarScanParams(params.scans()));
@@ -106,6 +114,7 @@ Status ValidateCalibrateParams(const proto::CalibrateParams& params) {
   TILTCAL_RETURN_IF_ERROR(ValidateSurfelMapParams(params.map(), "map"));
   TILTCAL_RETURN_IF_ERROR(ValidateAssociationParams(params.association()));
   TILTCAL_RETURN_IF_ERROR(ValidateGroundResidualsParams(params.ground()));
+  TILTCAL_RETURN_IF_ERROR(ValidateImuVibrationParams(params.imu_vibration()));
   return ValidateVerdictParams(params.verdict());
 }
 

@@ -27,6 +27,7 @@ Status ValidateLidarOdometryParams(const proto::LidarOdometryParams& params);
 Status ValidateAssociationParams(const proto::AssociationParams& params);
 Status ValidateGroundResidualsParams(const proto::GroundResidualsParams& params);
 Status ValidateVerdictParams(const proto::VerdictParams& params);
+Status ValidateImuVibrationParams(const proto::ImuVibrationParams& params);
 
 Status ValidateCalibrateParams(const proto::CalibrateParams& params);
 

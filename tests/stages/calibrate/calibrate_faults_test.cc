@@ -22,6 +22,7 @@
 #include "tiltcal/proto/simulate_params.pb.h"
 #include "stages/calibrate/rotation_from_motion.h"
 #include "tests/stages/calibrate/short_sequence_fixture.h"
+#include "tests/stages/calibrate/simulated_calibration.h"
 
 namespace tiltcal::calibrate {
 namespace {
@@ -134,23 +135,10 @@ TEST_F(CalibrateFaultsTest, ShortRecordingWithARightRigIsRefusedForItsMotion) {
                             &scenario)
                   .ok());
   scenario.set_duration_s(5.0);
-  const std::string scenario_path = dir_->File("short_5s.txtpb");
-  ASSERT_TRUE(WriteTextProto(scenario_path, scenario).ok());
-  const std::string bag = dir_->File("short_5s.bag"), rig = dir_->File("short_5s_rig.txtpb");
-  const std::string imu = dir_->File("short_5s_imu.binpb");
-  const std::string scans = dir_->File("short_5s_scans.binpb.lz4");
+  SimulatedInputs sim;
+  ASSERT_NO_FATAL_FAILURE(SimulateAndDecode(scenario, *dir_, "short_5s", &sim));
+  const std::string rig = sim.rig, imu = sim.imu, scans = sim.scans;
   std::string output;
-  ASSERT_EQ(testing::RunCommand(testing::ToolPath("tiltcal_simulate") + " --quiet --params=" +
-                                    scenario_path + " --out_bag=" + bag + " --out_truth=" +
-                                    dir_->File("short_5s_truth.txtpb") + " --out_rig=" + rig,
-                                &output),
-            0)
-      << output;
-  ASSERT_EQ(testing::RunCommand(testing::ToolPath("tiltcal_decode") + " --bag=" + bag + " --rig=" +
-                                    rig + " --out_imu=" + imu + " --out_scans=" + scans,
-                                &output),
-            0)
-      << output;
   const std::string params = dir_->File("short_5s_params.txtpb");
   ASSERT_TRUE(WriteTextProto(params, LidarImuParams()).ok());
   const std::string out = dir_->File("short_5s_calibration.txtpb");
@@ -241,110 +229,6 @@ TEST_F(CalibrateFaultsTest, AccelerometerSampleOf1e300ExitsWithOneLineAndNoResul
   ASSERT_FALSE(output.empty());
   EXPECT_EQ(output.find('\n'), output.size() - 1) << "more than one line:\n" << output;
   EXPECT_FALSE(testing::FileExists(out));
-}
-
-// A consumer-grade IMU (gyroscope and accelerometer scale errors of 0.3 to
-// 0.5 %, axes 0.2 to 0.3 deg off), simulated into the short sequence's bag,
-// through the executables: with the default imu_intrinsics.mode AUTO the
-// score test finds the errors, they are estimated and the extrinsic and tau
-// are right within their sigmas (exit 0); with OFF the same bag gives
-// SUSPECT (exit 3) naming the IMU's errors, never an OK with the errors
-// absorbed. (40 s sequences with ground residuals, several seeds:
-// bench/calibrate/run_imu_faults_bench.sh.)
-TEST_F(CalibrateFaultsTest, ConsumerImuIsEstimatedWithAutoAndSuspectWithOff) {
-  proto::SimulateParams scenario;
-  ASSERT_TRUE(ReadTextProto(testing::SourceDir() + "/tests/stages/calibrate/short_flat_vlp16.txtpb",
-                            &scenario)
-                  .ok());
-  ASSERT_TRUE(ParseTextProto(R"pb(
-    gyro_intrinsics {
-      scale_ppm { x: 4000 y: -3000 z: 5000 }
-      misalignment_deg { x: 0.3 y: -0.2 z: 0.25 }
-    }
-    accel_intrinsics {
-      scale_ppm { x: -5000 y: 4000 z: 3000 }
-      misalignment_deg { x: -0.3 y: 0.2 z: -0.2 }
-    })pb",
-                             "consumer faults", scenario.mutable_faults())
-                  .ok());
-  const std::string scenario_path = dir_->File("consumer.txtpb");
-  ASSERT_TRUE(WriteTextProto(scenario_path, scenario).ok());
-  const std::string bag = dir_->File("consumer.bag"), rig = dir_->File("consumer_rig.txtpb");
-  const std::string truth_path = dir_->File("consumer_truth.txtpb");
-  const std::string imu = dir_->File("consumer_imu.binpb");
-  const std::string scans = dir_->File("consumer_scans.binpb.lz4");
-  std::string output;
-  ASSERT_EQ(testing::RunCommand(testing::ToolPath("tiltcal_simulate") + " --quiet --params=" +
-                                    scenario_path + " --out_bag=" + bag + " --out_truth=" +
-                                    truth_path + " --out_rig=" + rig,
-                                &output),
-            0)
-      << output;
-  ASSERT_EQ(testing::RunCommand(testing::ToolPath("tiltcal_decode") + " --bag=" + bag + " --rig=" +
-                                    rig + " --out_imu=" + imu + " --out_scans=" + scans,
-                                &output),
-            0)
-      << output;
-  proto::SimulationTruth truth;
-  ASSERT_TRUE(ReadTextProto(truth_path, &truth).ok());
-  for (const auto mode : {proto::ImuIntrinsicsParams::AUTO, proto::ImuIntrinsicsParams::OFF}) {
-    const std::string name = proto::ImuIntrinsicsParams::Mode_Name(mode);
-    proto::CalibrateParams params = LidarImuParams();
-    params.mutable_imu_intrinsics()->set_mode(mode);
-    const std::string params_path = dir_->File("consumer_params_" + name + ".txtpb");
-    ASSERT_TRUE(WriteTextProto(params_path, params).ok());
-    const std::string out = dir_->File("consumer_calibration_" + name + ".txtpb");
-    output.clear();
-    const int exit_code = testing::RunCommand(
-        testing::ToolPath("tiltcal_calibrate") + " --imu=" + imu + " --scans=" + scans +
-            " --rig=" + rig + " --params=" + params_path + " --out=" + out,
-        &output);
-    proto::CalibrationResult result;
-    ASSERT_TRUE(ReadTextProto(out, &result).ok()) << name << ": " << output;
-    const Rigid3d estimate = ToEigen(result.imu_from_lidar());
-    const Rigid3d true_extrinsic = ToEigen(truth.imu_from_lidar());
-    const double rotation_deg = RotationFromTruthDeg(estimate.rotation, truth);
-    const Eigen::Vector3d translation = estimate.translation - true_extrinsic.translation;
-    const double tau_ms = (result.time_offset_s() - truth.time_offset_s()) * 1e3;
-    const proto::ImuIntrinsicsReport& k = result.imu_intrinsics();
-    std::printf("%s: exit %d, %s, %.3f deg, (%.1f, %.1f, %.1f) mm, tau %.3f ms, score %.0f, "
-                "gyro z scale %.0f ppm (truth %.0f)\n",
-                name.c_str(), exit_code,
-                proto::CalibrationResult::Verdict_Name(result.verdict()).c_str(), rotation_deg,
-                translation.x() * 1e3, translation.y() * 1e3, translation.z() * 1e3, tau_ms,
-                k.score_chi2(), k.gyro().scale_ppm().z(),
-                truth.gyro_intrinsics().scale_ppm().z());
-    EXPECT_TRUE(k.found()) << name << ": " << output;
-    if (mode == proto::ImuIntrinsicsParams::AUTO) {
-      EXPECT_EQ(exit_code, 0) << output;
-      EXPECT_NE(result.verdict(), proto::CalibrationResult::SUSPECT) << output;
-      EXPECT_TRUE(k.estimated());
-      // 16 s of LiDAR and IMU only (no ground residuals): the errors within
-      // three of the reported sigmas (the verdict is WEAK where they are
-      // large), the in-plane lever arm within 1 cm, tau within 0.5 ms.
-      const double rotation_sigma_deg = ToEigen(result.rotation_sigma_deg()).maxCoeff();
-      EXPECT_LT(rotation_deg, 3.0 * rotation_sigma_deg) << output;
-      EXPECT_LT(rotation_deg, 0.25) << output;
-      const Eigen::Vector3d sigma_m = ToEigen(result.translation_sigma_m());
-      for (int i = 0; i < 3; ++i) {
-        EXPECT_LT(std::abs(translation[i]), 3.0 * sigma_m[i]) << i << ": " << output;
-      }
-      EXPECT_LT(translation.head<2>().cwiseAbs().maxCoeff(), 0.01) << output;
-      EXPECT_LT(std::abs(tau_ms), 0.5) << output;
-      EXPECT_NEAR(k.gyro().scale_ppm().z(), 5000.0, 3.0 * k.gyro().scale_sigma_ppm().z() + 100.0);
-      EXPECT_GT(k.gyro().scale_sigma_ppm().z(), 0.0);
-    } else {
-      EXPECT_EQ(exit_code, 3) << output;
-      EXPECT_EQ(result.verdict(), proto::CalibrationResult::SUSPECT);
-      EXPECT_FALSE(k.estimated());
-      bool named = false;
-      for (const std::string& reason : result.verdict_reasons()) {
-        named = named || reason.find("the IMU's scale and axis errors show in the residuals") !=
-                             std::string::npos;
-      }
-      EXPECT_TRUE(named) << output;
-    }
-  }
 }
 
 }  // namespace
