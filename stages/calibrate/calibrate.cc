@@ -429,7 +429,12 @@ void FillCovariance(const CalibrateInputs& inputs, const proto::CalibrateParams&
       const VarianceFactor factor = ComputeVarianceFactor(problem->problem());
       result->set_variance_factor(factor.sigma0_squared);
       result->set_redundancy(factor.redundancy);
-      if (params.observability().scale_by_variance_factor() && factor.redundancy > 0) {
+      // Low-passed IMU readings (imu_vibration.h) are not white: their
+      // residuals' RMS says nothing of their noise, so a factor below 1
+      // must not shrink the covariance on their account.
+      const bool shrink_allowed = inputs.imu_decimation == 1 || factor.sigma0_squared > 1.0;
+      if (params.observability().scale_by_variance_factor() && factor.redundancy > 0 &&
+          shrink_allowed) {
         Matrix7d prior_information = Matrix7d::Zero();
         prior_information.block<3, 3>(3, 3) = geometry::TranslationPriorInformation(
             result->translation_prior_sigma_m(), ToEigen(result->translation_prior_axis_b()));

@@ -42,7 +42,8 @@ Status HandleImuVibration(const proto::ImuVibrationParams& params,
         "imu_vibration.cutoff_hz {:g} is not below the IMU's Nyquist frequency {:g} Hz",
         params.cutoff_hz(), 0.5 * v.sample_rate_hz));
   }
-  const int m = std::max(1, static_cast<int>(std::floor(v.sample_rate_hz / (2.0 * params.cutoff_hz()))));
+  const double thinned_rate_hz = std::max(params.thinned_rate_hz(), 2.0 * params.cutoff_hz());
+  const int m = std::max(1, static_cast<int>(std::floor(v.sample_rate_hz / thinned_rate_hz)));
   std::vector<imu::ImuReading> filtered = imu::LowPassAndDecimateImu(*readings, options.low_pass, m);
   if (filtered.size() < 2) {
     return Status::Error(fmt::format(

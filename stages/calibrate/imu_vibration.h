@@ -10,12 +10,12 @@
 // The readings are measured (common/imu/vibration.h); when vibration is
 // found (AUTO) or always (ON), they are replaced by their zero-phase
 // low-pass, thinned to every m-th sample of the grid at the recorded rate
-// f_s, m = floor(f_s / (2 f_c)). The white noise of sigma per recorded sample
-// keeps sigma · sqrt(2 f_c / f_s) ≈ sigma / sqrt(m) in the band, and thinned
-// samples are about independent: the residuals' sigmas become
-// imu_noise's / sqrt(m), which keeps the information per second of the
-// motion in the band what it was (covariance and variance factor stay
-// honest), and there are m times fewer IMU residuals.
+// f_s, m = floor(f_s / max(thinned_rate_hz, 2 f_c)) (4 at 200 Hz: 50 Hz, two
+// samples per knot interval, so the spline cannot fit them exactly). The
+// residuals' sigmas become imu_noise's / sqrt(m): weighted as independent,
+// f_s / m samples per second of sigma / sqrt(m) carry the information per
+// second of in-band motion that f_s samples of white noise sigma carried,
+// and there are m times fewer IMU residuals.
 
 #include <string>
 #include <vector>

@@ -23,17 +23,26 @@ void AddVibrationNote(const proto::CheckParams& params, const ImuFindings& imu,
     return t.peak_frequency_hz > 0.0 ? fmt::format(", peak {:.1f} Hz", t.peak_frequency_hz)
                                      : std::string();
   };
+  // A peak within the low-pass's transition (about 5.5 / span above the
+  // cut-off) is not removed whole.
+  const double stop_hz = p.vibration_cutoff_hz() + 5.5 / p.vibration_filter_span_s();
+  const double lowest_peak_hz = std::min(imu.gyro_vibrates ? v.gyro.peak_frequency_hz : 1e9,
+                                         imu.accel_vibrates ? v.accel.peak_frequency_hz : 1e9);
   notes->push_back(fmt::format(
       "IMU vibration above the motion's band (as sampled at {:.0f} Hz; above {:.0f} Hz it shows "
       "aliased): accelerometer RMS up to {:.3f} m/s² ({:.0f} × the {:g} m/s² white noise the "
-      "calibration assumes{}), gyro up to {:.4f} rad/s ({:.0f} × {:g} rad/s{}). The calibration's "
-      "IMU residuals will be far above its noise model and the result SUSPECT{}: damp the IMU's "
-      "mount, or set imu_noise.accel_sigma_mps2 and gyro_sigma_radps in params/calibrate.txtpb "
-      "to about these RMS (the IMU then counts for less and the result may be WEAK)",
+      "calibration assumes{}), gyro up to {:.4f} rad/s ({:.0f} × {:g} rad/s{}). The calibration "
+      "low-passes the IMU at {:g} Hz before the fit (calibrate params imu_vibration, AUTO){}{}",
       v.sample_rate_hz, 0.5 * v.sample_rate_hz, v.accel.rms.maxCoeff(), accel_ratio,
       p.accel_noise_mps2(), peak(v.accel), v.gyro.rms.maxCoeff(), gyro_ratio,
-      p.gyro_noise_radps(), peak(v.gyro),
-      imu.static_start.found ? "" : "; it also hides the static start"));
+      p.gyro_noise_radps(), peak(v.gyro), p.vibration_cutoff_hz(),
+      lowest_peak_hz > 0.0 && lowest_peak_hz < stop_hz
+          ? fmt::format("; at {:.1f} Hz the vibration is too near that cut-off to be removed "
+                        "whole: expect IMU residuals above their model",
+                        lowest_peak_hz)
+          : std::string(),
+      imu.static_start_after_low_pass ? "; the static start shows only after that low-pass"
+                                      : ""));
 }
 
 void AddImuNotes(const proto::CheckParams& params, CheckFindings* f) {

@@ -82,8 +82,30 @@ void AnalyseImu(const BagSurvey& survey, const proto::CheckParams& params, Check
   }
   const std::vector<imu::ImuReading> published = readings;
   imu::ConvertToSi(*imu.accel.unit, imu.gyro_unit, &readings);
-  imu.static_start =
-      imu::DetectStaticStart(readings, ToStaticDetectionOptions(params.static_detection()));
+  imu::VibrationOptions vibration;
+  vibration.low_pass.cutoff_hz = params.imu().vibration_cutoff_hz();
+  vibration.low_pass.span_s = params.imu().vibration_filter_span_s();
+  vibration.low_pass.max_gap_s = params.imu().vibration_max_gap_s();
+  vibration.spectrum_segment_s = params.imu().vibration_spectrum_segment_s();
+  vibration.max_segments = static_cast<int>(params.imu().vibration_max_segments());
+  imu.vibration = imu::MeasureImuVibration(readings, vibration);
+  const proto::ImuCheckParams& p = params.imu();
+  if (imu.vibration.num_samples > 0) {
+    imu.gyro_vibrates =
+        imu.vibration.gyro.rms.maxCoeff() > p.vibration_factor() * p.gyro_noise_radps();
+    imu.accel_vibrates =
+        imu.vibration.accel.rms.maxCoeff() > p.vibration_factor() * p.accel_noise_mps2();
+  }
+  // The static start as the calibration finds it: on the low-pass when it
+  // filters (vibration of an idling engine hides it in the readings).
+  const imu::StaticDetectionOptions static_options =
+      ToStaticDetectionOptions(params.static_detection());
+  imu.static_start = imu::DetectStaticStart(readings, static_options);
+  if (!imu.static_start.found && (imu.gyro_vibrates || imu.accel_vibrates)) {
+    imu.static_start = imu::DetectStaticStart(
+        imu::LowPassAndDecimateImu(readings, vibration.low_pass, 1), static_options);
+    imu.static_start_after_low_pass = imu.static_start.found;
+  }
   Eigen::Vector3d gyro_bias = Eigen::Vector3d::Zero();
   if (imu.static_start.found) {
     imu.accel = imu::DetectAccelUnit(published, {imu.static_start});
@@ -101,20 +123,6 @@ void AnalyseImu(const BagSurvey& survey, const proto::CheckParams& params, Check
   excitation.lateral_accel_hysteresis_mps2 = params.excitation().lateral_accel_hysteresis_mps2();
   imu.excitation =
       MeasureImuExcitation(readings, gyro_bias, imu.specific_force_at_rest_mps2, excitation);
-  imu::VibrationOptions vibration;
-  vibration.low_pass.cutoff_hz = params.imu().vibration_cutoff_hz();
-  vibration.low_pass.span_s = params.imu().vibration_filter_span_s();
-  vibration.low_pass.max_gap_s = params.imu().vibration_max_gap_s();
-  vibration.spectrum_segment_s = params.imu().vibration_spectrum_segment_s();
-  vibration.max_segments = static_cast<int>(params.imu().vibration_max_segments());
-  imu.vibration = imu::MeasureImuVibration(readings, vibration);
-  const proto::ImuCheckParams& p = params.imu();
-  if (imu.vibration.num_samples > 0) {
-    imu.gyro_vibrates =
-        imu.vibration.gyro.rms.maxCoeff() > p.vibration_factor() * p.gyro_noise_radps();
-    imu.accel_vibrates =
-        imu.vibration.accel.rms.maxCoeff() > p.vibration_factor() * p.accel_noise_mps2();
-  }
 }
 
 ScanGeometryOptions ToScanGeometryOptions(const proto::LidarCheckParams& p) {

@@ -33,6 +33,8 @@ struct ImuFindings {
   // A high-passed RMS above ImuCheckParams.vibration_factor times the
   // calibration's white-noise σ on some axis of the triad.
   bool gyro_vibrates = false, accel_vibrates = false;
+  // The static start was found only in the low-passed readings.
+  bool static_start_after_low_pass = false;
   double stamp_minus_record_s = 0.0;  // median header stamp − record time
 };
 

@@ -62,9 +62,10 @@ void WriteImu(const CheckFindings& f, std::ostream& out) {
   }
   const imu::StaticInterval& st = imu.static_start;
   Line(out, "static start",
-       st.found ? fmt::format("yes, {:.2f} s (gyro bias {:.4f} {:.4f} {:.4f} rad/s)",
+       st.found ? fmt::format("yes, {:.2f} s (gyro bias {:.4f} {:.4f} {:.4f} rad/s{})",
                               st.end_s - st.begin_s, st.mean_gyro_radps.x(), st.mean_gyro_radps.y(),
-                              st.mean_gyro_radps.z())
+                              st.mean_gyro_radps.z(),
+                              imu.static_start_after_low_pass ? "; after the low-pass" : "")
                 : std::string("no"));
 }
 

@@ -106,7 +106,7 @@ TEST_F(ImuFaultsTest, ConsumerImuIsEstimatedWithAutoAndSuspectWithOff) {
 
 // An idling engine: 37 Hz, 1.5 m/s^2 and 0.05 rad/s per axis, also during
 // the static start (53 and 12 times imu_noise's sigmas). AUTO low-passes
-// and thins the readings (every 8th at 200 Hz with 12 Hz): the static start
+// and thins the readings (every 4th at 200 Hz: 50 Hz): the static start
 // is found and the result is right; OFF leaves it in the residuals: SUSPECT.
 TEST_F(ImuFaultsTest, VibrationIsFilteredWithAutoAndSuspectWithOff) {
   SimulatedInputs sim;
@@ -131,8 +131,8 @@ TEST_F(ImuFaultsTest, VibrationIsFilteredWithAutoAndSuspectWithOff) {
       EXPECT_EQ(run.exit_code, 0) << run.output;
       EXPECT_NE(run.result.verdict(), proto::CalibrationResult::SUSPECT) << run.output;
       EXPECT_TRUE(v.filtered());
-      EXPECT_EQ(v.decimation(), 8);
-      EXPECT_NEAR(v.accel_sigma_mps2(), params.imu_noise().accel_sigma_mps2() / std::sqrt(8.0),
+      EXPECT_EQ(v.decimation(), 4);
+      EXPECT_NEAR(v.accel_sigma_mps2(), params.imu_noise().accel_sigma_mps2() / 2.0,
                   1e-12);
       EXPECT_TRUE(run.result.static_start()) << run.output;
       ExpectRightWithinSigmas(run, 0.15);

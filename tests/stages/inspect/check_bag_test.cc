@@ -256,6 +256,11 @@ TEST(CheckBag, VibrationClockDriftAndDroppedScansAreMeasuredAndSaid) {
   EXPECT_NEAR(f.imu.vibration.accel.peak_frequency_hz, 37.0, 0.5);
   EXPECT_NEAR(f.imu.vibration.gyro.peak_frequency_hz, 37.0, 0.5);
   EXPECT_TRUE(AnyContains(f.notes, "IMU vibration above the motion's band")) << run.report;
+  // The idling engine hides the static start; the low-pass finds it, as
+  // the calibration does.
+  EXPECT_TRUE(f.imu.static_start.found) << run.report;
+  EXPECT_TRUE(f.imu.static_start_after_low_pass);
+  EXPECT_NEAR(f.imu.static_start.end_s, 1.5, 0.35);
   EXPECT_TRUE(Contains(run.report, "(vibration, peak 37.0 Hz)")) << run.report;
   // The drift: LiDAR stamps against the record times (the IMU's clock).
   ASSERT_TRUE(f.clock.rate_measured);
