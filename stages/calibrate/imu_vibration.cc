@@ -1,5 +1,6 @@
 #include "stages/calibrate/imu_vibration.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -68,8 +69,10 @@ std::string DescribeImuVibration(const proto::ImuVibrationReport& r) {
   if (!r.found() && !r.filtered()) return "";
   auto peak = [](double hz) { return hz > 0.0 ? fmt::format(", peak {:.1f} Hz", hz) : std::string(); };
   const std::string measured = fmt::format(
-      "IMU vibration above the spline's band: gyro RMS up to {:.4f} rad/s{}, accelerometer up "
-      "to {:.3f} m/s²{} (as sampled at {:.0f} Hz)",
+      "{}: gyro RMS up to {:.4f} rad/s{}, accelerometer up to {:.3f} m/s²{} (as sampled at "
+      "{:.0f} Hz)",
+      r.found() ? "IMU vibration above the spline's band"
+                : "IMU above the spline's band (imu_vibration.mode ON)",
       std::max({r.gyro_rms_radps().x(), r.gyro_rms_radps().y(), r.gyro_rms_radps().z()}),
       peak(r.gyro_peak_hz()),
       std::max({r.accel_rms_mps2().x(), r.accel_rms_mps2().y(), r.accel_rms_mps2().z()}),
