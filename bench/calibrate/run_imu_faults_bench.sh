@@ -16,7 +16,8 @@
 # (deg), translation per axis (mm) and tau (ms) errors against the truth,
 # whether the intrinsics were estimated, the score, the gyro z scale and
 # the accelerometer's x/y scales found against the truth's (ppm), whether
-# the IMU was low-pass filtered (and thinned by m), seconds of make.
+# the IMU was low-pass filtered (and thinned by m), seconds of make; then
+# the NEES of the AUTO runs (covariance_consistency.py).
 #   bench/calibrate/run_imu_faults_bench.sh [--build_dir=DIR] [--scratch=DIR]
 #       [--seeds=101,102,103] [--fault=consumer] [--scale_ppm=10000]
 #       [--misalignment_deg=0.5] [--vibration_hz=37] [--vibration_accel=1.5]
@@ -43,7 +44,7 @@ for arg in "$@"; do
     --vibration_hz=*) HZ=${arg#*=} ;;
     --vibration_accel=*) ACCEL=${arg#*=} ;;
     --vibration_gyro=*) GYRO=${arg#*=} ;;
-    --help) sed -n '2,24p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --help) sed -n '2,/^set -euo/p' "$0" | sed '$d' | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "unknown argument $arg (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -157,3 +158,14 @@ for seed in ${SEEDS//,/ }; do
     run "${seed}_tilted_$mode" "tilted.$seed" $mode "../${seed}_flat_AUTO"
   done
 done
+
+# The covariance's honesty over the AUTO runs (covariance_consistency.py):
+# each run's NEES of the 7-vector and the mean's 95 % band for that many.
+pairs=""
+for seed in ${SEEDS//,/ }; do
+  for kind in flat tilted; do
+    cal=$SCRATCH/${seed}_${kind}_AUTO/out/seq/calibration.txtpb
+    [ -f "$cal" ] && pairs="$pairs $cal:$SCRATCH/$kind.$seed.truth.txtpb"
+  done
+done
+[ -n "$pairs" ] && "$PY" "$SRC/bench/calibrate/covariance_consistency.py" $pairs

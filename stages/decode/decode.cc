@@ -153,6 +153,11 @@ void PrintSummary(std::ostream* log, const DecodePaths& paths,
                           ? fmt::format(" (LiDAR stamps shifted by {:.3f} s, lidar_stamp_shift_s)",
                                         shift_s)
                           : "");
+  if (s.lidar_clock_vs_imu.measured && s.clock_drift_note.empty()) {
+    *log << fmt::format("  clocks: the LiDAR clock runs {:+.1f} ± {:.1f} ppm against the IMU's\n",
+                        s.lidar_clock_vs_imu.rate_ppm, s.lidar_clock_vs_imu.sigma_ppm);
+  }
+  if (!s.clock_drift_note.empty()) *log << "  WARNING: clocks: " << s.clock_drift_note << "\n";
   *log << "  tf_static: " << s.tf_static.summary << "\n";
   for (const std::string& warning : s.tf_static.warnings) {
     *log << "  WARNING: tf_static: " << warning << "\n";
@@ -312,6 +317,11 @@ Status CheckStampsAndUnits(const DecodePaths& paths, const proto::DecodeParams& 
   TILTCAL_RETURN_IF_ERROR(decode::CheckClockDomains(paths.bag, imu_span, lidar_span,
                                                     params.lidar_stamp_shift_s()));
   s->stamp_overlap_s = decode::StampOverlapSeconds(imu_span, lidar_span);
+  const double window_s = params.clock_drift().window_s();
+  s->lidar_clock_vs_imu = timing::ClockRateBetween(scans.ClockRate(window_s),
+                                                   imu.ClockRate(window_s), s->stamp_overlap_s);
+  s->clock_drift_note = timing::DescribeClockDrift(
+      s->lidar_clock_vs_imu, s->stamp_overlap_s, params.clock_drift().max_time_offset_drift_s());
   decode::ImuUnitsResolution units;
   TILTCAL_RETURN_IF_ERROR(decode::ResolveImuUnits(imu.Readings(), rig, {paths.bag, paths.rig},
                                                   params.imu_units(), &units));
@@ -398,6 +408,7 @@ Status Decode(const DecodePaths& paths, const proto::DecodeParams& params, std::
   TILTCAL_RETURN_IF_ERROR(imu.CheckPhysicalRange(params.imu_range(), s.accel_to_si, s.gyro_to_si));
   proto::Provenance imu_provenance = provenance;
   for (const std::string& note : s.imu_notes) imu_provenance.add_notes(note);
+  if (!s.clock_drift_note.empty()) imu_provenance.add_notes("clocks: " + s.clock_drift_note);
   RecordWriter imu_writer;
   TILTCAL_RETURN_IF_ERROR(
       imu.Write(paths.out_imu, imu_provenance, s.accel_to_si, s.gyro_to_si, &imu_writer, &s));

@@ -12,6 +12,7 @@
 
 #include "bag/input/static_transforms.h"
 #include "common/status.h"
+#include "common/timing/clock_rate.h"
 #include "tiltcal/proto/decode_params.pb.h"
 
 namespace tiltcal {
@@ -52,6 +53,10 @@ struct DecodeSummary {
   int64_t imu_first_stamp_ns = 0, imu_last_stamp_ns = 0;
   int64_t scan_first_stamp_ns = 0, scan_last_stamp_ns = 0;  // after lidar_stamp_shift_s
   double stamp_overlap_s = 0.0;  // time covered by both the IMU and the LiDAR stamps
+  // The LiDAR clock's rate against the IMU's (DecodeParams.clock_drift), and
+  // the sentence that reports it when the drift matters ("" otherwise).
+  timing::RelativeClockRate lidar_clock_vs_imu;
+  std::string clock_drift_note;
   double accel_to_si = 1.0;      // factors applied to the published IMU values
   double gyro_to_si = 1.0;
   std::vector<std::string> imu_notes;     // units and sign: what was decided and why

@@ -156,6 +156,21 @@ decode::StampSpan ImuSink::Span() const {
   return span;
 }
 
+timing::ClockRate ImuSink::ClockRate(double window_s) const {
+  std::vector<int64_t> stamps, records;
+  stamps.reserve(samples_.size());
+  records.reserve(samples_.size());
+  for (const Record& r : samples_) {
+    stamps.push_back(r.stamp_ns);
+    records.push_back(r.record_ns);
+  }
+  return timing::EstimateClockRate(stamps, records, window_s);
+}
+
+timing::ClockRate ScanSink::ClockRate(double window_s) const {
+  return timing::EstimateClockRate(stamps_ns_, records_ns_, window_s);
+}
+
 Status ImuSink::CheckStampGaps(double max_gap_s) const {
   for (size_t i = 1; i < samples_.size(); ++i) {
     const double gap_s = DifferenceSeconds(samples_[i].stamp_ns, samples_[i - 1].stamp_ns);
@@ -299,6 +314,8 @@ Status ScanSink::Convert(const bag::Message& m, int64_t index, proto::Scan* scan
   scan->set_index(static_cast<uint32_t>(s->scans_written));
   scan->set_record_stamp_ns(m.time_ns);
   record_delays_ns_.push_back(m.time_ns - scan->stamp_ns());
+  stamps_ns_.push_back(scan->stamp_ns());
+  records_ns_.push_back(m.time_ns);
   if (s->scans_written == 0) s->scan_first_stamp_ns = scan->stamp_ns();
   s->scan_last_stamp_ns = scan->stamp_ns();
   ++s->scans_written;

@@ -15,6 +15,7 @@
 #include "bag/sensor_messages.h"
 #include "common/imu/imu_reading.h"
 #include "common/status.h"
+#include "common/timing/clock_rate.h"
 #include "stages/decode/async_record_writer.h"
 #include "stages/decode/clock_domains.h"
 #include "stages/decode/decode.h"
@@ -48,6 +49,8 @@ class ImuSink {
   // the first stamp) and their stamp span.
   std::vector<imu::ImuReading> Readings() const;
   decode::StampSpan Span() const;
+  // The stamps' clock rate against the record times (common/timing).
+  timing::ClockRate ClockRate(double window_s) const;
 
   // After SortAndDropRepeatedStamps: an error naming the sample when two
   // consecutive stamps are more than max_gap_s apart.
@@ -97,6 +100,8 @@ class ScanSink {
 
   // The (shifted) stamp span of the scans written so far.
   decode::StampSpan Span(const DecodeSummary& s) const;
+  // The (shifted) stamps' clock rate against the record times.
+  timing::ClockRate ClockRate(double window_s) const;
 
  private:
   // Decodes the message and converts it into *scan (its type's decoder).
@@ -116,6 +121,7 @@ class ScanSink {
   int64_t stamp_shift_ns_ = 0;
   int64_t last_stamp_ns_ = INT64_MIN;
   std::vector<int64_t> record_delays_ns_;  // record time − shifted stamp, per written scan
+  std::vector<int64_t> stamps_ns_, records_ns_;  // per written scan
 };
 
 }  // namespace tiltcal

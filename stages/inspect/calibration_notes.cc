@@ -151,19 +151,9 @@ void AddClockNotes(const proto::CheckParams& params, CheckFindings* f) {
         params.clock().time_offset_window_s(), c.stamp_offset_difference_s,
         -c.stamp_offset_difference_s));
   }
-  const double max_drift_s = params.clock().max_time_offset_drift_s();
-  if (c.rate_measured && c.time_offset_drift_s > max_drift_s &&
-      std::abs(c.lidar_rate_vs_imu_ppm) > 3.0 * c.lidar_rate_vs_imu_sigma_ppm) {
-    const double rate = std::abs(c.lidar_rate_vs_imu_ppm) * 1e-6;
-    f->notes.push_back(fmt::format(
-        "the LiDAR clock runs {:+.1f} ± {:.1f} ppm against the IMU's (their stamps against the "
-        "record times): τ drifts by {:.2f} ms over the {:.1f} s of overlap, and the calibration "
-        "fits one τ for the whole sequence (its ends off by about half that); τ stays within "
-        "{:.1f} ms only over {:.0f} s: synchronise the clocks (PTP, GPS PPS) or calibrate shorter "
-        "recordings",
-        c.lidar_rate_vs_imu_ppm, c.lidar_rate_vs_imu_sigma_ppm, 1e3 * c.time_offset_drift_s,
-        c.overlap_s, 1e3 * max_drift_s, max_drift_s / rate));
-  }
+  const std::string drift = timing::DescribeClockDrift(c.lidar_vs_imu, c.overlap_s,
+                                                       params.clock().max_time_offset_drift_s());
+  if (!drift.empty()) f->notes.push_back(drift);
 }
 
 // The extrinsic of /tf_static, when there is one: a starting value the user

@@ -201,15 +201,9 @@ void AnalyseClock(const BagSurvey& survey, const proto::CheckParams& params, Che
                           : fmt::format("overlap only {:.3f} s", c.overlap_s)));
   }
   const double window_s = params.clock().rate_window_s();
-  c.imu_rate = EstimateClockRate(survey.imu_stamp_ns, survey.imu_record_ns, window_s);
-  c.lidar_rate = EstimateClockRate(survey.scan_stamp_ns, survey.scan_record_ns, window_s);
-  c.rate_measured = c.imu_rate.measured && c.lidar_rate.measured &&
-                    !(c.imu_rate.stamps_are_record && c.lidar_rate.stamps_are_record);
-  if (c.rate_measured) {
-    c.lidar_rate_vs_imu_ppm = c.lidar_rate.rate_ppm - c.imu_rate.rate_ppm;
-    c.lidar_rate_vs_imu_sigma_ppm = std::hypot(c.lidar_rate.sigma_ppm, c.imu_rate.sigma_ppm);
-    c.time_offset_drift_s = std::abs(c.lidar_rate_vs_imu_ppm) * 1e-6 * std::max(c.overlap_s, 0.0);
-  }
+  c.imu_rate = timing::EstimateClockRate(survey.imu_stamp_ns, survey.imu_record_ns, window_s);
+  c.lidar_rate = timing::EstimateClockRate(survey.scan_stamp_ns, survey.scan_record_ns, window_s);
+  c.lidar_vs_imu = timing::ClockRateBetween(c.lidar_rate, c.imu_rate, c.overlap_s);
 }
 
 }  // namespace

@@ -10,8 +10,8 @@
 #include "common/imu/imu_units.h"
 #include "common/imu/static_detection.h"
 #include "common/imu/vibration.h"
+#include "common/timing/clock_rate.h"
 #include "stages/inspect/bag_survey.h"
-#include "stages/inspect/clock_rate.h"
 #include "stages/inspect/excitation.h"
 #include "stages/inspect/stamp_statistics.h"
 #include "tiltcal/proto/check_params.pb.h"
@@ -62,10 +62,8 @@ struct ClockFindings {
   // Each stream's stamp clock against the record times, and the LiDAR's
   // against the IMU's: rate_ppm > 0 the LiDAR clock runs fast, τ changes by
   // −rate · 1e-6 per second (a LiDAR stamp reads later and later).
-  ClockRate imu_rate, lidar_rate;
-  bool rate_measured = false;
-  double lidar_rate_vs_imu_ppm = 0.0, lidar_rate_vs_imu_sigma_ppm = 0.0;
-  double time_offset_drift_s = 0.0;  // |rate| · 1e-6 · overlap
+  timing::ClockRate imu_rate, lidar_rate;
+  timing::RelativeClockRate lidar_vs_imu;
 };
 
 // Everything the check says. `problems` make the bag uncalibratable (exit

@@ -114,11 +114,11 @@ void WriteClock(const CheckFindings& f, std::ostream& out) {
                    f.lidar.stamp_minus_record_s));
   const ClockFindings& c = f.clock;
   Line(out, "LiDAR clock vs IMU's",
-       c.rate_measured
+       c.lidar_vs_imu.measured
            ? fmt::format("{:+.1f} ± {:.1f} ppm (stamps against the record times; τ drifts "
                          "{:.2f} ms over the overlap)",
-                         c.lidar_rate_vs_imu_ppm, c.lidar_rate_vs_imu_sigma_ppm,
-                         1e3 * c.time_offset_drift_s)
+                         c.lidar_vs_imu.rate_ppm, c.lidar_vs_imu.sigma_ppm,
+                         1e3 * c.lidar_vs_imu.time_offset_drift_s)
            : std::string("not measurable (the record times are the stamps, or too short)"));
 }
 

@@ -418,6 +418,32 @@ TEST_F(UnitsAndClocks, ClockDomainsYearsApartNameTheDates) {
 }
 
 // Stamps that overlap in part are the calibration's business: decoded.
+// A LiDAR clock 100 ppm fast: 1.2 ms of τ over the 12 s, said on stderr and
+// in imu.binpb's provenance; the same bag without drift says nothing.
+TEST_F(UnitsAndClocks, LidarClockDriftIsMeasuredAndSaid) {
+  for (const double ppm : {0.0, 100.0}) {
+    testing::VehicleBagOptions options;
+    options.lidar_clock_drift_ppm = ppm;
+    const std::string name = ppm == 0.0 ? "steady" : "drift";
+    const std::string out = OutDir(name);
+    DecodeSummary summary;
+    const Status status = Decode(Bag(name + ".bag", options), "", out, &summary);
+    ASSERT_TRUE(status.ok()) << status.message();
+    ASSERT_TRUE(summary.lidar_clock_vs_imu.measured);
+    EXPECT_NEAR(summary.lidar_clock_vs_imu.rate_ppm, ppm, 1.0);
+    EXPECT_NEAR(summary.lidar_clock_vs_imu.time_offset_drift_s, ppm * 1e-6 * summary.stamp_overlap_s,
+                2e-5);
+    RecordReader reader;
+    ASSERT_TRUE(reader.Open(out + "/imu.binpb").ok());
+    bool said = false;
+    for (const std::string& note : reader.header().provenance().notes()) {
+      said = said || note.find("ppm against the IMU's") != std::string::npos;
+    }
+    EXPECT_EQ(said, ppm > 0.0) << summary.clock_drift_note;
+    EXPECT_EQ(summary.clock_drift_note.empty(), ppm == 0.0);
+  }
+}
+
 TEST_F(UnitsAndClocks, PartialOverlapDecodes) {
   testing::VehicleBagOptions offset;
   offset.lidar_stamp_offset_ns = 9LL * 1000000000LL;  // 9 s of the LiDAR's 12 past the IMU's end

@@ -33,6 +33,9 @@ struct VehicleBagOptions {
   // Added to the LiDAR header stamps (not to the record times): a LiDAR that
   // stamps on another clock than the IMU.
   int64_t lidar_stamp_offset_ns = 0;
+  // The LiDAR's clock runs this fast against the IMU's and the recorder's:
+  // its header stamps gain t · ppm · 1e-6 over the bag (t since its start).
+  double lidar_clock_drift_ppm = 0.0;
   // IMU message `far_future_imu_index` (>= 0) stamped at the last second
   // uint32 can hold (2^32 − 1 s, in 2106); zero_stamps: every header stamp 0
   // (a driver that never sets them).
@@ -134,7 +137,12 @@ inline bool WriteVehicleBag(const std::string& path, const VehicleBagOptions& op
     }
     Message m{true_ns + kVehicleBagLidarLatencyNs, cloud_connection, ""};
     if (!ros1::SerializePointCloud2(static_cast<uint32_t>(k),
-                                    options.zero_stamps ? 0 : true_ns + options.lidar_stamp_offset_ns,
+                                    options.zero_stamps
+                                        ? 0
+                                        : true_ns + options.lidar_stamp_offset_ns +
+                                              std::llround(static_cast<double>(
+                                                               true_ns - kVehicleBagStartNs) *
+                                                           options.lidar_clock_drift_ppm * 1e-6),
                                     "lidar", 1, kPoints,
                                     fields, kPointStep, data, true, &m.bytes)) {
       return false;

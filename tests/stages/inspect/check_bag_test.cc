@@ -223,7 +223,7 @@ TEST(CheckBag, CleanSimulatedSequence) {
   EXPECT_LT(f.imu.vibration.accel.rms.maxCoeff(), 0.02);
   EXPECT_LT(f.imu.vibration.gyro.rms.maxCoeff(), 0.004);
   // The simulator's record times are the stamps: no clock rate to measure.
-  EXPECT_FALSE(f.clock.rate_measured);
+  EXPECT_FALSE(f.clock.lidar_vs_imu.measured);
   EXPECT_FALSE(AnyContains(f.notes, "vibration"));
   // The report.
   EXPECT_TRUE(Contains(run.report, "  samples                  2001\n")) << run.report;
@@ -263,10 +263,10 @@ TEST(CheckBag, VibrationClockDriftAndDroppedScansAreMeasuredAndSaid) {
   EXPECT_NEAR(f.imu.static_start.end_s, 1.5, 0.35);
   EXPECT_TRUE(Contains(run.report, "(vibration, peak 37.0 Hz)")) << run.report;
   // The drift: LiDAR stamps against the record times (the IMU's clock).
-  ASSERT_TRUE(f.clock.rate_measured);
-  EXPECT_NEAR(f.clock.lidar_rate_vs_imu_ppm, 100.0, 2.0);
-  EXPECT_LT(f.clock.lidar_rate_vs_imu_sigma_ppm, 2.0);
-  EXPECT_NEAR(f.clock.time_offset_drift_s, 100e-6 * f.clock.overlap_s, 1e-5);
+  ASSERT_TRUE(f.clock.lidar_vs_imu.measured);
+  EXPECT_NEAR(f.clock.lidar_vs_imu.rate_ppm, 100.0, 2.0);
+  EXPECT_LT(f.clock.lidar_vs_imu.sigma_ppm, 2.0);
+  EXPECT_NEAR(f.clock.lidar_vs_imu.time_offset_drift_s, 100e-6 * f.clock.overlap_s, 1e-5);
   EXPECT_TRUE(AnyContains(f.notes, "ppm against the IMU's")) << run.report;
   // The dropped scans are gaps: one per missing run of scans.
   const int dropped = static_cast<int>(std::lround(10.0 * kDurationS)) - sim.truth().scans_size();

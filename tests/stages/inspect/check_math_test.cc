@@ -11,7 +11,7 @@
 #include "bag/ros1/message_encoding.h"
 #include "bag/ros1/messages.h"
 #include "stages/inspect/check.h"
-#include "stages/inspect/clock_rate.h"
+#include "common/timing/clock_rate.h"
 #include "stages/inspect/default_params_text.h"
 #include "stages/inspect/excitation.h"
 #include "stages/inspect/point_cloud_sample.h"
@@ -40,7 +40,7 @@ TEST(ClockRate, SlopeOfStampMinusRecordInPpm) {
   for (const double ppm : {0.0, 50.0, -120.0}) {
     std::vector<int64_t> stamps, records;
     DriftingStamps(ppm, &stamps, &records);
-    const ClockRate r = EstimateClockRate(stamps, records, 5.0);
+    const timing::ClockRate r = timing::EstimateClockRate(stamps, records, 5.0);
     ASSERT_TRUE(r.measured);
     EXPECT_FALSE(r.stamps_are_record);
     EXPECT_EQ(r.windows, 12);
@@ -54,11 +54,11 @@ TEST(ClockRate, SlopeOfStampMinusRecordInPpm) {
 TEST(ClockRate, StampsThatAreTheRecordTimesAndTooFewWindows) {
   std::vector<int64_t> stamps;
   for (int i = 0; i < 100; ++i) stamps.push_back(1'000'000'000LL * i);
-  const ClockRate same = EstimateClockRate(stamps, stamps, 5.0);
+  const timing::ClockRate same = timing::EstimateClockRate(stamps, stamps, 5.0);
   EXPECT_TRUE(same.stamps_are_record);
   EXPECT_TRUE(same.measured);
   EXPECT_EQ(same.rate_ppm, 0.0);
-  const ClockRate short_one = EstimateClockRate(stamps, stamps, 50.0);  // 2 windows
+  const timing::ClockRate short_one = timing::EstimateClockRate(stamps, stamps, 50.0);  // 2 windows
   EXPECT_FALSE(short_one.measured);
 }
 

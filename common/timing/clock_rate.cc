@@ -1,12 +1,20 @@
-#include "stages/inspect/clock_rate.h"
+#include "common/timing/clock_rate.h"
 
 #include <algorithm>
 #include <cmath>
 #include <numeric>
 
-#include "stages/inspect/stamp_statistics.h"
+#include <fmt/format.h>
 
-namespace tiltcal::inspect {
+namespace tiltcal::timing {
+namespace {
+
+double Median(std::vector<double> v) {
+  std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
+  return v[v.size() / 2];
+}
+
+}  // namespace
 
 ClockRate EstimateClockRate(const std::vector<int64_t>& stamps_ns,
                             const std::vector<int64_t>& record_ns, double window_s) {
@@ -66,4 +74,30 @@ ClockRate EstimateClockRate(const std::vector<int64_t>& stamps_ns,
   return out;
 }
 
-}  // namespace tiltcal::inspect
+RelativeClockRate ClockRateBetween(const ClockRate& lidar, const ClockRate& imu, double overlap_s) {
+  RelativeClockRate out;
+  out.measured = lidar.measured && imu.measured && !(lidar.stamps_are_record && imu.stamps_are_record);
+  if (!out.measured) return out;
+  out.rate_ppm = lidar.rate_ppm - imu.rate_ppm;
+  out.sigma_ppm = std::hypot(lidar.sigma_ppm, imu.sigma_ppm);
+  out.time_offset_drift_s = std::abs(out.rate_ppm) * 1e-6 * std::max(overlap_s, 0.0);
+  return out;
+}
+
+std::string DescribeClockDrift(const RelativeClockRate& rate, double overlap_s,
+                               double max_drift_s) {
+  if (!rate.measured || rate.time_offset_drift_s <= max_drift_s ||
+      std::abs(rate.rate_ppm) <= 3.0 * rate.sigma_ppm) {
+    return "";
+  }
+  return fmt::format(
+      "the LiDAR clock runs {:+.1f} ± {:.1f} ppm against the IMU's (their stamps against the "
+      "record times): τ drifts by {:.2f} ms over the {:.1f} s of overlap, and the calibration "
+      "fits one τ for the whole sequence (its ends off by about half that); τ stays within "
+      "{:.1f} ms only over {:.0f} s: synchronise the clocks (PTP, GPS PPS) or calibrate shorter "
+      "recordings",
+      rate.rate_ppm, rate.sigma_ppm, 1e3 * rate.time_offset_drift_s, overlap_s, 1e3 * max_drift_s,
+      max_drift_s / (std::abs(rate.rate_ppm) * 1e-6));
+}
+
+}  // namespace tiltcal::timing
