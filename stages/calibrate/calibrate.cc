@@ -54,6 +54,19 @@ void Log(std::ostream* log, const std::string& line) {
   if (log != nullptr) *log << "tiltcal_calibrate: " << line << "\n" << std::flush;
 }
 
+// tiltcal_decode's clock-drift note (a provenance note "clocks: ...") of
+// the IMU stream, "" without.
+Status ReadClockDriftNote(const std::string& imu_path, std::string* note) {
+  note->clear();
+  RecordReader reader;
+  TILTCAL_RETURN_IF_ERROR(reader.Open(imu_path));
+  const std::string prefix = "clocks: ";
+  for (const std::string& n : reader.header().provenance().notes()) {
+    if (n.rfind(prefix, 0) == 0) *note = n.substr(prefix.size());
+  }
+  return Status::Ok();
+}
+
 }  // namespace
 
 Status ReadCalibrateInputs(const CalibratePaths& paths, const proto::CalibrateParams& params,
@@ -62,6 +75,7 @@ Status ReadCalibrateInputs(const CalibratePaths& paths, const proto::CalibratePa
   TILTCAL_RETURN_IF_ERROR(LoadRigWithExtrinsic(paths.rig, &inputs->rig));
   TILTCAL_RETURN_IF_ERROR(
       ReadImuReadings(paths.imu, &inputs->imu, &inputs->first_imu_stamp_ns));
+  TILTCAL_RETURN_IF_ERROR(ReadClockDriftNote(paths.imu, &inputs->clock_drift));
   TILTCAL_RETURN_IF_ERROR(
       ReadLidarScans(paths.scans, inputs->first_imu_stamp_ns, params.scans(), &inputs->scans));
   if (inputs->scans.empty()) return Status::Error(paths.scans + ": no scans");
@@ -572,6 +586,7 @@ void FillVerdictFacts(const CalibrateInputs& inputs, const proto::CalibrateParam
   }
   result->set_static_start(init.imu.from_static_start);
   result->set_static_samples(init.imu.num_samples_averaged * inputs.imu_decimation);
+  result->set_clock_drift(inputs.clock_drift);
   FillStartingExtrinsicNotes(inputs.rig, state, result);
   AddTiming("verdict_facts", Seconds(start), result);
   AddTiming("map_sharpness", sharpness.seconds, result);

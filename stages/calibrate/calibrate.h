@@ -64,6 +64,8 @@ struct CalibrateInputs {
   // The IMU readings were thinned to every imu_decimation-th sample
   // (imu_vibration.h); 1 when not.
   int imu_decimation = 1;
+  // tiltcal_decode's clock-drift note in imu.binpb's provenance ("" without).
+  std::string clock_drift;
 };
 
 // Reads and checks the inputs (errors name the file and record).

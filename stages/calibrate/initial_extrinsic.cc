@@ -13,6 +13,7 @@
 #include "common/io/rig.h"
 #include "common/io/text_proto.h"
 #include "common/io/tf_static_extrinsic.h"
+#include "stages/calibrate/imu_vibration.h"
 #include "stages/calibrate/lidar_scans.h"
 #include "stages/calibrate/rotation_from_motion.h"
 
@@ -74,6 +75,15 @@ Status FindSequenceRig(const InitialExtrinsicPaths& paths, const proto::Calibrat
   std::vector<imu::ImuReading> imu;
   int64_t first_imu_stamp_ns = 0;
   TILTCAL_RETURN_IF_ERROR(ReadImuReadings(paths.imu, &imu, &first_imu_stamp_ns));
+  // The readings the calibration will use (imu_vibration.h): vibration
+  // would otherwise swamp the accelerations that decide the rotation about
+  // the motion's axis.
+  proto::CalibrateParams used = params;
+  proto::ImuVibrationReport vibration;
+  TILTCAL_RETURN_IF_ERROR(
+      HandleImuVibration(params.imu_vibration(), &imu, used.mutable_imu_noise(), &vibration)
+          .WithContext(paths.imu));
+  if (vibration.filtered()) Log(log, DescribeImuVibration(vibration));
   std::vector<LidarScan> scans;
   TILTCAL_RETURN_IF_ERROR(ReadLidarScans(paths.scans, first_imu_stamp_ns, params.scans(), &scans));
   if (scans.empty()) return Status::Error(paths.scans + ": no scans");
@@ -90,7 +100,7 @@ Status FindSequenceRig(const InitialExtrinsicPaths& paths, const proto::Calibrat
   RotationFromMotion found;
   const Status status = FindImuFromLidarRotation(
       imu, scans, guess ? std::optional<Eigen::Quaterniond>(guess->rotation) : std::nullopt,
-      translation, params, &found);
+      translation, used, &found);
   if (!status.ok()) {
     const std::string message =
         "cannot find the extrinsic rotation from the motion: " + status.message();

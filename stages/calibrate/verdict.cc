@@ -133,6 +133,12 @@ void CheckImuIntrinsics(const proto::CalibrationResult& r, Findings* f) {
       a.misalignment_deg().x(), a.misalignment_deg().y(), a.misalignment_deg().z()));
 }
 
+void CheckClockDrift(const proto::CalibrationResult& r, Findings* f) {
+  if (r.clock_drift().empty()) return;
+  f->weak.push_back("τ is the offset the whole sequence fits best, not the one at every time: " +
+                    r.clock_drift());
+}
+
 // Translation direction d (frame b): the rig's and the estimate's component.
 std::string WeakTranslationReason(const proto::ObservabilityDirection& d,
                                   const proto::CalibrationResult& r) {
@@ -211,6 +217,7 @@ void DecideVerdict(const proto::VerdictParams& params, proto::CalibrationResult*
   CheckHandEye(*result, params, &f);
   CheckStaticStart(*result, params, &f);
   CheckImuIntrinsics(*result, &f);
+  CheckClockDrift(*result, &f);
   CheckWeakDirections(*result, &f);
   result->clear_verdict_reasons();
   if (!f.suspect.empty()) {

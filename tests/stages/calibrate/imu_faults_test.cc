@@ -4,7 +4,8 @@
 // engine vibration felt by the IMU (imu_vibration.h). With the defaults
 // (AUTO) each is found, handled and the result is right; with the handling
 // OFF the result is SUSPECT (exit 3) naming what the residuals show, never
-// OK and wrong. (40 s sequences with ground residuals, several seeds:
+// OK and wrong. A LiDAR clock drifting against the IMU's, which decode
+// measures and the calibration does not model, makes the result WEAK. (40 s sequences with ground residuals, several seeds:
 // bench/calibrate/run_imu_faults_bench.sh.)
 
 #include <cmath>
@@ -143,6 +144,26 @@ TEST_F(ImuFaultsTest, VibrationIsFilteredWithAutoAndSuspectWithOff) {
           << run.output;
     }
   }
+}
+
+// A LiDAR clock 100 ppm fast: τ moves by 1.6 ms over the 16 s. Decode says
+// so (imu.binpb's provenance); the calibration fits one τ, so its result is
+// WEAK with decode's finding, never OK.
+TEST_F(ImuFaultsTest, ClockDriftMakesTheResultWeakNamingIt) {
+  SimulatedInputs sim;
+  ASSERT_NO_FATAL_FAILURE(
+      SimulateAndDecode(ShortSequenceWith("lidar_clock_drift_ppm: 100"), *dir_, "drift", &sim));
+  const CalibrationRun run = RunCalibrate(sim, LidarImuParams(), *dir_, "drift");
+  ASSERT_TRUE(run.has_result) << run.output;
+  Print("drift", run);
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_EQ(run.result.verdict(), proto::CalibrationResult::WEAK) << run.output;
+  EXPECT_NE(run.result.clock_drift().find("ppm against the IMU's"), std::string::npos);
+  EXPECT_TRUE(AnyContains(run.result.verdict_reasons(),
+                          "τ is the offset the whole sequence fits best"))
+      << run.output;
+  // The fitted τ lies within the drift's span over the sequence.
+  EXPECT_LT(std::abs(run.tau_ms), 2.0) << run.output;
 }
 
 }  // namespace
