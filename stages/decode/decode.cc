@@ -317,11 +317,13 @@ Status CheckStampsAndUnits(const DecodePaths& paths, const proto::DecodeParams& 
   TILTCAL_RETURN_IF_ERROR(decode::CheckClockDomains(paths.bag, imu_span, lidar_span,
                                                     params.lidar_stamp_shift_s()));
   s->stamp_overlap_s = decode::StampOverlapSeconds(imu_span, lidar_span);
-  const double window_s = params.clock_drift().window_s();
+  const bool given = params.has_clock_drift();
+  const double window_s = given ? params.clock_drift().window_s() : 2.0;
+  const double max_drift_s = given ? params.clock_drift().max_time_offset_drift_s() : 5e-4;
   s->lidar_clock_vs_imu = timing::ClockRateBetween(scans.ClockRate(window_s),
                                                    imu.ClockRate(window_s), s->stamp_overlap_s);
-  s->clock_drift_note = timing::DescribeClockDrift(
-      s->lidar_clock_vs_imu, s->stamp_overlap_s, params.clock_drift().max_time_offset_drift_s());
+  s->clock_drift_note =
+      timing::DescribeClockDrift(s->lidar_clock_vs_imu, s->stamp_overlap_s, max_drift_s);
   decode::ImuUnitsResolution units;
   TILTCAL_RETURN_IF_ERROR(decode::ResolveImuUnits(imu.Readings(), rig, {paths.bag, paths.rig},
                                                   params.imu_units(), &units));
