@@ -36,6 +36,10 @@ struct RelativeClockRate {
 };
 RelativeClockRate ClockRateBetween(const ClockRate& lidar, const ClockRate& imu, double overlap_s);
 
+// tiltcal_decode's provenance note of imu.binpb that carries the sentence
+// below starts with this; tiltcal_calibrate finds it there.
+inline const std::string kClockDriftNotePrefix = "clocks: ";
+
 // The sentence the stages print when the drift is significant (above
 // max_drift_s and 3 σ), "" otherwise.
 std::string DescribeClockDrift(const RelativeClockRate& rate, double overlap_s,

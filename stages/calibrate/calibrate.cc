@@ -19,6 +19,7 @@
 #include "common/io/record_stream.h"
 #include "common/io/rig.h"
 #include "common/io/text_proto.h"
+#include "common/timing/clock_rate.h"
 #include "stages/calibrate/covariance_report.h"
 #include "stages/calibrate/ground_residuals.h"
 #include "stages/calibrate/imu_intrinsics.h"
@@ -60,7 +61,7 @@ Status ReadClockDriftNote(const std::string& imu_path, std::string* note) {
   note->clear();
   RecordReader reader;
   TILTCAL_RETURN_IF_ERROR(reader.Open(imu_path));
-  const std::string prefix = "clocks: ";
+  const std::string prefix = timing::kClockDriftNotePrefix;
   for (const std::string& n : reader.header().provenance().notes()) {
     if (n.rfind(prefix, 0) == 0) *note = n.substr(prefix.size());
   }
@@ -721,20 +722,24 @@ Status Run(const CalibratePaths& paths, const proto::CalibrateParams& params, st
   CalibrationState final_state(
       spline::UniformKnotGrid::ForDuration(0.0, 1.0, params.spline().knot_spacing_s()));
   proto::CalibrateParams used = params;
-  proto::ImuVibrationReport vibration;
-  TILTCAL_RETURN_IF_ERROR(HandleImuVibration(params.imu_vibration(), &inputs.imu,
-                                             used.mutable_imu_noise(), &vibration)
-                              .WithContext(paths.imu));
-  inputs.imu_decimation = vibration.decimation();
-  const std::string vibration_note = DescribeImuVibration(vibration);
-  if (!vibration_note.empty()) Log(log, vibration_note);
   if (inputs.rig.has_starting_extrinsic() &&
       !inputs.rig.starting_extrinsic().translation_known()) {
     used.set_extrinsic_translation_prior_sigma_m(params.unknown_translation_prior_sigma_m());
     Log(log, fmt::format("no translation guess: prior sigma {} m at zero",
                          params.unknown_translation_prior_sigma_m()));
   }
-  TILTCAL_RETURN_IF_ERROR(Calibrate(inputs, used, &result, &final_state, log));
+  // The solve weighs filtered readings with the thinned sigmas
+  // (imu_vibration.h); the provenance keeps imu_noise as given, so that the
+  // recorded params rerun to the same result.
+  proto::CalibrateParams solve = used;
+  proto::ImuVibrationReport vibration;
+  TILTCAL_RETURN_IF_ERROR(HandleImuVibration(params.imu_vibration(), &inputs.imu,
+                                             solve.mutable_imu_noise(), &vibration)
+                              .WithContext(paths.imu));
+  inputs.imu_decimation = vibration.decimation();
+  const std::string vibration_note = DescribeImuVibration(vibration);
+  if (!vibration_note.empty()) Log(log, vibration_note);
+  TILTCAL_RETURN_IF_ERROR(Calibrate(inputs, solve, &result, &final_state, log));
   *result.mutable_imu_vibration() = vibration;
   if (!vibration_note.empty()) result.add_verdict_notes(vibration_note);
   TILTCAL_RETURN_IF_ERROR(WriteMaps(paths, params, inputs, final_state, log));

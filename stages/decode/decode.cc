@@ -410,7 +410,7 @@ Status Decode(const DecodePaths& paths, const proto::DecodeParams& params, std::
   TILTCAL_RETURN_IF_ERROR(imu.CheckPhysicalRange(params.imu_range(), s.accel_to_si, s.gyro_to_si));
   proto::Provenance imu_provenance = provenance;
   for (const std::string& note : s.imu_notes) imu_provenance.add_notes(note);
-  if (!s.clock_drift_note.empty()) imu_provenance.add_notes("clocks: " + s.clock_drift_note);
+  if (!s.clock_drift_note.empty()) imu_provenance.add_notes(timing::kClockDriftNotePrefix + s.clock_drift_note);
   RecordWriter imu_writer;
   TILTCAL_RETURN_IF_ERROR(
       imu.Write(paths.out_imu, imu_provenance, s.accel_to_si, s.gyro_to_si, &imu_writer, &s));
