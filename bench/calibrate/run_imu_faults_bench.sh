@@ -9,6 +9,9 @@
 #                   WHILE_MOVING) of HZ, ACCEL m/s^2 and GYRO rad/s per axis;
 #                   compared: imu_vibration AUTO / OFF
 #   idle_vibration  the same, also during the static start (ALWAYS)
+#   drift           the LiDAR clock DRIFT ppm fast against the IMU's
+#                   (lidar_clock_drift_ppm; decode notes it); compared:
+#                   time_offset_drift AUTO (rate estimated) / OFF (one tau)
 # Each sequence is calibrated by `make -f Makefile.pipeline` as a one-bag
 # dataset with the simulator's rig, once with the defaults (AUTO) and once
 # with the fault's params block OFF.
@@ -16,12 +19,16 @@
 # (deg), translation per axis (mm) and tau (ms) errors against the truth,
 # whether the intrinsics were estimated, the score, the gyro z scale and
 # the accelerometer's x/y scales found against the truth's (ppm), whether
-# the IMU was low-pass filtered (and thinned by m), seconds of make; then
-# the NEES of the AUTO runs (covariance_consistency.py).
+# the IMU was low-pass filtered (and thinned by m), seconds of make; the
+# clock rate found (ppm, with its sigma; "-" when not estimated), tau's
+# error against the truth at the first and the last scan (ms) and
+# tiltcal_calibrate's own total (s); then the NEES of the AUTO runs
+# (covariance_consistency.py).
 #   bench/calibrate/run_imu_faults_bench.sh [--build_dir=DIR] [--scratch=DIR]
 #       [--seeds=101,102,103] [--fault=consumer] [--scale_ppm=10000]
 #       [--misalignment_deg=0.5] [--vibration_hz=37] [--vibration_accel=1.5]
-#       [--vibration_gyro=0.05]
+#       [--vibration_gyro=0.05] [--drift_ppm=50] [--duration_s=40]
+# e.g. bench/calibrate/run_imu_faults_bench.sh --fault=drift --seeds=101 --duration_s=160
 set -euo pipefail
 SRC=$(cd "$(dirname "$0")/../.." && pwd)
 BUILD=$SRC/build
@@ -33,6 +40,8 @@ MIS=0.5
 HZ=37
 ACCEL=1.5
 GYRO=0.05
+DRIFT=50
+DURATION=40
 for arg in "$@"; do
   case "$arg" in
     --build_dir=*) BUILD=${arg#*=} ;;
@@ -44,6 +53,8 @@ for arg in "$@"; do
     --vibration_hz=*) HZ=${arg#*=} ;;
     --vibration_accel=*) ACCEL=${arg#*=} ;;
     --vibration_gyro=*) GYRO=${arg#*=} ;;
+    --drift_ppm=*) DRIFT=${arg#*=} ;;
+    --duration_s=*) DURATION=${arg#*=} ;;
     --help) sed -n '2,/^set -euo/p' "$0" | sed '$d' | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "unknown argument $arg (see --help)" >&2; exit 2 ;;
   esac
@@ -51,6 +62,7 @@ done
 case "$FAULT" in
   consumer) BLOCK=imu_intrinsics ;;
   vibration|idle_vibration) BLOCK=imu_vibration ;;
+  drift) BLOCK=time_offset_drift ;;
   *) echo "unknown fault $FAULT (see --help)" >&2; exit 2 ;;
 esac
 BIN=$(cd "$BUILD" && pwd)/bin
@@ -63,7 +75,7 @@ PY=/usr/bin/python3
 scenario() {
   local kind=$1 seed=$2 pitch=0 roll=0
   [ "$kind" = tilted ] && { pitch=8; roll=3; }
-  sed -E -e "s/^seed: .*/seed: $seed/" -e "s/^duration_s: .*/duration_s: 40/" \
+  sed -E -e "s/^seed: .*/seed: $seed/" -e "s/^duration_s: .*/duration_s: $DURATION/" \
     -e "s/^ground_pitch_deg: .*/ground_pitch_deg: $pitch/" \
     -e "s/^ground_roll_deg: .*/ground_roll_deg: $roll/" \
     "$SRC/stages/simulate/scenarios/tilted_husky_vlp16.txtpb"
@@ -77,6 +89,8 @@ scenario() {
       [ "$FAULT" = idle_vibration ] && when=ALWAYS
       echo "  imu_vibration { frequency_hz: $HZ accel_amplitude_mps2: $ACCEL"
       echo "    gyro_amplitude_radps: $GYRO when: $when }" ;;
+    drift)
+      echo "  lidar_clock_drift_ppm: $DRIFT" ;;
   esac
   echo "}"
 }
@@ -113,9 +127,24 @@ ax = scale(k, 'accel', 'x'); tax = scale(truth, 'accel_intrinsics', 'x')
 ay = scale(k, 'accel', 'y'); tay = scale(truth, 'accel_intrinsics', 'y')
 v = first(cal, 'imu_vibration') or {}
 filtered = 'm=%d' % int(float(first(v, 'decimation'))) if first(v, 'filtered') == 'true' else 'no'
-print('%.3f  %6.1f %6.1f %6.1f  %6.2f  %-3s %8.0f  %6.0f/%6.0f  %6.0f/%6.0f  %6.0f/%6.0f  %-4s' % (
+# The clock drift: rate and sigma, and tau at the first / last scan against
+# the truth's scans (true_stamp - stamp) there.
+dr = first(cal, 'time_offset_drift') or {}
+rate = ('%+.2f±%.2f' % (float(first(dr, 'rate_ppm') or 0), float(first(dr, 'rate_sigma_ppm') or 0))
+        if first(dr, 'estimated') == 'true' else '-')
+scans = truth.get('scans', [])
+def true_tau(s):
+    return (int(first(s, 'true_stamp_ns')) - int(first(s, 'stamp_ns'))) * 1e-9
+ends = '- -'
+if scans and dr:
+    ends = '%+.3f %+.3f' % (
+        (float(first(dr, 'time_offset_start_s') or 0) - true_tau(scans[0])) * 1e3,
+        (float(first(dr, 'time_offset_end_s') or 0) - true_tau(scans[-1])) * 1e3)
+total = next((float(first(t, 'seconds')) for t in cal.get('timings', [])
+              if first(t, 'phase') == 'total'), 0.0)
+print('%.3f  %6.1f %6.1f %6.1f  %6.2f  %-3s %8.0f  %6.0f/%6.0f  %6.0f/%6.0f  %6.0f/%6.0f  %-4s  %s  %s  %.0f' % (
     rot, *[(a - b) * 1e3 for a, b in zip(r1, r2)], tau, 'yes' if est else 'no', score,
-    gz, tgz, ax, tax, ay, tay, filtered))
+    gz, tgz, ax, tax, ay, tay, filtered, rate, ends, total))
 PYEOF
 }
 
@@ -145,7 +174,7 @@ run() {
 
 export SRC
 echo "fault $FAULT; mode: $BLOCK.mode"
-echo "seed  ground  mode  exit  verdict  rot_deg  dx_mm  dy_mm  dz_mm  tau_ms  est  score  gyro_z/truth  acc_x/truth  acc_y/truth  filtered  make"
+echo "seed  ground  mode  exit  verdict  rot_deg  dx_mm  dy_mm  dz_mm  tau_ms  est  score  gyro_z/truth  acc_x/truth  acc_y/truth  filtered  rate_ppm  tau_start/end_err_ms  calibrate_s  make"
 for seed in ${SEEDS//,/ }; do
   for kind in flat tilted; do
     scenario $kind "$seed" > "$SCRATCH/$kind.$seed.scenario.txtpb"

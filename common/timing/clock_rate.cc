@@ -100,4 +100,20 @@ std::string DescribeClockDrift(const RelativeClockRate& rate, double overlap_s,
       max_drift_s / (std::abs(rate.rate_ppm) * 1e-6));
 }
 
+double TimeOffsetSigmaAt(double dt_s, double var_tau0_s2, double var_rho, double cov_tau0_rho_s) {
+  const double variance = var_tau0_s2 + dt_s * dt_s * var_rho + 2.0 * dt_s * cov_tau0_rho_s;
+  return variance > 0.0 ? std::sqrt(variance) : 0.0;
+}
+
+std::string DescribeDriftAdvice(double rate_ppm, double span_s, double tau_start_s,
+                                double tau_end_s) {
+  return fmt::format(
+      "the LiDAR clock runs {:+.1f} ppm against the IMU's: tau drifts {:+.2f} ms over {:.1f} s "
+      "(from {:.2f} ms at the start to {:.2f} ms at the end); synchronise the clocks (PTP, GPS "
+      "PPS), or know that the time offset given here is the one at the sequence's middle and "
+      "is off by up to {:.2f} ms at its ends",
+      rate_ppm, 1e3 * (tau_end_s - tau_start_s), span_s, 1e3 * tau_start_s, 1e3 * tau_end_s,
+      0.5e3 * std::abs(tau_end_s - tau_start_s));
+}
+
 }  // namespace tiltcal::timing

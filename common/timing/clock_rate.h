@@ -45,6 +45,37 @@ inline const std::string kClockDriftNotePrefix = "clocks: ";
 std::string DescribeClockDrift(const RelativeClockRate& rate, double overlap_s,
                                double max_drift_s);
 
+// A time offset that drifts linearly (the calibration's clock model,
+// docs/design.md §5): a LiDAR stamp t (s, LiDAR clock, from any fixed origin)
+// happened at IMU time t + tau(t) with
+//   tau(t) = tau0 + rho (t - t_ref),
+// rho = d tau / d t dimensionless. The LiDAR clock's rate against the IMU's
+// is dt_l / dt_imu - 1 = 1 / (1 + rho) - 1 = -rho to first order (rho of a
+// few hundred ppm: the second order is 1e-7 of it), so a LiDAR clock that
+// runs fast (rate > 0) makes tau fall over the sequence.
+struct LinearTimeOffset {
+  double tau0_s = 0.0;       // tau at reference_s, s
+  double rho = 0.0;          // d tau / d t
+  double reference_s = 0.0;  // t_ref, s
+  // Exactly tau0_s when rho is 0.
+  double At(double t_s) const { return rho == 0.0 ? tau0_s : tau0_s + rho * (t_s - reference_s); }
+  // The LiDAR clock's rate against the IMU's, ppm (> 0: the LiDAR clock is fast).
+  double LidarRatePpm() const { return -rho * 1e6; }
+};
+
+// sigma of tau(t) = tau0 + rho dt, dt = t - t_ref, from var(tau0), var(rho)
+// and cov(tau0, rho): sqrt(var_tau0 + dt^2 var_rho + 2 dt cov), s (0 when
+// the variance is not positive).
+double TimeOffsetSigmaAt(double dt_s, double var_tau0_s2, double var_rho, double cov_tau0_rho_s);
+
+// What a user should do about a drifting clock, one sentence, e.g. "the
+// LiDAR clock runs +50.0 ppm against the IMU's: tau drifts -8.00 ms over
+// 160.0 s (from 4.00 ms at the start to -4.00 ms at the end); synchronise
+// the clocks (PTP, GPS PPS), or know that the time offset given here is the
+// one at the sequence's middle". rate_ppm: the LiDAR's rate (LidarRatePpm).
+std::string DescribeDriftAdvice(double rate_ppm, double span_s, double tau_start_s,
+                                double tau_end_s);
+
 }  // namespace tiltcal::timing
 
 #endif  // TILTCAL_COMMON_TIMING_CLOCK_RATE_H_

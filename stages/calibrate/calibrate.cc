@@ -31,6 +31,7 @@
 #include "stages/calibrate/problem_builder.h"
 #include "stages/calibrate/residual_statistics.h"
 #include "stages/calibrate/solve_check.h"
+#include "stages/calibrate/time_offset_drift.h"
 #include "stages/calibrate/verdict.h"
 
 namespace tiltcal::calibrate {
@@ -236,6 +237,7 @@ Status RunOuterRound(const OuterLoopSetup& setup, CalibrationState* state, Outer
   const Eigen::Quaterniond rotation_before = state->ImuFromLidarRotation();
   const Eigen::Vector3d translation_before = state->ImuFromLidarTranslation();
   const double tau_before = state->time_offset_s[0];
+  const double rho_before = state->clock_rate[0];
   AssociationStageSummary assoc;
   BuildMapAndAssociate(*state, setup.inputs.scans, params.map(), params.association(),
                        static_cast<int>(params.num_threads()), &loop->lidar, &assoc);
@@ -297,6 +299,14 @@ Status RunOuterRound(const OuterLoopSetup& setup, CalibrationState* state, Outer
   }
   loop->moved_m = moved_b.norm();
   loop->moved_s = std::abs(state->time_offset_s[0] - tau_before);
+  if (setup.problem_options.estimate_clock_rate) {
+    // tau at the scans' ends moved by the rate's change times the half span.
+    const double rho_moved = std::abs(state->clock_rate[0] - rho_before);
+    loop->moved_s =
+        std::max(loop->moved_s, rho_moved * setup.problem_options.clock_rate_half_length_s);
+    Log(log, fmt::format("outer {}: clock rate {:+.2f} ppm (LiDAR against IMU), moved {:.2f} ppm",
+                         round, -state->clock_rate[0] * 1e6, rho_moved * 1e6));
+  }
   const proto::OuterLoopParams& stop = params.outer_loop();
   *settled = round >= 2 && loop->moved_deg < stop.stop_rotation_deg() &&
              loop->moved_m < stop.stop_translation_m() &&
@@ -426,20 +436,47 @@ void AddImuIntrinsicsNote(proto::CalibrationResult* result, std::ostream* log) {
   Log(log, line);
 }
 
+// The clock drift's report (time_offset_drift.h) from the last problem and
+// the covariance's rho row, its observability entry, and, when rho was
+// estimated, its verdict note (also on stderr).
+void FillTimeOffsetDrift(const proto::CalibrateParams& params,
+                         const TimeOffsetDriftDecision& decision, const ScanTimeSpan& span,
+                         const CalibrationState& state, const CalibrationProblem& problem,
+                         const std::vector<double>& clock_rate_row,
+                         proto::CalibrationResult* result, std::ostream* log) {
+  const double sigma_tau = result->time_offset_sigma_s();
+  proto::TimeOffsetDriftReport* report = result->mutable_time_offset_drift();
+  FillTimeOffsetDriftReport(params.time_offset_drift(), decision, span, state.time_offset_s[0],
+                            state.clock_rate[0],
+                            {problem.clock_rate_lower(), problem.clock_rate_upper()},
+                            clock_rate_row, sigma_tau * sigma_tau,
+                            params.observability().weak_time_offset_sigma_s(), report);
+  AddClockRateObservability(*report, params.observability(), result);
+  const std::string note = DescribeTimeOffsetDrift(*report);
+  if (note.empty()) return;
+  result->add_verdict_notes(note);
+  Log(log, note);
+}
+
 // Covariance and observability on the last problem (the extrinsic and tau do
 // not depend on the world gauge).
 // *intrinsics_covariance: that of the IMU intrinsics when they are estimated
 // (covariance_report.h), else empty.
+// *clock_rate_row: rho's row of the covariance (covariance_report.h), scaled
+// as the 7x7, when the drift is estimated; else empty.
 void FillCovariance(const CalibrateInputs& inputs, const proto::CalibrateParams& params,
                     CalibrationProblem* problem, CalibrationState* state,
-                    proto::CalibrationResult* result, Eigen::MatrixXd* intrinsics_covariance) {
+                    proto::CalibrationResult* result, Eigen::MatrixXd* intrinsics_covariance,
+                    std::vector<double>* clock_rate_row) {
   const auto start = Clock::now();
   intrinsics_covariance->resize(0, 0);
+  clock_rate_row->clear();
   if (params.observability().compute_covariance()) {
     Matrix7d cov;
-    Status cs = ComputeExtrinsicCovariance(problem->problem(), state, params.observability(),
-                                           static_cast<int>(params.num_threads()), &cov,
-                                           intrinsics_covariance);
+    Status cs = ComputeExtrinsicCovariance(
+        problem->problem(), state, params.observability(), static_cast<int>(params.num_threads()),
+        &cov, intrinsics_covariance,
+        ClockRateInProblem(*state, *problem->problem()) ? clock_rate_row : nullptr);
     if (cs.ok()) {
       const VarianceFactor factor = ComputeVarianceFactor(problem->problem());
       result->set_variance_factor(factor.sigma0_squared);
@@ -453,12 +490,29 @@ void FillCovariance(const CalibrateInputs& inputs, const proto::CalibrateParams&
         Matrix7d prior_information = Matrix7d::Zero();
         prior_information.block<3, 3>(3, 3) = geometry::TranslationPriorInformation(
             result->translation_prior_sigma_m(), ToEigen(result->translation_prior_axis_b()));
-        cov = ScaleDataInformation(cov, prior_information, factor.sigma0_squared);
+        if (clock_rate_row->size() == 8) {
+          // The 7 and rho together (rho has no prior).
+          Eigen::MatrixXd full = Eigen::MatrixXd::Zero(8, 8);
+          full.topLeftCorner<7, 7>() = cov;
+          for (int j = 0; j < 8; ++j) {
+            full(7, j) = full(j, 7) = (*clock_rate_row)[static_cast<size_t>(j)];
+          }
+          Eigen::MatrixXd prior_full = Eigen::MatrixXd::Zero(8, 8);
+          prior_full.topLeftCorner<7, 7>() = prior_information;
+          full = ScaleDataInformation(full, prior_full, factor.sigma0_squared);
+          cov = full.topLeftCorner<7, 7>();
+          for (int j = 0; j < 8; ++j) (*clock_rate_row)[static_cast<size_t>(j)] = full(7, j);
+        } else {
+          cov = ScaleDataInformation(cov, prior_information, factor.sigma0_squared);
+        }
         result->set_covariance_scaled_by_variance_factor(true);
       }
       // A covariance that is not finite is no covariance (SUSPECT), never
       // NaN sigmas next to an OK verdict.
       if (!cov.allFinite()) cs = Status::Error("covariance: not finite");
+      for (const double c : *clock_rate_row) {
+        if (!std::isfinite(c)) cs = Status::Error("covariance: the clock rate's is not finite");
+      }
     }
     if (cs.ok()) {
       const MotionAxis motion = PrincipalRotationAxis(inputs.imu, state->GyroBias());
@@ -466,6 +520,7 @@ void FillCovariance(const CalibrateInputs& inputs, const proto::CalibrateParams&
       FillCovarianceReport(cov, state->ImuFromLidarRotation().toRotationMatrix(), motion,
                            params.observability(), result);
     } else {
+      clock_rate_row->clear();
       proto::ObservabilityDirection* d = result->add_observability();
       d->set_weak(true);
       d->set_description(cs.message());
@@ -654,6 +709,17 @@ Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& pa
   problem_options.translation_prior_m = ToEigen(inputs.rig.imu_from_lidar()).translation;
   problem_options.translation_prior_sigma_m = params.extrinsic_translation_prior_sigma_m();
   problem_options.translation_prior_axis_b = init.rotation_axis_b;
+  // Clock drift (time_offset_drift.h): t_ref the middle of the scans' stamps;
+  // rho starts at 0 from the single tau of the initialisation.
+  const ScanTimeSpan span = ScanStampSpan(inputs.scans);
+  state.time_reference_s = span.reference_s;
+  const TimeOffsetDriftDecision drift =
+      DecideTimeOffsetDrift(params.time_offset_drift(), inputs.clock_drift, span);
+  problem_options.estimate_clock_rate = drift.estimate;
+  problem_options.clock_rate_max_ppm = params.time_offset_drift().max_rate_ppm();
+  problem_options.clock_rate_half_length_s = span.half_length_s();
+  Log(log, std::string("clock drift ") + (drift.estimate ? "estimated" : "not estimated") + ": " +
+               drift.reason);
   result->set_translation_prior_sigma_m(problem_options.translation_prior_sigma_m);
   *result->mutable_translation_prior_axis_b() = ToProto(init.rotation_axis_b.normalized());
   // IMU intrinsics (imu_intrinsics.h): ON from the first round; AUTO from
@@ -690,11 +756,14 @@ Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& pa
       std::async(params.num_threads() > 1 ? std::launch::async : std::launch::deferred,
                  MeasureBothMapSharpnesses, std::cref(inputs), std::cref(params), std::cref(state));
   Eigen::MatrixXd intrinsics_covariance;
-  FillCovariance(inputs, params, loop.problem.get(), &state, result, &intrinsics_covariance);
+  std::vector<double> clock_rate_row;
+  FillCovariance(inputs, params, loop.problem.get(), &state, result, &intrinsics_covariance,
+                 &clock_rate_row);
   FillImuIntrinsics(intrinsics, loop, problem_options.estimate_imu_intrinsics, state,
                     intrinsics_covariance, result);
   FillVerdictFacts(inputs, params, init, loop.problem.get(), state, sharpness.get(), result);
   AddImuIntrinsicsNote(result, log);
+  FillTimeOffsetDrift(params, drift, span, state, *loop.problem, clock_rate_row, result, log);
   loop.problem.reset();
 
   ReexpressInFirstImuFrame(&state);

@@ -3,6 +3,7 @@
 #include <string>
 
 #include <fmt/format.h>
+#include <google/protobuf/text_format.h>
 
 #include "common/io/params.h"
 #include "stages/calibrate/bias_segments.h"
@@ -120,6 +121,15 @@ Status ValidateCalibrateParams(const proto::CalibrateParams& params) {
 
 Status LoadCalibrateParams(const std::string& path, proto::CalibrateParams* params) {
   TILTCAL_RETURN_IF_ERROR(LoadParamsOrDefaults(path, DefaultParamsText(), params));
+  // Optional messages (a params file older than them keeps working): the
+  // compiled-in defaults.
+  if (!params->has_time_offset_drift()) {
+    proto::CalibrateParams defaults;
+    if (!google::protobuf::TextFormat::ParseFromString(std::string(DefaultParamsText()), &defaults)) {
+      return Status::Error("default CalibrateParams: not readable");
+    }
+    *params->mutable_time_offset_drift() = defaults.time_offset_drift();
+  }
   return ValidateCalibrateParams(*params).WithContext(path.empty() ? "default CalibrateParams"
                                                                    : path);
 }

@@ -8,7 +8,8 @@
 //
 // Frames: IMU b, LiDAR l, world a = the IMU frame at the first IMU sample.
 // Times: double seconds relative to the first IMU stamp (IMU clock). A LiDAR
-// time t_l happened at IMU time t = t_l + tau.
+// time t_l happened at IMU time t = t_l + tau(t_l), with the linear clock
+// drift tau(t_l) = tau0 + rho (t_l - t_ref) (TimeOffsetAt; rho = 0: one tau).
 //
 // Blocks (all owned here) and their manifolds, as set by the problem builder
 // (problem_builder.h) BEFORE any residual is added:
@@ -19,7 +20,11 @@
 //                                spline::RightQuaternionManifold;
 //   imu_from_lidar_translation   3 doubles, r_b^{lb}, m;
 //   time_offset_s                1 double, tau, s, bounded (lower/upper bound
-//                                set on the block);
+//                                set on the block); with a clock drift, tau0:
+//                                tau at time_reference_s;
+//   clock_rate                   1 double, rho, dimensionless (ppm * 1e-6),
+//                                bounded; in the problem only when the drift
+//                                is estimated (time_offset_drift.h), else 0;
 //   gravity_direction            3 doubles, unit vector n_g in a pointing DOWN
 //                                (g_a = gravity_norm_mps2 * n_g),
 //                                ceres::SphereManifold<3>;
@@ -73,7 +78,10 @@ struct CalibrationState {
   spline::SplineTrajectory trajectory;
   double imu_from_lidar_rotation[4] = {0.0, 0.0, 0.0, 1.0};  // C_bl (x, y, z, w)
   double imu_from_lidar_translation[3] = {0.0, 0.0, 0.0};    // r_b^{lb}, m
-  double time_offset_s[1] = {0.0};                           // tau, s
+  double time_offset_s[1] = {0.0};                           // tau (tau0), s
+  double clock_rate[1] = {0.0};                              // rho, dimensionless
+  // t_ref of the drift: LiDAR clock, s from the first IMU stamp.
+  double time_reference_s = 0.0;
   double gravity_direction[3] = {0.0, 0.0, -1.0};            // n_g, unit, frame a, down
   double gravity_norm_mps2 = 9.81;                           // |g_a|, fixed
   BiasSegments gyro_bias;   // b_g, rad/s
@@ -139,11 +147,19 @@ struct CalibrationState {
   void SetGyroBias(const Eigen::Vector3d& b) { gyro_bias.SetAll(b); }
   void SetAccelBias(const Eigen::Vector3d& b) { accel_bias.SetAll(b); }
 
+  // tau at LiDAR time t_lidar_s (s from the first IMU stamp, LiDAR clock):
+  //   tau(t) = tau0 + rho (t - t_ref),
+  // exactly tau0 when rho is 0 (the single-tau path is unchanged bit for bit).
+  double TimeOffsetAt(double t_lidar_s) const {
+    if (clock_rate[0] == 0.0) return time_offset_s[0];
+    return time_offset_s[0] + clock_rate[0] * (t_lidar_s - time_reference_s);
+  }
+
   // The frozen knot window of a residual at LiDAR time t_lidar_s, chosen with
-  // the current tau: Locate(t_lidar_s + tau). Returns false when that time is
-  // outside the spline (the residual is then skipped).
+  // the current tau: Locate(t_lidar_s + tau(t_lidar_s)). Returns false when
+  // that time is outside the spline (the residual is then skipped).
   bool TimeWindow(double t_lidar_s, spline::KnotWindow* window) const {
-    return trajectory.grid().Locate(t_lidar_s + time_offset_s[0], window);
+    return trajectory.grid().Locate(t_lidar_s + TimeOffsetAt(t_lidar_s), window);
   }
 };
 

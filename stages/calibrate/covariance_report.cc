@@ -36,8 +36,13 @@ MotionAxis PrincipalRotationAxis(const std::vector<imu::ImuReading>& samples,
 
 Status ComputeExtrinsicCovariance(ceres::Problem* problem, CalibrationState* state,
                                   const proto::ObservabilityParams& params, int num_threads,
-                                  Matrix7d* covariance, Eigen::MatrixXd* intrinsics_covariance) {
+                                  Matrix7d* covariance, Eigen::MatrixXd* intrinsics_covariance,
+                                  std::vector<double>* clock_rate_row) {
   covariance->setZero();
+  if (clock_rate_row != nullptr) clock_rate_row->clear();
+  // rho, marginalised last when asked for and free.
+  const bool with_rate = clock_rate_row != nullptr && problem->HasParameterBlock(state->clock_rate) &&
+                         !problem->IsParameterBlockConstant(state->clock_rate);
   if (intrinsics_covariance != nullptr) intrinsics_covariance->resize(0, 0);
   // The triad errors, marginalised last (before the 7) when asked for
   // and free.
@@ -71,8 +76,9 @@ Status ComputeExtrinsicCovariance(ceres::Problem* problem, CalibrationState* sta
   for (double* b : blocks) {
     const bool calibration = std::any_of(std::begin(groups), std::end(groups),
                                          [b](const Group& g) { return g.block == b; });
-    const bool last = calibration || std::find(intrinsics.begin(), intrinsics.end(), b) !=
-                                         intrinsics.end();
+    const bool last = calibration ||
+                      std::find(intrinsics.begin(), intrinsics.end(), b) != intrinsics.end() ||
+                      (with_rate && b == state->clock_rate);
     if (!last && !problem->IsParameterBlockConstant(b)) ordered.push_back(b);
   }
   ordered.insert(ordered.end(), intrinsics.begin(), intrinsics.end());
@@ -89,6 +95,10 @@ Status ComputeExtrinsicCovariance(ceres::Problem* problem, CalibrationState* sta
   }
   if (k == intrinsics_size) {
     return Status::Error("covariance: the extrinsic and time offset are held constant");
+  }
+  if (with_rate) {
+    ordered.push_back(state->clock_rate);
+    ++k;
   }
 
   ceres::Problem::EvaluateOptions options;
@@ -118,6 +128,19 @@ Status ComputeExtrinsicCovariance(ceres::Problem* problem, CalibrationState* sta
     }
     row += gi->size;
   }
+  if (with_rate) {
+    // rho's row: its covariance with the free groups, then its variance.
+    const Eigen::Index rate = marginal.rows() - 1;
+    clock_rate_row->assign(8, 0.0);
+    int col = intrinsics_size;
+    for (const Group* g : free_groups) {
+      for (int j = 0; j < g->size; ++j) {
+        (*clock_rate_row)[static_cast<size_t>(g->offset + j)] = marginal(rate, col + j);
+      }
+      col += g->size;
+    }
+    (*clock_rate_row)[7] = marginal(rate, rate);
+  }
   return Status::Ok();
 }
 
@@ -144,9 +167,17 @@ VarianceFactor ComputeVarianceFactor(ceres::Problem* problem) {
 
 Matrix7d ScaleDataInformation(const Matrix7d& covariance, const Matrix7d& prior_information,
                               double sigma0_squared) {
+  return ScaleDataInformation(Eigen::MatrixXd(covariance), Eigen::MatrixXd(prior_information),
+                              sigma0_squared);
+}
+
+Eigen::MatrixXd ScaleDataInformation(const Eigen::MatrixXd& covariance,
+                                     const Eigen::MatrixXd& prior_information,
+                                     double sigma0_squared) {
   // Only the estimated parameters: a held one has zero rows and columns.
+  const int size = static_cast<int>(covariance.rows());
   std::vector<int> free;
-  for (int i = 0; i < 7; ++i) {
+  for (int i = 0; i < size; ++i) {
     if (covariance(i, i) > 0.0) free.push_back(i);
   }
   const int n = static_cast<int>(free.size());
@@ -160,7 +191,7 @@ Matrix7d ScaleDataInformation(const Matrix7d& covariance, const Matrix7d& prior_
   const Eigen::MatrixXd information = sub_covariance.inverse();
   const Eigen::MatrixXd scaled = (information - sub_prior) / sigma0_squared + sub_prior;
   const Eigen::MatrixXd sub_out = scaled.inverse();
-  Matrix7d out = Matrix7d::Zero();
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(size, size);
   for (int r = 0; r < n; ++r) {
     for (int c = 0; c < n; ++c) out(free[r], free[c]) = 0.5 * (sub_out(r, c) + sub_out(c, r));
   }
@@ -242,6 +273,24 @@ void FillCovarianceReport(const Matrix7d& covariance, const Eigen::Matrix3d& c_b
     std::snprintf(buf, sizeof(buf), "time offset: sigma %.4g s%s", tau_sigma,
                   tau_sigma > params.weak_time_offset_sigma_s() ? " -- WEAK" : "");
   }
+  d->set_description(buf);
+}
+
+void AddClockRateObservability(const proto::TimeOffsetDriftReport& report,
+                               const proto::ObservabilityParams& params,
+                               proto::CalibrationResult* result) {
+  if (!report.estimated() || report.covariance_row_size() != 8) return;
+  proto::ObservabilityDirection* d = result->add_observability();
+  for (int j = 0; j < 8; ++j) d->add_direction(j == 7 ? 1.0 : 0.0);
+  d->set_sigma(report.rate_sigma_ppm() * 1e-6);
+  d->set_weak(report.weak());
+  const double span_s = report.end_time_s() - report.start_time_s();
+  char buf[256];
+  std::snprintf(buf, sizeof(buf),
+                "clock rate (tau drift): sigma %.3g ppm, %.3g ms over the scans' %.1f s "
+                "(observability.weak_time_offset_sigma_s %.3g ms)%s",
+                report.rate_sigma_ppm(), report.rate_sigma_ppm() * 1e-3 * span_s, span_s,
+                params.weak_time_offset_sigma_s() * 1e3, report.weak() ? " -- WEAK" : "");
   d->set_description(buf);
 }
 

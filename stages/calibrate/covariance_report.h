@@ -59,10 +59,16 @@ MotionAxis PrincipalRotationAxis(const std::vector<imu::ImuReading>& samples,
 // they are marginalised last as well and their covariance (12x12, tangent:
 // E_g's 6 lower-triangular entries row by row, then E_a's)
 // is returned there; otherwise it is left empty.
+// With clock_rate_row and the clock rate rho free in the problem (the drift
+// is estimated, time_offset_drift.h), rho is marginalised last, after the 7,
+// and its row of the 8x8 covariance is returned there: cov(rho, .) with the
+// 7 above, then var(rho) (rho dimensionless); otherwise it is left empty.
+// The 7x7 is the marginal covariance of the 7 either way.
 Status ComputeExtrinsicCovariance(ceres::Problem* problem, CalibrationState* state,
                                   const proto::ObservabilityParams& params, int num_threads,
                                   Matrix7d* covariance,
-                                  Eigen::MatrixXd* intrinsics_covariance = nullptr);
+                                  Eigen::MatrixXd* intrinsics_covariance = nullptr,
+                                  std::vector<double>* clock_rate_row = nullptr);
 
 // A-posteriori variance factor of the weighted least-squares problem at its
 // current parameters: sigma0^2 = 2 F / (m - n), F the cost with the robust
@@ -85,6 +91,10 @@ VarianceFactor ComputeVarianceFactor(ceres::Problem* problem);
 // columns; the rest is computed without them.
 Matrix7d ScaleDataInformation(const Matrix7d& covariance, const Matrix7d& prior_information,
                               double sigma0_squared);
+// The same for any size (n x n; the 7 and rho when the drift is estimated).
+Eigen::MatrixXd ScaleDataInformation(const Eigen::MatrixXd& covariance,
+                                     const Eigen::MatrixXd& prior_information,
+                                     double sigma0_squared);
 
 // Writes covariance, rotation_sigma_deg, translation_sigma_m,
 // time_offset_sigma_s and the observability directions into *result; a
@@ -94,6 +104,13 @@ Matrix7d ScaleDataInformation(const Matrix7d& covariance, const Matrix7d& prior_
 void FillCovarianceReport(const Matrix7d& covariance, const Eigen::Matrix3d& c_bl,
                           const MotionAxis& motion, const proto::ObservabilityParams& params,
                           proto::CalibrationResult* result);
+
+// Adds the clock rate's observability entry (its sigma in ppm and the drift
+// sigma over the scans' span; direction: 8 values, the 8th rho's) when the
+// drift report is estimated and has a covariance; weak as report.weak().
+void AddClockRateObservability(const proto::TimeOffsetDriftReport& report,
+                               const proto::ObservabilityParams& params,
+                               proto::CalibrationResult* result);
 
 // "x", "y", "z" of the dominant component and the direction, e.g.
 // "(0.01, -0.02, 1.00)".

@@ -11,7 +11,9 @@
 #include <Eigen/Geometry>
 
 #include "common/spline/so3_spline.h"
+#include "stages/calibrate/drifting_time_offset_cost_function.h"
 #include "stages/calibrate/ground_cost_functions.h"
+#include "stages/calibrate/problem_builder.h"
 
 namespace tiltcal::calibrate {
 namespace {
@@ -234,6 +236,24 @@ struct GroundPlaneSample {
   Eigen::Matrix4d covariance = Eigen::Matrix4d::Zero();
 };
 
+// Adds a flat or inclination residual of scan time t_k (blocks: 4 rotation
+// knots, n_g, C_bl, tau); with the clock drift in the problem, wrapped so
+// that tau is tau(t_k) = tau0 + rho (t_k - t_ref) (rho appended,
+// drifting_time_offset_cost_function.h).
+void AddTimedResidual(ceres::CostFunction* cost, ceres::LossFunction* loss, double t_k,
+                      double* const knots[4], CalibrationState* state, ceres::Problem* problem) {
+  if (!ClockRateInProblem(*state, *problem)) {
+    problem->AddResidualBlock(cost, loss, knots[0], knots[1], knots[2], knots[3],
+                              state->gravity_direction, state->imu_from_lidar_rotation,
+                              state->time_offset_s);
+    return;
+  }
+  problem->AddResidualBlock(
+      new DriftingTimeOffsetCostFunction(cost, 6, t_k - state->time_reference_s), loss,
+      {knots[0], knots[1], knots[2], knots[3], state->gravity_direction,
+       state->imu_from_lidar_rotation, state->time_offset_s, state->clock_rate});
+}
+
 // Adds the selected residuals of one plane.
 Status AddPlaneResiduals(const GroundBuild& build, const GroundPlaneSample& plane,
                          CalibrationState* state, ceres::Problem* problem,
@@ -257,9 +277,7 @@ Status AddPlaneResiduals(const GroundBuild& build, const GroundPlaneSample& plan
                                       : Eigen::Matrix3d::Zero();
     auto* cost = new FlatGroundCostFunction(segment_start_s, grid.inv_dt(), plane.t_k, plane.normal,
                                             WhiteningMatrix(params.flat().sigma(), extra));
-    problem->AddResidualBlock(cost, build.losses.flat(), knots[0], knots[1], knots[2], knots[3],
-                              state->gravity_direction, state->imu_from_lidar_rotation,
-                              state->time_offset_s);
+    AddTimedResidual(cost, build.losses.flat(), plane.t_k, knots, state, problem);
     ++summary->num_flat;
   }
   if (selection.dist) {
@@ -282,7 +300,7 @@ Status AddPlaneResiduals(const GroundBuild& build, const GroundPlaneSample& plan
       const double* const const_knots[4] = {knots[0], knots[1], knots[2], knots[3]};
       spline::So3SplineSample s;
       spline::EvaluateSo3Spline(
-          const_knots, (plane.t_k + state->time_offset_s[0] - segment_start_s) * grid.inv_dt(),
+          const_knots, (plane.t_k + state->TimeOffsetAt(plane.t_k) - segment_start_s) * grid.inv_dt(),
           grid.inv_dt(), spline::kSo3Rotation, &s);
       const Eigen::Vector3d up_l =
           build.c_bl.transpose() * (-(s.rotation.transpose() * build.gravity_dir));
@@ -291,9 +309,7 @@ Status AddPlaneResiduals(const GroundBuild& build, const GroundPlaneSample& plan
     auto* cost = new InclinationCostFunction(segment_start_s, grid.inv_dt(), plane.t_k,
                                              plane.normal, build.info.gravity_flat_in_imu,
                                              1.0 / std::sqrt(variance));
-    problem->AddResidualBlock(cost, build.losses.incl(), knots[0], knots[1], knots[2], knots[3],
-                              state->gravity_direction, state->imu_from_lidar_rotation,
-                              state->time_offset_s);
+    AddTimedResidual(cost, build.losses.incl(), plane.t_k, knots, state, problem);
     ++summary->num_incl;
   }
   if (selection.up) {

@@ -6,7 +6,8 @@
 //
 // Times: seconds relative to the first IMU stamp, on the LiDAR clock:
 //   t_j = (stamp_ns - first_imu_stamp_ns) * 1e-9 + point_time_s[j],
-// and the point happened at IMU time t_j + tau.
+// and the point happened at IMU time t_j + tau (with a clock drift, tau at
+// the scan stamp: CalibrationState::TimeOffsetAt(t_k) for the whole sweep).
 
 #include <cstdint>
 #include <string>

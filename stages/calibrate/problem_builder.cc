@@ -8,10 +8,12 @@
 #include "common/spline/so3_spline.h"
 #include "stages/calibrate/accel_cost_function.h"
 #include "stages/calibrate/bias_random_walk_cost_function.h"
+#include "stages/calibrate/drifting_time_offset_cost_function.h"
 #include "stages/calibrate/gyro_cost_function.h"
 #include "stages/calibrate/interval_manifold.h"
 #include "stages/calibrate/point_to_plane_cost_function.h"
 #include "stages/calibrate/stacked_cost_function.h"
+#include "stages/calibrate/time_offset_drift.h"
 #include "stages/calibrate/triad_errors_prior_cost_function.h"
 
 namespace tiltcal::calibrate {
@@ -91,6 +93,22 @@ CalibrationProblem::CalibrationProblem(CalibrationState* state,
     p.SetManifold(state_->time_offset_s, time_offset_manifold_.get());
   } else {
     p.SetParameterBlockConstant(state_->time_offset_s);
+  }
+  // rho (only with the drift; see problem_builder.h), clamped into its bounds.
+  if (options_.estimate_clock_rate) {
+    const ClockRateBounds rho = ClockRateBoundsOfBuild(
+        state_->clock_rate[0], options_.clock_rate_max_ppm, options_.time_offset_step_bound_s,
+        options_.clock_rate_half_length_s);
+    rho_lower_ = rho.lower;
+    rho_upper_ = rho.upper;
+    state_->clock_rate[0] = std::clamp(state_->clock_rate[0], rho_lower_, rho_upper_);
+    p.AddParameterBlock(state_->clock_rate, 1);
+    if (rho_upper_ > rho_lower_) {
+      clock_rate_manifold_ = std::make_unique<IntervalManifold>(rho_lower_, rho_upper_);
+      p.SetManifold(state_->clock_rate, clock_rate_manifold_.get());
+    } else {
+      p.SetParameterBlockConstant(state_->clock_rate);
+    }
   }
   if (!options_.estimate_extrinsic) {
     p.SetParameterBlockConstant(state_->imu_from_lidar_rotation);
@@ -184,6 +202,7 @@ void CalibrationProblem::AddLidarResiduals(const std::vector<LidarPointResidual>
   spline::SplineTrajectory& traj = state_->trajectory;
   const spline::UniformKnotGrid& grid = traj.grid();
   StackedResidualAdder rows(lidar_loss_.get());
+  const bool drift = ClockRateInProblem(*state_, *problem_);
   for (const LidarPointResidual& r : points) {
     spline::KnotWindow w;
     if (!state_->TimeWindow(r.time_s, &w)) {
@@ -199,7 +218,14 @@ void CalibrationProblem::AddLidarResiduals(const std::vector<LidarPointResidual>
         traj.rotation_knot(k + 3), traj.position_knot(k), traj.position_knot(k + 1),
         traj.position_knot(k + 2), traj.position_knot(k + 3), state_->imu_from_lidar_rotation,
         state_->imu_from_lidar_translation, state_->time_offset_s};
-    rows.Add(row, std::move(blocks));
+    if (drift) {
+      // tau(t_j) = tau0 + rho (t_j - t_ref); rho is the last block.
+      blocks.push_back(state_->clock_rate);
+      rows.Add(new DriftingTimeOffsetCostFunction(row, 10, r.time_s - state_->time_reference_s),
+               std::move(blocks));
+    } else {
+      rows.Add(row, std::move(blocks));
+    }
     ++counts_.lidar_residuals;
     MarkKnots(k, true);
   }
@@ -246,6 +272,7 @@ void CalibrationProblem::RemoveUnusedKnots() {
                     state_->gyro_triad_errors.data(), state_->accel_triad_errors.data()}) {
     blocks.push_back(b);
   }
+  if (problem_->HasParameterBlock(state_->clock_rate)) blocks.push_back(state_->clock_rate);
   for (double* block : blocks) {
     users.clear();
     problem_->GetResidualBlocksForParameterBlock(block, &users);
@@ -262,6 +289,10 @@ const ProblemCounts& CalibrationProblem::counts() {
   }
   counts_.free_parameters = free;
   return counts_;
+}
+
+bool ClockRateInProblem(const CalibrationState& state, const ceres::Problem& problem) {
+  return problem.HasParameterBlock(state.clock_rate);
 }
 
 ceres::Solver::Options MakeSolverOptions(const SolverSettings& settings) {

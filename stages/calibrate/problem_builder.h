@@ -53,6 +53,15 @@
 // windows of the LiDAR residuals in this build). The problem is rebuilt (and
 // the windows re-chosen) at every outer iteration.
 //
+// Clock drift (time_offset_drift.h): with estimate_clock_rate the state's
+// clock_rate rho is a block of the problem, held in
+//   [max(-R, rho_bin - S / H), min(R, rho_bin + S / H)]
+// (R = clock_rate_max_ppm * 1e-6, H = clock_rate_half_length_s, the largest |t - t_ref|),
+// and every residual that uses tau is wrapped in
+// DriftingTimeOffsetCostFunction (rho appended as its last block), the LiDAR
+// ones here, the ground ones by their adder (ClockRateInProblem). Without
+// it, rho is not in the problem and stays at its value (0).
+//
 // The object owns the manifolds and the shared loss (Ceres does not), and the
 // Problem; it must outlive any evaluation of the Problem (the covariance).
 
@@ -102,6 +111,10 @@ struct ProblemOptions {
   bool estimate_gravity = true;
   bool estimate_biases = true;
   bool estimate_imu_intrinsics = false;
+  // rho, its bound R (ppm) and H of the step bound (s); see above.
+  bool estimate_clock_rate = false;
+  double clock_rate_max_ppm = 0.0;
+  double clock_rate_half_length_s = 0.0;
   // Prior sigmas of the triad errors when they are estimated: scale (a
   // fraction) and misalignment (rad).
   double intrinsics_scale_prior_sigma = 0.0;
@@ -165,6 +178,9 @@ class CalibrationProblem {
   const ProblemCounts& counts();
   double time_offset_lower_s() const { return tau_lower_; }
   double time_offset_upper_s() const { return tau_upper_; }
+  // rho's bounds of this build (both 0 when rho is not estimated).
+  double clock_rate_lower() const { return rho_lower_; }
+  double clock_rate_upper() const { return rho_upper_; }
 
  private:
   void MarkKnots(int first_knot, bool position);
@@ -178,11 +194,14 @@ class CalibrationProblem {
   // E_g, E_a lower triangular: entries (0, 1), (0, 2), (1, 2) held.
   ceres::SubsetManifold lower_triangular_manifold_{9, {1, 2, 5}};
   std::unique_ptr<IntervalManifold> time_offset_manifold_;  // tau in its bounds
+  std::unique_ptr<IntervalManifold> clock_rate_manifold_;   // rho in its bounds
   std::unique_ptr<ceres::LossFunction> lidar_loss_;
   std::unique_ptr<ceres::Problem> problem_;
   ProblemCounts counts_;
   double tau_lower_ = 0.0;
   double tau_upper_ = 0.0;
+  double rho_lower_ = 0.0;
+  double rho_upper_ = 0.0;
   std::vector<char> rotation_used_;
   std::vector<char> position_used_;
 };
@@ -194,6 +213,11 @@ struct SolverSettings {
   double function_tolerance = 0.0;          // 0: Ceres' default
   double initial_trust_region_radius = 0.0;  // 0: Ceres' default
 };
+
+// Whether the state's clock rate rho is a block of `problem` (the drift is
+// estimated): residual adders then wrap their tau residuals
+// (DriftingTimeOffsetCostFunction).
+bool ClockRateInProblem(const CalibrationState& state, const ceres::Problem& problem);
 
 // Solver settings of the calibrator: LM, SPARSE_NORMAL_CHOLESKY (no Schur
 // solvers) and the given settings.

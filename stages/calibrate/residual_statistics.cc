@@ -5,6 +5,7 @@
 #include <functional>
 
 #include "stages/calibrate/accel_cost_function.h"
+#include "stages/calibrate/drifting_time_offset_cost_function.h"
 #include "stages/calibrate/ground_cost_functions.h"
 #include "stages/calibrate/gyro_cost_function.h"
 #include "stages/calibrate/point_to_plane_cost_function.h"
@@ -21,6 +22,9 @@ constexpr const char* kTypeNames[] = {"gyro", "accel", "lidar", "ground"};
 ResidualType TypeOf(const ceres::CostFunction* f) {
   if (const auto* stacked = dynamic_cast<const StackedCostFunction*>(f)) {
     return TypeOf(&stacked->row(0));
+  }
+  if (const auto* drifting = dynamic_cast<const DriftingTimeOffsetCostFunction*>(f)) {
+    return TypeOf(&drifting->inner());
   }
   if (dynamic_cast<const GyroCostFunction*>(f) != nullptr) return kGyro;
   if (dynamic_cast<const AccelCostFunction*>(f) != nullptr) return kAccel;

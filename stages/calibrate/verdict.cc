@@ -133,7 +133,40 @@ void CheckImuIntrinsics(const proto::CalibrationResult& r, Findings* f) {
       a.misalignment_deg().x(), a.misalignment_deg().y(), a.misalignment_deg().z()));
 }
 
-void CheckClockDrift(const proto::CalibrationResult& r, Findings* f) {
+// The clock drift: with rho estimated (time_offset_drift.h) decode's finding
+// is answered (a verdict note gives the rate and tau at both ends); rho at a
+// bound of the final solve is SUSPECT, rho undetermined WEAK. Without it,
+// decode's finding makes the single tau WEAK.
+void CheckClockDrift(const proto::CalibrationResult& r, const proto::VerdictParams& params,
+                     Findings* f) {
+  const proto::TimeOffsetDriftReport& d = r.time_offset_drift();
+  if (d.estimated()) {
+    const double half_span_s = 0.5 * (d.end_time_s() - d.start_time_s());
+    const double lower = d.rate_lower_bound_ppm();
+    const double upper = d.rate_upper_bound_ppm();
+    // at_bound_tolerance_s of tau at the scans' ends, in ppm.
+    const double tolerance_ppm =
+        half_span_s > 0.0 ? params.at_bound_tolerance_s() / half_span_s * 1e6 : 0.0;
+    if (lower < upper && (d.rate_ppm() - lower <= tolerance_ppm ||
+                          upper - d.rate_ppm() <= tolerance_ppm)) {
+      f->suspect.push_back(fmt::format(
+          "clock rate at a bound of the solve: {:+.1f} ppm, bounds [{:+.1f}, {:+.1f}] ppm; the "
+          "true rate may lie beyond it (time_offset_drift.max_rate_ppm, "
+          "outer_loop.time_offset_step_bound_s)",
+          d.rate_ppm(), lower, upper));
+    }
+    if (d.weak()) {
+      f->weak.push_back(fmt::format(
+          "clock drift not determined by this sequence: the LiDAR clock runs {:+.1f} ± {:.1f} ppm "
+          "against the IMU's, so tau is known to {:.2f} ms at the first scan and {:.2f} ms at the "
+          "last (the drift over the scans has a sigma above "
+          "observability.weak_time_offset_sigma_s){}",
+          d.rate_ppm(), d.rate_sigma_ppm(), d.time_offset_start_sigma_s() * 1e3,
+          d.time_offset_end_sigma_s() * 1e3,
+          r.clock_drift().empty() ? "" : "; decode: " + r.clock_drift()));
+    }
+    return;
+  }
   if (r.clock_drift().empty()) return;
   f->weak.push_back("τ is the offset the whole sequence fits best, not the one at every time: " +
                     r.clock_drift());
@@ -217,7 +250,7 @@ void DecideVerdict(const proto::VerdictParams& params, proto::CalibrationResult*
   CheckHandEye(*result, params, &f);
   CheckStaticStart(*result, params, &f);
   CheckImuIntrinsics(*result, &f);
-  CheckClockDrift(*result, &f);
+  CheckClockDrift(*result, params, &f);
   CheckWeakDirections(*result, &f);
   result->clear_verdict_reasons();
   if (!f.suspect.empty()) {

@@ -5,6 +5,8 @@
 
 #include <fmt/format.h>
 
+#include "common/timing/clock_rate.h"
+
 namespace tiltcal::exporter {
 namespace {
 
@@ -82,6 +84,14 @@ Status MakeExportedCalibration(const proto::CalibrationResult& calibration,
   e.verdict = VerdictName(calibration.verdict());
   e.verdict_reasons.assign(calibration.verdict_reasons().begin(),
                            calibration.verdict_reasons().end());
+  const proto::TimeOffsetDriftReport& drift = calibration.time_offset_drift();
+  if (drift.estimated()) {
+    e.clock_drift_advice = timing::DescribeDriftAdvice(
+        drift.rate_ppm(), drift.end_time_s() - drift.start_time_s(), drift.time_offset_start_s(),
+        drift.time_offset_end_s());
+  } else if (!calibration.clock_drift().empty()) {
+    e.clock_drift_advice = "tiltcal_decode: " + calibration.clock_drift();
+  }
   e.imu_frame = imu_frame;
   e.lidar_frame = lidar_frame;
   *exported = std::move(e);

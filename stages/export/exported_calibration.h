@@ -32,6 +32,10 @@ struct ExportedCalibration {
   std::optional<ExportedSigma> sigma;  // absent when the file has none
   std::string verdict;                 // "OK", "WEAK", "SUSPECT", "UNSET"
   std::vector<std::string> verdict_reasons;
+  // What to do about a drifting LiDAR clock (CalibrationResult.time_offset_drift
+  // estimated: its rate and tau at both ends; else decode's clock_drift
+  // finding), one sentence; "" when the clocks did not drift.
+  std::string clock_drift_advice;
   std::string imu_frame;    // e.g. "imu_link"
   std::string lidar_frame;  // e.g. "lidar_link"
 };

@@ -66,6 +66,7 @@ std::string HeaderText(const ExportedCalibration& c) {
   line(fmt::format("time offset tau = {} s: t_imu = t_lidar + tau (a LiDAR stamp plus tau is",
                    Num(c.time_offset_s)));
   line("  the same instant on the IMU clock; tau > 0: the LiDAR clock is behind the IMU's)");
+  if (!c.clock_drift_advice.empty()) line("clock drift: " + c.clock_drift_advice);
   if (c.sigma) {
     const ExportedSigma& s = *c.sigma;
     line(fmt::format("1-sigma: rotation {:.3g} {:.3g} {:.3g} deg (about the LiDAR axes),",

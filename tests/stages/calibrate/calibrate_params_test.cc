@@ -72,6 +72,25 @@ TEST(CalibrateParamsTest, LoadingChecksTheRulesAndNamesTheFile) {
   EXPECT_NE(status.message().find("scans.max_range_m"), std::string::npos) << status.message();
 }
 
+// A user's params file from before the clock drift (no time_offset_drift
+// block) keeps working: the block's defaults are used.
+TEST(CalibrateParamsTest, ParamsWithoutTheClockDriftBlockGetItsDefaults) {
+  std::string text(DefaultParamsText());
+  const size_t begin = text.find("time_offset_drift {");
+  ASSERT_NE(begin, std::string::npos);
+  const size_t end = text.find('}', begin);
+  text.erase(begin, end + 1 - begin);
+  tiltcal::testing::TempDir dir;
+  ASSERT_TRUE(WriteFileAtomically(dir.File("old.txtpb"), text).ok());
+  proto::CalibrateParams params;
+  const Status status = LoadCalibrateParams(dir.File("old.txtpb"), &params);
+  ASSERT_TRUE(status.ok()) << status.message();
+  ASSERT_TRUE(params.has_time_offset_drift());
+  EXPECT_EQ(params.time_offset_drift().mode(), proto::TimeOffsetDriftParams::AUTO);
+  EXPECT_DOUBLE_EQ(params.time_offset_drift().expected_rate_ppm(), 5.0);
+  EXPECT_DOUBLE_EQ(params.time_offset_drift().max_rate_ppm(), 2000.0);
+}
+
 // The error of ValidateCalibrateParams on the defaults with `override_text`.
 std::string ErrorWith(const std::string& override_text) {
   proto::CalibrateParams params = tiltcal::testing::DefaultCalibrateParamsWith();

@@ -5,7 +5,8 @@
 // (AUTO) each is found, handled and the result is right; with the handling
 // OFF the result is SUSPECT (exit 3) naming what the residuals show, never
 // OK and wrong. A LiDAR clock drifting against the IMU's, which decode
-// measures and the calibration does not model, makes the result WEAK. (40 s sequences with ground residuals, several seeds:
+// measures: the calibration estimates its rate (time_offset_drift AUTO), or,
+// OFF, fits one tau and the result is WEAK. (40 s sequences with ground residuals, several seeds:
 // bench/calibrate/run_imu_faults_bench.sh.)
 
 #include <cmath>
@@ -146,24 +147,78 @@ TEST_F(ImuFaultsTest, VibrationIsFilteredWithAutoAndSuspectWithOff) {
   }
 }
 
-// A LiDAR clock 100 ppm fast: τ moves by 1.6 ms over the 16 s. Decode says
-// so (imu.binpb's provenance); the calibration fits one τ, so its result is
-// WEAK with decode's finding, never OK.
-TEST_F(ImuFaultsTest, ClockDriftMakesTheResultWeakNamingIt) {
+// The true tau at a truth scan: its IMU-clock time minus its LiDAR stamp.
+double TrueTimeOffsetS(const proto::TruthScan& scan) {
+  return static_cast<double>(scan.true_stamp_ns() - scan.stamp_ns()) * 1e-9;
+}
+
+// A LiDAR clock 250 ppm fast: tau falls by 4 ms over the 16 s. Decode says
+// so (imu.binpb's provenance). With time_offset_drift AUTO the calibration
+// estimates the rate: exit 0, not WEAK on the clocks' account, the rate
+// within 3 sigma of the truth and tau at the first and the last scan within
+// 0.5 ms of the truth. With OFF it fits one tau, and the result is WEAK with
+// decode's finding, never OK.
+TEST_F(ImuFaultsTest, ClockDriftIsEstimatedOrMakesTheResultWeak) {
+  constexpr double kRatePpm = 250.0;
   SimulatedInputs sim;
-  ASSERT_NO_FATAL_FAILURE(
-      SimulateAndDecode(ShortSequenceWith("lidar_clock_drift_ppm: 100"), *dir_, "drift", &sim));
-  const CalibrationRun run = RunCalibrate(sim, LidarImuParams(), *dir_, "drift");
+  ASSERT_NO_FATAL_FAILURE(SimulateAndDecode(
+      ShortSequenceWith("lidar_clock_drift_ppm: " + std::to_string(kRatePpm)), *dir_, "drift",
+      &sim));
+  ASSERT_GE(sim.truth.scans_size(), 2);
+  const proto::TruthScan& first = sim.truth.scans(0);
+  const proto::TruthScan& last = sim.truth.scans(sim.truth.scans_size() - 1);
+
+  const CalibrationRun run = RunCalibrate(sim, LidarImuParams(), *dir_, "drift_auto");
   ASSERT_TRUE(run.has_result) << run.output;
-  Print("drift", run);
+  Print("drift AUTO", run);
+  const proto::TimeOffsetDriftReport& d = run.result.time_offset_drift();
+  std::printf("  rate %+.1f +- %.1f ppm (truth %+.1f); tau %.3f / %.3f ms at the ends (truth "
+              "%.3f / %.3f)\n",
+              d.rate_ppm(), d.rate_sigma_ppm(), kRatePpm, d.time_offset_start_s() * 1e3,
+              d.time_offset_end_s() * 1e3, TrueTimeOffsetS(first) * 1e3,
+              TrueTimeOffsetS(last) * 1e3);
   EXPECT_EQ(run.exit_code, 0) << run.output;
-  EXPECT_EQ(run.result.verdict(), proto::CalibrationResult::WEAK) << run.output;
-  EXPECT_NE(run.result.clock_drift().find("ppm against the IMU's"), std::string::npos);
-  EXPECT_TRUE(AnyContains(run.result.verdict_reasons(),
-                          "τ is the offset the whole sequence fits best"))
+  EXPECT_NE(run.result.verdict(), proto::CalibrationResult::SUSPECT) << run.output;
+  EXPECT_FALSE(run.result.clock_drift().empty()) << run.output;
+  EXPECT_FALSE(AnyContains(run.result.verdict_reasons(), "τ is the offset the whole sequence"))
       << run.output;
-  // The fitted τ lies within the drift's span over the sequence.
-  EXPECT_LT(std::abs(run.tau_ms), 2.0) << run.output;
+  EXPECT_FALSE(AnyContains(run.result.verdict_reasons(), "clock")) << run.output;
+  EXPECT_TRUE(AnyContains(run.result.verdict_notes(), "clock drift estimated")) << run.output;
+  EXPECT_NE(run.output.find("clock drift estimated"), std::string::npos) << run.output;
+  ASSERT_TRUE(d.estimated()) << run.output;
+  EXPECT_FALSE(d.weak()) << run.output;
+  EXPECT_GT(d.rate_sigma_ppm(), 0.0);
+  EXPECT_LT(std::abs(d.rate_ppm() - kRatePpm), 3.0 * d.rate_sigma_ppm()) << run.output;
+  // The report's ends are the truth's first and last scans.
+  const double first_s = static_cast<double>(first.stamp_ns() - sim.truth.start_stamp_ns()) * 1e-9;
+  const double last_s = static_cast<double>(last.stamp_ns() - sim.truth.start_stamp_ns()) * 1e-9;
+  EXPECT_NEAR(d.start_time_s(), first_s, 1e-3);
+  EXPECT_NEAR(d.end_time_s(), last_s, 1e-3);
+  EXPECT_NEAR(d.time_offset_start_s(), TrueTimeOffsetS(first), 0.5e-3) << run.output;
+  EXPECT_NEAR(d.time_offset_end_s(), TrueTimeOffsetS(last), 0.5e-3) << run.output;
+  EXPECT_GT(d.time_offset_start_sigma_s(), 0.0);
+
+  const CalibrationRun off = RunCalibrate(
+      sim, testing::DefaultCalibrateParamsWith(R"pb(
+        ground {
+          flat { mode: OFF }
+          dist { mode: OFF }
+          incl { mode: OFF }
+          up { mode: OFF }
+        }
+        time_offset_drift { mode: OFF })pb"),
+      *dir_, "drift_off");
+  ASSERT_TRUE(off.has_result) << off.output;
+  Print("drift OFF", off);
+  EXPECT_EQ(off.exit_code, 0) << off.output;
+  EXPECT_EQ(off.result.verdict(), proto::CalibrationResult::WEAK) << off.output;
+  EXPECT_FALSE(off.result.time_offset_drift().estimated());
+  EXPECT_TRUE(AnyContains(off.result.verdict_reasons(),
+                          "τ is the offset the whole sequence fits best"))
+      << off.output;
+  // The single tau lies between the truth's ends.
+  EXPECT_LT(off.result.time_offset_s(), TrueTimeOffsetS(first));
+  EXPECT_GT(off.result.time_offset_s(), TrueTimeOffsetS(last));
 }
 
 }  // namespace

@@ -3,7 +3,9 @@
 // (numeric differences through the manifolds), at several knot spacings and
 // normalised times including segment ends, and the time-offset window
 // behaviour of the point-to-plane residual at a segment boundary; the
-// random-walk prior between consecutive bias segments.
+// random-walk prior between consecutive bias segments; the clock drift's
+// wrapper (tau(t) = tau0 + rho (t - t_ref)) around the LiDAR and ground
+// residuals.
 
 #include <memory>
 #include <random>
@@ -19,6 +21,8 @@
 #include "common/spline/quaternion_manifold.h"
 #include "stages/calibrate/accel_cost_function.h"
 #include "stages/calibrate/bias_random_walk_cost_function.h"
+#include "stages/calibrate/drifting_time_offset_cost_function.h"
+#include "stages/calibrate/ground_cost_functions.h"
 #include "stages/calibrate/gyro_cost_function.h"
 #include "stages/calibrate/orientation_sample_cost_function.h"
 #include "stages/calibrate/interval_manifold.h"
@@ -513,6 +517,126 @@ TEST(IntervalManifoldTest, SolveEndsAtTheBoundLikeCeresBounds) {
   ceres::Solve(ceres::Solver::Options(), &problem, &summary);
   EXPECT_EQ(x, 0.25);
   EXPECT_FALSE(summary.is_constrained) << "no Ceres bounds: no projected line search";
+}
+
+// The clock drift's wrapper around the point-to-plane residual: the value is
+// the inner residual's at tau(t_j) = tau0 + rho (t_j - t_ref), dr/drho is
+// (t_j - t_ref) dr/dtau, and every Jacobian (rho's too) matches central
+// differences. t_j - t_ref of both signs and up to 80 s (a 160 s sequence),
+// rho up to 500 ppm. The shared check steps every block by 1e-6, which moves
+// tau by 1e-6 (t_j - t_ref): beyond 1 s its truncation error grows with the
+// lever, so there rho's difference is taken with a step of 1e-7 s in tau.
+TEST(DriftingTimeOffsetCostFunctionTest, PointToPlaneMatchesNumericDifferences) {
+  std::mt19937 rng(61);
+  std::uniform_real_distribution<double> rate(-5e-4, 5e-4);
+  for (double dt : kSpacings) {
+    for (double from_reference : {-80.0, -0.9, 0.0, 0.7, 45.0}) {
+      for (double u : {0.0, 0.37, 0.96}) {
+        State s = RandomState(&rng, dt);
+        double rho = rate(rng);
+        const double tau = s.tau + rho * from_reference;
+        const double segment_start = 100.0;
+        const double point_time = segment_start + u * dt - tau;
+        const Eigen::Vector3d point(4.0, -2.0, 0.7);
+        const Eigen::Vector3d normal = Eigen::Vector3d(0.2, -0.3, 0.9).normalized();
+        auto* inner = new PointToPlaneCostFunction(segment_start, 1.0 / dt, point_time, point,
+                                                   normal, -1.3, 0.03);
+        const DriftingTimeOffsetCostFunction drifting(inner, 10, from_reference);
+        std::vector<double*> params = PlaneParams(&s, 0);
+        params.push_back(&rho);
+        std::vector<Block> blocks = kPlaneBlocks;
+        blocks.push_back(Block::kEuclidean);
+        const std::string label = "dt " + std::to_string(dt) + " t-t_ref " +
+                                  std::to_string(from_reference) + " u " + std::to_string(u);
+        if (std::abs(from_reference) <= 1.0) {
+          ExpectTangentDifferencesMatch(drifting, params, blocks, label);
+        }
+
+        // Value and tau Jacobian are the inner function's at tau(t_j).
+        State at = s;
+        at.tau = tau;
+        const std::vector<double*> inner_params = PlaneParams(&at, 0);
+        Eigen::VectorXd r_inner, r_drift;
+        std::vector<testing::RowMajor> j_inner, j_drift;
+        testing::EvaluateAll(*inner, inner_params, &r_inner, &j_inner);
+        testing::EvaluateAll(drifting, params, &r_drift, &j_drift);
+        EXPECT_NEAR(r_drift[0], r_inner[0], 1e-12 * (1.0 + std::abs(r_inner[0]))) << label;
+        EXPECT_NEAR(j_drift[10](0, 0), j_inner[10](0, 0), 1e-12 * (1.0 + std::abs(j_inner[10](0, 0))))
+            << label;
+        EXPECT_NEAR(j_drift[11](0, 0), from_reference * j_inner[10](0, 0),
+                    1e-12 * (1.0 + std::abs(from_reference * j_inner[10](0, 0))))
+            << label;
+        EXPECT_NEAR(u, inner->NormalizedTime(tau), 1e-9) << label;
+        if (from_reference != 0.0) {
+          const double h = 1e-7 / std::abs(from_reference);
+          const double rho0 = rho;
+          double r_plus, r_minus;
+          rho = rho0 + h;
+          ASSERT_TRUE(drifting.Evaluate(params.data(), &r_plus, nullptr));
+          rho = rho0 - h;
+          ASSERT_TRUE(drifting.Evaluate(params.data(), &r_minus, nullptr));
+          rho = rho0;
+          const double numeric = (r_plus - r_minus) / (2.0 * h);
+          EXPECT_NEAR(j_drift[11](0, 0), numeric, 1e-5 * (1.0 + std::abs(numeric))) << label;
+        }
+      }
+    }
+  }
+}
+
+// dr/drho asked for without dr/dtau0 (tau0 held, rho free) is the same.
+TEST(DriftingTimeOffsetCostFunctionTest, RateJacobianWithoutTheOffsetJacobian) {
+  std::mt19937 rng(67);
+  State s = RandomState(&rng, 0.05);
+  double rho = 2e-4;
+  auto* inner = new PointToPlaneCostFunction(10.0, 20.0, 10.02 - s.tau, Eigen::Vector3d(3, 1, -1),
+                                             Eigen::Vector3d(0, 0.6, 0.8), 0.4, 0.02);
+  const DriftingTimeOffsetCostFunction drifting(inner, 10, -12.5);
+  std::vector<double*> params = PlaneParams(&s, 0);
+  params.push_back(&rho);
+  double r_all, r_rate_only, j_tau, j_rate_all, j_rate_only;
+  double* all[12] = {nullptr};
+  all[10] = &j_tau;
+  all[11] = &j_rate_all;
+  ASSERT_TRUE(drifting.Evaluate(params.data(), &r_all, all));
+  double* rate_only[12] = {nullptr};
+  rate_only[11] = &j_rate_only;
+  ASSERT_TRUE(drifting.Evaluate(params.data(), &r_rate_only, rate_only));
+  EXPECT_EQ(r_all, r_rate_only);
+  EXPECT_EQ(j_rate_all, j_rate_only);
+  EXPECT_DOUBLE_EQ(j_rate_all, -12.5 * j_tau);
+  EXPECT_NE(j_tau, 0.0);
+}
+
+// The ground residuals that use tau (flat: 3 rows, inclination: 1), wrapped:
+// central differences of every block, rho's included.
+TEST(DriftingTimeOffsetCostFunctionTest, GroundResidualsMatchNumericDifferences) {
+  std::mt19937 rng(71);
+  for (double from_reference : {-0.8, 0.6}) {
+    State s = RandomState(&rng, 0.05);
+    double rho = -3e-4;
+    const double tau = s.tau + rho * from_reference;
+    const double segment_start = 4.0;
+    const double scan_time = segment_start + 0.4 * 0.05 - tau;
+    const Eigen::Vector3d normal = Eigen::Vector3d(0.05, -0.1, 1.0).normalized();
+    std::vector<double*> params = {s.q[0].coeffs().data(), s.q[1].coeffs().data(),
+                                   s.q[2].coeffs().data(), s.q[3].coeffs().data(),
+                                   s.gravity_dir.data(),   s.q_bl.coeffs().data(),
+                                   &s.tau,                 &rho};
+    const std::vector<Block> blocks = {Block::kQuaternion, Block::kQuaternion, Block::kQuaternion,
+                                       Block::kQuaternion, Block::kSphere,     Block::kQuaternion,
+                                       Block::kEuclidean,  Block::kEuclidean};
+    const DriftingTimeOffsetCostFunction flat(
+        new FlatGroundCostFunction(segment_start, 20.0, scan_time, normal,
+                                   Eigen::Matrix3d::Identity() / 0.01),
+        6, from_reference);
+    ExpectTangentDifferencesMatch(flat, params, blocks, "flat " + std::to_string(from_reference));
+    const DriftingTimeOffsetCostFunction incl(
+        new InclinationCostFunction(segment_start, 20.0, scan_time, normal,
+                                    Eigen::Vector3d(0.1, 0.2, -9.8), 100.0),
+        6, from_reference);
+    ExpectTangentDifferencesMatch(incl, params, blocks, "incl " + std::to_string(from_reference));
+  }
 }
 
 }  // namespace

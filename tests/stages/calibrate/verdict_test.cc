@@ -153,6 +153,62 @@ TEST(VerdictTest, TimeOffsetAtEitherBoundIsSuspect) {
   EXPECT_EQ(Decide(&r), "");
 }
 
+// The clock drift (time_offset_drift.h): decode's finding makes a single
+// tau WEAK; with rho estimated and determined it does not (the numbers are a
+// verdict note, added by the stage); rho undetermined is WEAK naming it, rho
+// at a bound of the solve SUSPECT.
+proto::TimeOffsetDriftReport EstimatedDrift() {
+  proto::TimeOffsetDriftReport d;
+  d.set_estimated(true);
+  d.set_start_time_s(2.0);
+  d.set_end_time_s(162.0);
+  d.set_reference_time_s(82.0);
+  d.set_rate_ppm(50.3);
+  d.set_rate_sigma_ppm(0.4);
+  d.set_rate_lower_bound_ppm(-2000.0);
+  d.set_rate_upper_bound_ppm(2000.0);
+  d.set_time_offset_start_s(0.0165);
+  d.set_time_offset_end_s(0.0085);
+  d.set_time_offset_start_sigma_s(1e-4);
+  d.set_time_offset_end_sigma_s(1e-4);
+  return d;
+}
+
+TEST(VerdictTest, ClockDriftIsWeakUnlessTheRateIsEstimated) {
+  CalibrationResult r = CleanResult();
+  r.set_clock_drift("the LiDAR clock runs +50.1 ± 0.3 ppm against the IMU's");
+  std::string reasons = Decide(&r);
+  EXPECT_EQ(r.verdict(), CalibrationResult::WEAK);
+  EXPECT_NE(reasons.find("τ is the offset the whole sequence fits best"), std::string::npos)
+      << reasons;
+
+  *r.mutable_time_offset_drift() = EstimatedDrift();
+  EXPECT_EQ(Decide(&r), "");
+  EXPECT_EQ(r.verdict(), CalibrationResult::OK);
+
+  r.mutable_time_offset_drift()->set_weak(true);
+  r.mutable_time_offset_drift()->set_rate_sigma_ppm(30.0);
+  reasons = Decide(&r);
+  EXPECT_EQ(r.verdict(), CalibrationResult::WEAK);
+  EXPECT_NE(reasons.find("clock drift not determined by this sequence: the LiDAR clock runs "
+                         "+50.3 ± 30.0 ppm"),
+            std::string::npos)
+      << reasons;
+}
+
+TEST(VerdictTest, ClockRateAtABoundIsSuspect) {
+  CalibrationResult r = CleanResult();
+  *r.mutable_time_offset_drift() = EstimatedDrift();
+  r.mutable_time_offset_drift()->set_rate_upper_bound_ppm(50.3);
+  EXPECT_TRUE(SuspectWith(r, "clock rate at a bound of the solve: +50.3 ppm"));
+  // 0.1 ppm inside the bound is 8 us at the ends of 160 s: within
+  // at_bound_tolerance_s (10 us).
+  r.mutable_time_offset_drift()->set_rate_upper_bound_ppm(50.4);
+  EXPECT_TRUE(SuspectWith(r, "clock rate at a bound"));
+  r.mutable_time_offset_drift()->set_rate_upper_bound_ppm(51.0);
+  EXPECT_EQ(Decide(&r), "");
+}
+
 TEST(VerdictTest, NoConvergenceAndNoCovarianceAreSuspect) {
   CalibrationResult r = CleanResult();
   r.mutable_solver()->set_converged(false);
