@@ -11,7 +11,9 @@
 #   idle_vibration  the same, also during the static start (ALWAYS)
 #   drift           the LiDAR clock DRIFT ppm fast against the IMU's
 #                   (lidar_clock_drift_ppm; decode notes it); compared:
-#                   time_offset_drift AUTO (rate estimated) / OFF (one tau)
+#                   time_offset_drift AUTO (rate estimated, with decode's
+#                   rate as prior) / DATA (AUTO without that prior:
+#                   use_decode_rate false) / OFF (one tau)
 # Each sequence is calibrated by `make -f Makefile.pipeline` as a one-bag
 # dataset with the simulator's rig, once with the defaults (AUTO) and once
 # with the fault's params block OFF.
@@ -156,8 +158,13 @@ run() {
   cp "$SCRATCH/$bag.bag" "$d/seq.bag"
   sed '/^gravity_reference:/d' "$SCRATCH/$bag.rig.txtpb" > "$d/rig.txtpb"
   [ -n "$ref" ] && echo "gravity_reference: \"$ref\"" >> "$d/rig.txtpb"
-  sed -E "/^$BLOCK \{/,/^\}/ s/^  mode: AUTO$/  mode: $mode/" \
-    "$SRC/stages/calibrate/default_params.txtpb" > "$d/params/calibrate.txtpb"
+  if [ "$mode" = DATA ]; then
+    sed -E "/^$BLOCK \{/,/^\}/ s/^  use_decode_rate: true$/  use_decode_rate: false/" \
+      "$SRC/stages/calibrate/default_params.txtpb" > "$d/params/calibrate.txtpb"
+  else
+    sed -E "/^$BLOCK \{/,/^\}/ s/^  mode: AUTO$/  mode: $mode/" \
+      "$SRC/stages/calibrate/default_params.txtpb" > "$d/params/calibrate.txtpb"
+  fi
   local start=$SECONDS rc=0
   make -s -f "$SRC/Makefile.pipeline" DATASET="$d" BIN="$BIN" > "$d/make.log" 2>&1 || rc=$?
   local cal=$d/out/seq/calibration.txtpb
@@ -182,7 +189,9 @@ for seed in ${SEEDS//,/ }; do
       --out_bag="$SCRATCH/$kind.$seed.bag" --out_truth="$SCRATCH/$kind.$seed.truth.txtpb" \
       --out_rig="$SCRATCH/$kind.$seed.rig.txtpb" 2> /dev/null
   done
-  for mode in AUTO OFF; do
+  MODES="AUTO OFF"
+  [ "$FAULT" = drift ] && MODES="AUTO DATA OFF"
+  for mode in $MODES; do
     run "${seed}_flat_$mode" "flat.$seed" $mode
     run "${seed}_tilted_$mode" "tilted.$seed" $mode "../${seed}_flat_AUTO"
   done

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <numeric>
 
 #include <fmt/format.h>
@@ -98,6 +99,26 @@ std::string DescribeClockDrift(const RelativeClockRate& rate, double overlap_s,
       "recordings",
       rate.rate_ppm, rate.sigma_ppm, 1e3 * rate.time_offset_drift_s, overlap_s, 1e3 * max_drift_s,
       max_drift_s / (std::abs(rate.rate_ppm) * 1e-6));
+}
+
+bool ParseClockDriftRate(const std::string& sentence, double* rate_ppm, double* sigma_ppm) {
+  const std::string runs = "runs ";
+  const std::string plus_minus = " ± ";
+  const size_t at = sentence.find(runs);
+  if (at == std::string::npos) return false;
+  const char* begin = sentence.c_str() + at + runs.size();
+  char* end = nullptr;
+  const double rate = std::strtod(begin, &end);
+  if (end == begin || sentence.compare(static_cast<size_t>(end - sentence.c_str()),
+                                       plus_minus.size(), plus_minus) != 0) {
+    return false;
+  }
+  begin = end + plus_minus.size();
+  const double sigma = std::strtod(begin, &end);
+  if (end == begin || !std::isfinite(rate) || !std::isfinite(sigma) || sigma < 0.0) return false;
+  *rate_ppm = rate;
+  *sigma_ppm = sigma;
+  return true;
 }
 
 double TimeOffsetSigmaAt(double dt_s, double var_tau0_s2, double var_rho, double cov_tau0_rho_s) {

@@ -45,6 +45,11 @@ inline const std::string kClockDriftNotePrefix = "clocks: ";
 std::string DescribeClockDrift(const RelativeClockRate& rate, double overlap_s,
                                double max_drift_s);
 
+// The rate and its σ (ppm, LiDAR against IMU) back from a DescribeClockDrift
+// sentence ("… runs +249.5 ± 0.3 ppm …", 0.1 ppm resolution); false when the
+// sentence does not hold them.
+bool ParseClockDriftRate(const std::string& sentence, double* rate_ppm, double* sigma_ppm);
+
 // A time offset that drifts linearly (the calibration's clock model,
 // docs/design.md §5): a LiDAR stamp t (s, LiDAR clock, from any fixed origin)
 // happened at IMU time t + tau(t) with

@@ -463,11 +463,12 @@ void FillTimeOffsetDrift(const proto::CalibrateParams& params,
 // *intrinsics_covariance: that of the IMU intrinsics when they are estimated
 // (covariance_report.h), else empty.
 // *clock_rate_row: rho's row of the covariance (covariance_report.h), scaled
-// as the 7x7, when the drift is estimated; else empty.
+// as the 7x7 (its prior of sigma clock_rate_prior_sigma, 0 = none, kept like
+// the translation's), when the drift is estimated; else empty.
 void FillCovariance(const CalibrateInputs& inputs, const proto::CalibrateParams& params,
                     CalibrationProblem* problem, CalibrationState* state,
-                    proto::CalibrationResult* result, Eigen::MatrixXd* intrinsics_covariance,
-                    std::vector<double>* clock_rate_row) {
+                    double clock_rate_prior_sigma, proto::CalibrationResult* result,
+                    Eigen::MatrixXd* intrinsics_covariance, std::vector<double>* clock_rate_row) {
   const auto start = Clock::now();
   intrinsics_covariance->resize(0, 0);
   clock_rate_row->clear();
@@ -499,6 +500,9 @@ void FillCovariance(const CalibrateInputs& inputs, const proto::CalibrateParams&
           }
           Eigen::MatrixXd prior_full = Eigen::MatrixXd::Zero(8, 8);
           prior_full.topLeftCorner<7, 7>() = prior_information;
+          if (clock_rate_prior_sigma > 0.0) {
+            prior_full(7, 7) = 1.0 / (clock_rate_prior_sigma * clock_rate_prior_sigma);
+          }
           full = ScaleDataInformation(full, prior_full, factor.sigma0_squared);
           cov = full.topLeftCorner<7, 7>();
           for (int j = 0; j < 8; ++j) (*clock_rate_row)[static_cast<size_t>(j)] = full(7, j);
@@ -718,6 +722,9 @@ Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& pa
   problem_options.estimate_clock_rate = drift.estimate;
   problem_options.clock_rate_max_ppm = params.time_offset_drift().max_rate_ppm();
   problem_options.clock_rate_half_length_s = span.half_length_s();
+  problem_options.clock_rate_prior = drift.prior_rho;
+  problem_options.clock_rate_prior_sigma = drift.prior_sigma;
+  if (drift.estimate && drift.prior_sigma > 0.0) state.clock_rate[0] = drift.prior_rho;
   Log(log, std::string("clock drift ") + (drift.estimate ? "estimated" : "not estimated") + ": " +
                drift.reason);
   result->set_translation_prior_sigma_m(problem_options.translation_prior_sigma_m);
@@ -757,8 +764,8 @@ Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& pa
                  MeasureBothMapSharpnesses, std::cref(inputs), std::cref(params), std::cref(state));
   Eigen::MatrixXd intrinsics_covariance;
   std::vector<double> clock_rate_row;
-  FillCovariance(inputs, params, loop.problem.get(), &state, result, &intrinsics_covariance,
-                 &clock_rate_row);
+  FillCovariance(inputs, params, loop.problem.get(), &state, problem_options.clock_rate_prior_sigma,
+                 result, &intrinsics_covariance, &clock_rate_row);
   FillImuIntrinsics(intrinsics, loop, problem_options.estimate_imu_intrinsics, state,
                     intrinsics_covariance, result);
   FillVerdictFacts(inputs, params, init, loop.problem.get(), state, sharpness.get(), result);

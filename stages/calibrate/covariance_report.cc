@@ -287,9 +287,10 @@ void AddClockRateObservability(const proto::TimeOffsetDriftReport& report,
   const double span_s = report.end_time_s() - report.start_time_s();
   char buf[256];
   std::snprintf(buf, sizeof(buf),
-                "clock rate (tau drift): sigma %.3g ppm, %.3g ms over the scans' %.1f s "
-                "(observability.weak_time_offset_sigma_s %.3g ms)%s",
+                "clock rate (tau drift): sigma %.3g ppm (%.3g ms over the scans' %.1f s); tau at "
+                "the first / last scan: sigma %.3g / %.3g ms (weak above %.3g ms)%s",
                 report.rate_sigma_ppm(), report.rate_sigma_ppm() * 1e-3 * span_s, span_s,
+                report.time_offset_start_sigma_s() * 1e3, report.time_offset_end_sigma_s() * 1e3,
                 params.weak_time_offset_sigma_s() * 1e3, report.weak() ? " -- WEAK" : "");
   d->set_description(buf);
 }

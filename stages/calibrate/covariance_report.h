@@ -105,8 +105,9 @@ void FillCovarianceReport(const Matrix7d& covariance, const Eigen::Matrix3d& c_b
                           const MotionAxis& motion, const proto::ObservabilityParams& params,
                           proto::CalibrationResult* result);
 
-// Adds the clock rate's observability entry (its sigma in ppm and the drift
-// sigma over the scans' span; direction: 8 values, the 8th rho's) when the
+// Adds the clock rate's observability entry (its sigma in ppm, the drift's
+// over the scans' span, tau's at both ends; direction: 8 values, the 8th
+// rho's) when the
 // drift report is estimated and has a covariance; weak as report.weak().
 void AddClockRateObservability(const proto::TimeOffsetDriftReport& report,
                                const proto::ObservabilityParams& params,

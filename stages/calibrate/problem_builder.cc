@@ -44,6 +44,22 @@ class TranslationPriorCost final : public ceres::SizedCostFunction<3, 3> {
   Eigen::Matrix3d weight_;
 };
 
+// r = (x - prior) / sigma (1), for a scalar block (the clock rate rho).
+class ScalarPriorCost final : public ceres::SizedCostFunction<1, 1> {
+ public:
+  ScalarPriorCost(double prior, double sigma) : prior_(prior), inv_sigma_(1.0 / sigma) {}
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    residuals[0] = (parameters[0][0] - prior_) * inv_sigma_;
+    if (jacobians != nullptr && jacobians[0] != nullptr) jacobians[0][0] = inv_sigma_;
+    return true;
+  }
+
+ private:
+  double prior_;
+  double inv_sigma_;
+};
+
 }  // namespace
 
 CalibrationProblem::CalibrationProblem(CalibrationState* state,
@@ -106,6 +122,12 @@ CalibrationProblem::CalibrationProblem(CalibrationState* state,
     if (rho_upper_ > rho_lower_) {
       clock_rate_manifold_ = std::make_unique<IntervalManifold>(rho_lower_, rho_upper_);
       p.SetManifold(state_->clock_rate, clock_rate_manifold_.get());
+      if (options_.clock_rate_prior_sigma > 0.0) {
+        p.AddResidualBlock(
+            new ScalarPriorCost(options_.clock_rate_prior, options_.clock_rate_prior_sigma),
+            nullptr, state_->clock_rate);
+        ++counts_.prior_residuals;
+      }
     } else {
       p.SetParameterBlockConstant(state_->clock_rate);
     }

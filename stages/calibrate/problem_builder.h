@@ -115,6 +115,10 @@ struct ProblemOptions {
   bool estimate_clock_rate = false;
   double clock_rate_max_ppm = 0.0;
   double clock_rate_half_length_s = 0.0;
+  // Prior rho ~ N(clock_rate_prior, clock_rate_prior_sigma^2) (sigma 0 = none;
+  // time_offset_drift.h), counted in prior_residuals.
+  double clock_rate_prior = 0.0;
+  double clock_rate_prior_sigma = 0.0;
   // Prior sigmas of the triad errors when they are estimated: scale (a
   // fraction) and misalignment (rad).
   double intrinsics_scale_prior_sigma = 0.0;

@@ -21,6 +21,24 @@ ScanTimeSpan ScanStampSpan(const std::vector<LidarScan>& scans) {
   return span;
 }
 
+namespace {
+
+// rho's prior from decode's rate (use_decode_rate), said in the reason.
+void SetDecodePrior(const proto::TimeOffsetDriftParams& params, const std::string& decode_note,
+                    TimeOffsetDriftDecision* d) {
+  double rate_ppm = 0.0, sigma_ppm = 0.0;
+  if (!params.use_decode_rate() || !timing::ParseClockDriftRate(decode_note, &rate_ppm, &sigma_ppm)) {
+    return;
+  }
+  const double prior_sigma_ppm = std::max(sigma_ppm, params.decode_rate_min_sigma_ppm());
+  d->prior_rho = -rate_ppm * 1e-6;
+  d->prior_sigma = prior_sigma_ppm * 1e-6;
+  d->reason += fmt::format("; prior {:+.1f} ± {:.1f} ppm from decode's rate", rate_ppm,
+                           prior_sigma_ppm);
+}
+
+}  // namespace
+
 TimeOffsetDriftDecision DecideTimeOffsetDrift(const proto::TimeOffsetDriftParams& params,
                                               const std::string& decode_note,
                                               const ScanTimeSpan& span) {
@@ -30,6 +48,7 @@ TimeOffsetDriftDecision DecideTimeOffsetDrift(const proto::TimeOffsetDriftParams
     case proto::TimeOffsetDriftParams::ON:
       d.estimate = true;
       d.reason = "time_offset_drift.mode ON";
+      SetDecodePrior(params, decode_note, &d);
       return d;
     case proto::TimeOffsetDriftParams::OFF:
       d.reason = "time_offset_drift.mode OFF";
@@ -40,6 +59,7 @@ TimeOffsetDriftDecision DecideTimeOffsetDrift(const proto::TimeOffsetDriftParams
   if (!decode_note.empty()) {
     d.estimate = true;
     d.reason = "AUTO: tiltcal_decode found the clocks drifting";
+    SetDecodePrior(params, decode_note, &d);
   } else if (expected_drift_s > params.min_expected_drift_s()) {
     d.estimate = true;
     d.reason = fmt::format(
@@ -87,6 +107,10 @@ void FillTimeOffsetDriftReport(const proto::TimeOffsetDriftParams& params,
   report->set_time_offset_end_s(model.At(span.end_s));
   if (!decision.estimate) return;
   report->set_rate_ppm(model.LidarRatePpm());
+  if (decision.prior_sigma > 0.0) {
+    report->set_rate_prior_ppm(-decision.prior_rho * 1e6);
+    report->set_rate_prior_sigma_ppm(decision.prior_sigma * 1e6);
+  }
   report->set_rate_lower_bound_ppm(-bounds.upper * 1e6);
   report->set_rate_upper_bound_ppm(-bounds.lower * 1e6);
   if (covariance_row.size() != 8) return;
@@ -98,7 +122,8 @@ void FillTimeOffsetDriftReport(const proto::TimeOffsetDriftParams& params,
       span.start_s - span.reference_s, var_tau0_s2, var_rho, cov_tau0_rho));
   report->set_time_offset_end_sigma_s(timing::TimeOffsetSigmaAt(
       span.end_s - span.reference_s, var_tau0_s2, var_rho, cov_tau0_rho));
-  report->set_weak(std::sqrt(var_rho) * span.length_s() > weak_time_offset_sigma_s);
+  report->set_weak(std::max(report->time_offset_start_sigma_s(),
+                            report->time_offset_end_sigma_s()) > weak_time_offset_sigma_s);
 }
 
 std::string DescribeTimeOffsetDrift(const proto::TimeOffsetDriftReport& r) {

@@ -50,9 +50,13 @@ ScanTimeSpan ScanStampSpan(const std::vector<LidarScan>& scans);
 //   AUTO: when decode_note (tiltcal_decode's clock-drift note, "" without) is
 //   not empty, or when expected_rate_ppm * 1e-6 * span length exceeds
 //   min_expected_drift_s.
+// With use_decode_rate and a rate in the note: rho's prior (and start) at
+// -rate * 1e-6 with sigma max(decode's sigma, decode_rate_min_sigma_ppm) * 1e-6.
 struct TimeOffsetDriftDecision {
   bool estimate = false;
   std::string reason;
+  double prior_rho = 0.0;
+  double prior_sigma = 0.0;  // 0: no prior
 };
 TimeOffsetDriftDecision DecideTimeOffsetDrift(const proto::TimeOffsetDriftParams& params,
                                               const std::string& decode_note,
@@ -70,8 +74,10 @@ ClockRateBounds ClockRateBoundsOfBuild(double rho_bin, double max_rate_ppm,
 // Fills *report (mode, decision, span) and, when estimated, the rate and tau
 // at both ends with their sigmas from covariance_row: cov(rho, .) with the 7
 // tangent parameters of the result's covariance (tau0 last), then var(rho)
-// (8 values; empty: no covariance, the sigmas stay 0). weak: the rate's sigma
-// times the span above weak_time_offset_sigma_s. tau0 is the state's.
+// (8 values; empty: no covariance, the sigmas stay 0). weak: tau at the first
+// or the last scan has a sigma above weak_time_offset_sigma_s (tau is then
+// not determined at every time of the sequence, as a single tau with such a
+// sigma is weak). tau0 is the state's.
 void FillTimeOffsetDriftReport(const proto::TimeOffsetDriftParams& params,
                                const TimeOffsetDriftDecision& decision, const ScanTimeSpan& span,
                                double tau0_s, double rho, const ClockRateBounds& bounds,

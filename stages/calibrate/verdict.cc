@@ -159,8 +159,7 @@ void CheckClockDrift(const proto::CalibrationResult& r, const proto::VerdictPara
       f->weak.push_back(fmt::format(
           "clock drift not determined by this sequence: the LiDAR clock runs {:+.1f} ± {:.1f} ppm "
           "against the IMU's, so tau is known to {:.2f} ms at the first scan and {:.2f} ms at the "
-          "last (the drift over the scans has a sigma above "
-          "observability.weak_time_offset_sigma_s){}",
+          "last (above observability.weak_time_offset_sigma_s){}",
           d.rate_ppm(), d.rate_sigma_ppm(), d.time_offset_start_sigma_s() * 1e3,
           d.time_offset_end_sigma_s() * 1e3,
           r.clock_drift().empty() ? "" : "; decode: " + r.clock_drift()));

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include "common/timing/clock_rate.h"
 #include "stages/calibrate/calibration_state.h"
 #include "stages/calibrate/time_offset_drift.h"
 #include "tests/stages/calibrate/calibrate_params_text.h"
@@ -40,6 +41,29 @@ TEST(TimeOffsetDriftTest, AutoEstimatesOnDecodesNoteOrALongSequence) {
   EXPECT_TRUE(DecideTimeOffsetDrift(DriftParams("ON"), "", DriftSpan(1.0, 5.0)).estimate);
 }
 
+// decode's rate (its note's "runs +249.5 ± 0.3 ppm") becomes rho's prior,
+// with its sigma floored; without use_decode_rate, or a note without the
+// rate, there is none.
+TEST(TimeOffsetDriftTest, DecodesRateIsThePrior) {
+  const std::string note =
+      "the LiDAR clock runs +249.5 ± 0.3 ppm against the IMU's (their stamps against the record "
+      "times): τ drifts by 3.94 ms";
+  double rate = 0.0, sigma = 0.0;
+  ASSERT_TRUE(timing::ParseClockDriftRate(note, &rate, &sigma));
+  EXPECT_DOUBLE_EQ(rate, 249.5);
+  EXPECT_DOUBLE_EQ(sigma, 0.3);
+  EXPECT_FALSE(timing::ParseClockDriftRate("the LiDAR clock runs fast", &rate, &sigma));
+  const TimeOffsetDriftDecision d = DecideTimeOffsetDrift(DriftParams(), note, DriftSpan(0, 20));
+  EXPECT_TRUE(d.estimate);
+  EXPECT_DOUBLE_EQ(d.prior_rho, -249.5e-6);
+  EXPECT_DOUBLE_EQ(d.prior_sigma, 2e-6);  // decode_rate_min_sigma_ppm
+  proto::TimeOffsetDriftParams without = DriftParams();
+  without.set_use_decode_rate(false);
+  EXPECT_EQ(DecideTimeOffsetDrift(without, note, DriftSpan(0, 20)).prior_sigma, 0.0);
+  EXPECT_EQ(DecideTimeOffsetDrift(DriftParams(), "clocks drift", DriftSpan(0, 20)).prior_sigma,
+            0.0);
+}
+
 TEST(TimeOffsetDriftTest, RateBoundsOfABuild) {
   // S = 15 ms over H = 80 s: 187.5 ppm per build, within +-2000 ppm.
   ClockRateBounds b = ClockRateBoundsOfBuild(1e-4, 2000.0, 0.015, 80.0);
@@ -70,11 +94,11 @@ TEST(TimeOffsetDriftTest, EndsAndTheirSigmas) {
   EXPECT_NEAR(r.time_offset_end_sigma_s(),
               std::sqrt(var_tau0 + 6400.0 * 1e-14 + 2.0 * 80.0 * 2e-12), 1e-15);
   EXPECT_FALSE(r.weak());  // 0.1 ppm over 160 s: 16 us
-  row[7] = 1e-11;          // 3.2 ppm: 0.51 ms over 160 s
+  row[7] = 4e-11;          // 6.3 ppm: tau at the ends known to 0.52 ms
   FillTimeOffsetDriftReport(DriftParams(), decision, span, 0.012, -50e-6, {-1e-3, 1e-3}, row,
                             var_tau0, 5e-4, &r);
   EXPECT_TRUE(r.weak());
-  EXPECT_NE(DescribeTimeOffsetDrift(r).find("+50.0 ± 3.2 ppm"), std::string::npos)
+  EXPECT_NE(DescribeTimeOffsetDrift(r).find("+50.0 ± 6.3 ppm"), std::string::npos)
       << DescribeTimeOffsetDrift(r);
 }
 
