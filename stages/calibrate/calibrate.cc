@@ -492,7 +492,7 @@ void FillCovariance(const CalibrateInputs& inputs, const proto::CalibrateParams&
         prior_information.block<3, 3>(3, 3) = geometry::TranslationPriorInformation(
             result->translation_prior_sigma_m(), ToEigen(result->translation_prior_axis_b()));
         if (clock_rate_row->size() == 8) {
-          // The 7 and rho together (rho has no prior).
+          // The 7 and rho together; rho's prior (decode's rate) kept unscaled.
           Eigen::MatrixXd full = Eigen::MatrixXd::Zero(8, 8);
           full.topLeftCorner<7, 7>() = cov;
           for (int j = 0; j < 8; ++j) {
@@ -714,7 +714,8 @@ Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& pa
   problem_options.translation_prior_sigma_m = params.extrinsic_translation_prior_sigma_m();
   problem_options.translation_prior_axis_b = init.rotation_axis_b;
   // Clock drift (time_offset_drift.h): t_ref the middle of the scans' stamps;
-  // rho starts at 0 from the single tau of the initialisation.
+  // tau0 starts at the initialisation's single tau, rho at 0 or, with its
+  // prior, at decode's rate.
   const ScanTimeSpan span = ScanStampSpan(inputs.scans);
   state.time_reference_s = span.reference_s;
   const TimeOffsetDriftDecision drift =

@@ -125,7 +125,8 @@ Status LoadCalibrateParams(const std::string& path, proto::CalibrateParams* para
   // compiled-in defaults.
   if (!params->has_time_offset_drift()) {
     proto::CalibrateParams defaults;
-    if (!google::protobuf::TextFormat::ParseFromString(std::string(DefaultParamsText()), &defaults)) {
+    if (!google::protobuf::TextFormat::ParseFromString(std::string(DefaultParamsText()),
+                                                       &defaults)) {
       return Status::Error("default CalibrateParams: not readable");
     }
     *params->mutable_time_offset_drift() = defaults.time_offset_drift();

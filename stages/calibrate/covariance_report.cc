@@ -41,7 +41,8 @@ Status ComputeExtrinsicCovariance(ceres::Problem* problem, CalibrationState* sta
   covariance->setZero();
   if (clock_rate_row != nullptr) clock_rate_row->clear();
   // rho, marginalised last when asked for and free.
-  const bool with_rate = clock_rate_row != nullptr && problem->HasParameterBlock(state->clock_rate) &&
+  const bool with_rate = clock_rate_row != nullptr &&
+                         problem->HasParameterBlock(state->clock_rate) &&
                          !problem->IsParameterBlockConstant(state->clock_rate);
   if (intrinsics_covariance != nullptr) intrinsics_covariance->resize(0, 0);
   // The triad errors, marginalised last (before the 7) when asked for

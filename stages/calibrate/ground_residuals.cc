@@ -299,9 +299,9 @@ Status AddPlaneResiduals(const GroundBuild& build, const GroundPlaneSample& plan
       // g~_b at the current state: -C_ab(t)^T n_g.
       const double* const const_knots[4] = {knots[0], knots[1], knots[2], knots[3]};
       spline::So3SplineSample s;
-      spline::EvaluateSo3Spline(
-          const_knots, (plane.t_k + state->TimeOffsetAt(plane.t_k) - segment_start_s) * grid.inv_dt(),
-          grid.inv_dt(), spline::kSo3Rotation, &s);
+      const double t = plane.t_k + state->TimeOffsetAt(plane.t_k);
+      spline::EvaluateSo3Spline(const_knots, (t - segment_start_s) * grid.inv_dt(),
+                                grid.inv_dt(), spline::kSo3Rotation, &s);
       const Eigen::Vector3d up_l =
           build.c_bl.transpose() * (-(s.rotation.transpose() * build.gravity_dir));
       variance += up_l.dot(cov_nn * up_l);

@@ -27,14 +27,15 @@ namespace {
 void SetDecodePrior(const proto::TimeOffsetDriftParams& params, const std::string& decode_note,
                     TimeOffsetDriftDecision* d) {
   double rate_ppm = 0.0, sigma_ppm = 0.0;
-  if (!params.use_decode_rate() || !timing::ParseClockDriftRate(decode_note, &rate_ppm, &sigma_ppm)) {
+  if (!params.use_decode_rate() ||
+      !timing::ParseClockDriftRate(decode_note, &rate_ppm, &sigma_ppm)) {
     return;
   }
   const double prior_sigma_ppm = std::max(sigma_ppm, params.decode_rate_min_sigma_ppm());
   d->prior_rho = -rate_ppm * 1e-6;
   d->prior_sigma = prior_sigma_ppm * 1e-6;
-  d->reason += fmt::format("; prior {:+.1f} ± {:.1f} ppm from decode's rate", rate_ppm,
-                           prior_sigma_ppm);
+  d->reason +=
+      fmt::format("; prior {:+.1f} ± {:.1f} ppm from decode's rate", rate_ppm, prior_sigma_ppm);
 }
 
 }  // namespace
@@ -81,8 +82,7 @@ ClockRateBounds ClockRateBoundsOfBuild(double rho_bin, double max_rate_ppm,
                                        double time_offset_step_bound_s, double half_length_s) {
   const double highest = max_rate_ppm * 1e-6;
   const double bin = std::clamp(rho_bin, -highest, highest);
-  const double step =
-      half_length_s > 0.0 ? time_offset_step_bound_s / half_length_s : highest;
+  const double step = half_length_s > 0.0 ? time_offset_step_bound_s / half_length_s : highest;
   ClockRateBounds b;
   b.lower = std::max(-highest, bin - step);
   b.upper = std::min(highest, bin + step);
@@ -120,8 +120,8 @@ void FillTimeOffsetDriftReport(const proto::TimeOffsetDriftParams& params,
   report->set_rate_sigma_ppm(std::sqrt(var_rho) * 1e6);
   report->set_time_offset_start_sigma_s(timing::TimeOffsetSigmaAt(
       span.start_s - span.reference_s, var_tau0_s2, var_rho, cov_tau0_rho));
-  report->set_time_offset_end_sigma_s(timing::TimeOffsetSigmaAt(
-      span.end_s - span.reference_s, var_tau0_s2, var_rho, cov_tau0_rho));
+  report->set_time_offset_end_sigma_s(
+      timing::TimeOffsetSigmaAt(span.end_s - span.reference_s, var_tau0_s2, var_rho, cov_tau0_rho));
   report->set_weak(std::max(report->time_offset_start_sigma_s(),
                             report->time_offset_end_sigma_s()) > weak_time_offset_sigma_s);
 }

@@ -68,8 +68,7 @@ struct ClockRateBounds {
   double upper = 0.0;
 };
 ClockRateBounds ClockRateBoundsOfBuild(double rho_bin, double max_rate_ppm,
-                                       double time_offset_step_bound_s,
-                                       double half_length_s);
+                                       double time_offset_step_bound_s, double half_length_s);
 
 // Fills *report (mode, decision, span) and, when estimated, the rate and tau
 // at both ends with their sigmas from covariance_row: cov(rho, .) with the 7

@@ -561,7 +561,8 @@ TEST(DriftingTimeOffsetCostFunctionTest, PointToPlaneMatchesNumericDifferences) 
         testing::EvaluateAll(*inner, inner_params, &r_inner, &j_inner);
         testing::EvaluateAll(drifting, params, &r_drift, &j_drift);
         EXPECT_NEAR(r_drift[0], r_inner[0], 1e-12 * (1.0 + std::abs(r_inner[0]))) << label;
-        EXPECT_NEAR(j_drift[10](0, 0), j_inner[10](0, 0), 1e-12 * (1.0 + std::abs(j_inner[10](0, 0))))
+        EXPECT_NEAR(j_drift[10](0, 0), j_inner[10](0, 0),
+                    1e-12 * (1.0 + std::abs(j_inner[10](0, 0))))
             << label;
         EXPECT_NEAR(j_drift[11](0, 0), from_reference * j_inner[10](0, 0),
                     1e-12 * (1.0 + std::abs(from_reference * j_inner[10](0, 0))))

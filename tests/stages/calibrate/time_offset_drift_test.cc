@@ -16,8 +16,8 @@ namespace tiltcal::calibrate {
 namespace {
 
 proto::TimeOffsetDriftParams DriftParams(const char* mode = "AUTO") {
-  return tiltcal::testing::DefaultCalibrateParamsWith(
-             std::string("time_offset_drift { mode: ") + mode + " }")
+  return tiltcal::testing::DefaultCalibrateParamsWith(std::string("time_offset_drift { mode: ") +
+                                                      mode + " }")
       .time_offset_drift();
 }
 
@@ -32,12 +32,15 @@ ScanTimeSpan DriftSpan(double start_s, double end_s) {
 TEST(TimeOffsetDriftTest, AutoEstimatesOnDecodesNoteOrALongSequence) {
   // 5 ppm over 60 s is 0.3 ms: not estimated; over 160 s 0.8 ms: estimated.
   EXPECT_FALSE(DecideTimeOffsetDrift(DriftParams(), "", DriftSpan(1.0, 61.0)).estimate);
-  const TimeOffsetDriftDecision longer = DecideTimeOffsetDrift(DriftParams(), "", DriftSpan(1.0, 161.0));
+  const TimeOffsetDriftDecision longer =
+      DecideTimeOffsetDrift(DriftParams(), "", DriftSpan(1.0, 161.0));
   EXPECT_TRUE(longer.estimate);
   EXPECT_NE(longer.reason.find("0.80 ms"), std::string::npos) << longer.reason;
-  EXPECT_TRUE(DecideTimeOffsetDrift(DriftParams(), "the LiDAR clock runs", DriftSpan(1.0, 17.0)).estimate);
+  EXPECT_TRUE(
+      DecideTimeOffsetDrift(DriftParams(), "the LiDAR clock runs", DriftSpan(1.0, 17.0)).estimate);
   EXPECT_FALSE(
-      DecideTimeOffsetDrift(DriftParams("OFF"), "the LiDAR clock runs", DriftSpan(1.0, 161.0)).estimate);
+      DecideTimeOffsetDrift(DriftParams("OFF"), "the LiDAR clock runs", DriftSpan(1.0, 161.0))
+          .estimate);
   EXPECT_TRUE(DecideTimeOffsetDrift(DriftParams("ON"), "", DriftSpan(1.0, 5.0)).estimate);
 }
 
@@ -78,8 +81,8 @@ TEST(TimeOffsetDriftTest, EndsAndTheirSigmas) {
   const ScanTimeSpan span = DriftSpan(2.0, 162.0);  // t_ref 82, dt -80 and +80
   TimeOffsetDriftDecision decision{true, "ON"};
   std::vector<double> row(8, 0.0);
-  row[6] = 2e-12;   // cov(tau0, rho), s
-  row[7] = 1e-14;   // var rho (0.1 ppm)
+  row[6] = 2e-12;                // cov(tau0, rho), s
+  row[7] = 1e-14;                // var rho (0.1 ppm)
   const double var_tau0 = 1e-8;  // (0.1 ms)^2
   proto::TimeOffsetDriftReport r;
   FillTimeOffsetDriftReport(DriftParams(), decision, span, 0.012, -50e-6, {-1e-3, 1e-3}, row,
