@@ -54,6 +54,23 @@ def chi2_quantile(p, k):
     return k * (1 - 2 / (9 * k) + z * math.sqrt(2 / (9 * k))) ** 3
 
 
+def true_time_offset(cal, truth):
+    """The truth's tau where the calibration's time_offset_s refers to: at t=0
+    (truth time_offset_s), or, with the clock drift estimated, at its
+    reference time (LiDAR clock, s from the first IMU stamp), interpolated
+    between the truth scans' true_stamp_ns - stamp_ns."""
+    if get(cal, 'time_offset_drift.estimated', 'false') != 'true':
+        return get(truth, 'time_offset_s')
+    t_ref = get(cal, 'time_offset_drift.reference_time_s')
+    start = get(truth, 'start_stamp_ns')
+    points = [((get(s, 'stamp_ns') - start) * 1e-9, (get(s, 'true_stamp_ns') - get(s, 'stamp_ns')) * 1e-9)
+              for s in truth.get('scans', [])]
+    for (t0, a), (t1, b) in zip(points, points[1:]):
+        if t0 <= t_ref <= t1:
+            return a + (b - a) * (t_ref - t0) / (t1 - t0) if t1 > t0 else a
+    return get(truth, 'time_offset_s')
+
+
 def main():
     if len(sys.argv) < 2:
         sys.exit(__doc__)
@@ -68,7 +85,7 @@ def main():
         e = log_quaternion(qmul([q_true[0], -q_true[1], -q_true[2], -q_true[3]], q_est))
         e += [a - b for a, b in zip(vec(cal, 'imu_from_lidar.translation'),
                                     vec(truth, 'imu_from_lidar.translation'))]
-        e.append(get(cal, 'time_offset_s') - get(truth, 'time_offset_s'))
+        e.append(get(cal, 'time_offset_s') - true_time_offset(cal, truth))
         cov = cal.get('covariance', [])
         if len(cov) != 49:
             print('%s: no 7x7 covariance' % cal_path)
