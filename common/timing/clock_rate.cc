@@ -93,10 +93,10 @@ std::string DescribeClockDrift(const RelativeClockRate& rate, double overlap_s,
   }
   return fmt::format(
       "the LiDAR clock runs {:+.1f} ± {:.1f} ppm against the IMU's (their stamps against the "
-      "record times): τ drifts by {:.2f} ms over the {:.1f} s of overlap, and the calibration "
-      "fits one τ for the whole sequence (its ends off by about half that); τ stays within "
-      "{:.1f} ms only over {:.0f} s: synchronise the clocks (PTP, GPS PPS) or calibrate shorter "
-      "recordings",
+      "record times): τ drifts by {:.2f} ms over the {:.1f} s of overlap, so one τ for the "
+      "whole sequence has its ends off by about half that (tiltcal_calibrate estimates the rate: "
+      "time_offset_drift); τ stays within {:.1f} ms only over {:.0f} s: synchronise the clocks "
+      "(PTP, GPS PPS) or calibrate shorter recordings",
       rate.rate_ppm, rate.sigma_ppm, 1e3 * rate.time_offset_drift_s, overlap_s, 1e3 * max_drift_s,
       max_drift_s / (std::abs(rate.rate_ppm) * 1e-6));
 }

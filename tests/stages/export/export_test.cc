@@ -285,6 +285,44 @@ int RunExport(const std::string& args, std::string* output) {
   return RunCommand(ToolPath("tiltcal_export") + " " + args, output);
 }
 
+// A drifting LiDAR clock: every format with comments says so in one comment
+// line (the rate, tau at both ends, what to do); the numbers and JSON do not
+// change.
+TEST_F(ExportTest, ClockDriftIsACommentAndChangesNoNumber) {
+  std::string before[8];
+  const char* formats[] = {"fast_lio", "lio_sam", "urdf", "tf_ros1",
+                           "tf_ros2",  "kalibr",  "matrix", "json"};
+  for (int i = 0; i < 8; ++i) before[i] = Export(formats[i]);
+  WriteText(calibration_path_, std::string(kCalibrationText) + R"pb(
+time_offset_drift {
+  estimated: true
+  start_time_s: 0.1
+  end_time_s: 160.1
+  reference_time_s: 80.1
+  rate_ppm: 50.0
+  time_offset_start_s: 0.0163
+  time_offset_end_s: 0.0083
+}
+)pb");
+  const std::string line =
+      "clock drift: the LiDAR clock runs +50.0 ppm against the IMU's: tau drifts -8.00 ms over "
+      "160.0 s (from 16.30 ms at the start to 8.30 ms at the end); synchronise the clocks";
+  for (int i = 0; i < 8; ++i) {
+    const std::string text = Export(formats[i]);
+    if (std::string(formats[i]) == "json") {
+      EXPECT_EQ(text, before[i]);
+      continue;
+    }
+    EXPECT_THAT(text, HasSubstr(line)) << formats[i];
+    // Without that line the text is the one before.
+    std::string without = text;
+    const size_t at = without.find(line);
+    const size_t line_start = without.rfind('\n', at) + 1;
+    without.erase(line_start, without.find('\n', at) + 1 - line_start);
+    EXPECT_EQ(without, before[i]) << formats[i];
+  }
+}
+
 TEST_F(ExportTest, SuspectIsRefusedUnlessAllowed) {
   const std::string suspect = dir_.File("suspect.txtpb");
   std::string text = kCalibrationText;
