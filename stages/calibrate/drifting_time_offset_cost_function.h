@@ -8,8 +8,8 @@
 // first IMU stamp on the LiDAR clock; t_ref: the reference time of the state
 // (CalibrationState::time_reference_s, the middle of the scans' stamps);
 // tau0, s: the time offset block; rho: the clock-rate block (1 double,
-// dimensionless; the LiDAR clock's rate against the IMU's, so that a LiDAR
-// stamp t happened at IMU time t + tau(t)).
+// d tau / d t, dimensionless; the LiDAR clock's rate against the IMU's is
+// -rho), so that a LiDAR stamp t happened at IMU time t + tau(t).
 //
 // Wraps an inner cost function whose block tau_block is tau (the
 // point-to-plane and the ground residuals, block 10 and 6): the inner

@@ -22,7 +22,10 @@
 // Bounds of one build (problem_builder.h), as tau's: |rho| <= max_rate_ppm,
 // and rho moves at most S / max|t - t_ref| from the value that chose the
 // frozen knot windows (S = outer_loop.time_offset_step_bound_s): no residual's
-// tau moves more than 2 S from its binning value.
+// tau moves more than 2 S from its binning value. With decode's measured
+// rate (use_decode_rate), rho starts there and has a prior N(that, sigma^2),
+// sigma = max(decode's, decode_rate_min_sigma_ppm) (ScalarPriorCost in
+// problem_builder.cc); otherwise rho starts at 0 without a prior.
 
 #include <string>
 #include <vector>
