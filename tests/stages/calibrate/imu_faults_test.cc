@@ -5,8 +5,9 @@
 // (AUTO) each is found, handled and the result is right; with the handling
 // OFF the result is SUSPECT (exit 3) naming what the residuals show, never
 // OK and wrong. A LiDAR clock drifting against the IMU's, which decode
-// measures: the calibration estimates its rate (time_offset_drift AUTO), or,
-// OFF, fits one tau and the result is WEAK. (40 s sequences with ground residuals, several seeds:
+// measures (20 s here): the calibration estimates its rate (time_offset_drift
+// AUTO), or, OFF, fits one tau and the result is WEAK. (40 s sequences with
+// ground residuals, several seeds, and 160 s with a drift:
 // bench/calibrate/run_imu_faults_bench.sh.)
 
 #include <cmath>
