@@ -195,6 +195,13 @@ Status Initialise(const CalibrateInputs& inputs, const proto::CalibrateParams& p
 // The outer iterations' running totals and the last round's problem.
 struct OuterLoop {
   std::unique_ptr<CalibrationProblem> problem;
+  // The last round drawn with AssociationParams `association`, kept when the
+  // final round (OuterLoopParams.final_association) solves a denser sample:
+  // the covariance, the residual statistics and the intrinsics' score test
+  // read it at the final estimate (ReportProblem), because the dense
+  // sample's points are correlated (neighbours on one surfel in one scan)
+  // and its own covariance would claim more than the data hold.
+  std::unique_ptr<CalibrationProblem> sample_problem;
   ceres::Solver::Summary summary;
   std::vector<LidarPointResidual> lidar;
   double map_s = 0, assoc_s = 0, build_s = 0, solve_s = 0, solve_cpu_s = 0;
@@ -214,6 +221,11 @@ struct OuterLoop {
   bool intrinsics_found = false;
 };
 
+// The problem the covariance and the verdict read (see OuterLoop).
+CalibrationProblem* ReportProblem(const OuterLoop& loop) {
+  return loop.sample_problem ? loop.sample_problem.get() : loop.problem.get();
+}
+
 // What every outer round uses and does not change.
 struct OuterLoopSetup {
   const CalibrateInputs& inputs;
@@ -227,10 +239,32 @@ struct OuterLoopSetup {
   bool translation_along_axis_observed;
 };
 
+// The LiDAR residuals' params for a sample of n residuals that stands for
+// one of n_reference (0: itself): the points of a denser sample are
+// correlated (neighbours on one surfel in one scan share its plane's error),
+// so its information is taken as (n / n_reference)^e times the reference
+// sample's, e = `information_exponent`: sigma_m scaled by
+// (n / n_reference)^((1 - e) / 2), the Cauchy scale (in units of sigma)
+// divided by the same so that the loss bends at the same distance in metres.
+proto::LidarResidualParams DenseSampleLidarParams(const proto::LidarResidualParams& lidar,
+                                                  size_t n, size_t n_reference,
+                                                  double information_exponent) {
+  proto::LidarResidualParams out = lidar;
+  if (n_reference == 0 || n <= n_reference) return out;
+  const double scale = std::pow(static_cast<double>(n) / static_cast<double>(n_reference),
+                                0.5 * (1.0 - information_exponent));
+  out.set_sigma_m(lidar.sigma_m() * scale);
+  out.set_cauchy_scale(lidar.cauchy_scale() / scale);
+  return out;
+}
+
 // One round: surfel map + association with the current state, problem
-// build, LM solve. Sets *settled when the round moved the extrinsic by less
+// build, LM solve. `association` draws the LiDAR sample; with
+// reference_lidar_residuals > 0 it stands for a sample of that size
+// (DenseSampleLidarParams). Sets *settled when the round moved the extrinsic by less
 // than the OuterLoopParams stop thresholds (from the second round on).
-Status RunOuterRound(const OuterLoopSetup& setup, CalibrationState* state, OuterLoop* loop,
+Status RunOuterRound(const OuterLoopSetup& setup, const proto::AssociationParams& association,
+                     size_t reference_lidar_residuals, CalibrationState* state, OuterLoop* loop,
                      bool* settled, std::ostream* log) {
   const proto::CalibrateParams& params = setup.params;
   const int round = loop->rounds + 1;
@@ -239,7 +273,7 @@ Status RunOuterRound(const OuterLoopSetup& setup, CalibrationState* state, Outer
   const double tau_before = state->time_offset_s[0];
   const double rho_before = state->clock_rate[0];
   AssociationStageSummary assoc;
-  BuildMapAndAssociate(*state, setup.inputs.scans, params.map(), params.association(),
+  BuildMapAndAssociate(*state, setup.inputs.scans, params.map(), association,
                        static_cast<int>(params.num_threads()), &loop->lidar, &assoc);
   loop->map_s += assoc.map_seconds;
   loop->assoc_s += assoc.associate_seconds;
@@ -249,7 +283,10 @@ Status RunOuterRound(const OuterLoopSetup& setup, CalibrationState* state, Outer
   }
   auto start = Clock::now();
   loop->problem.reset();
-  loop->problem = std::make_unique<CalibrationProblem>(state, params.imu_noise(), params.lidar(),
+  const proto::LidarResidualParams lidar = DenseSampleLidarParams(
+      params.lidar(), loop->lidar.size(), reference_lidar_residuals,
+      params.outer_loop().final_lidar_information_exponent());
+  loop->problem = std::make_unique<CalibrationProblem>(state, params.imu_noise(), lidar,
                                                        setup.problem_options);
   loop->problem->AddImuResiduals(setup.inputs.imu, true, true);
   loop->problem->AddLidarResiduals(loop->lidar);
@@ -356,7 +393,7 @@ void FillSolverReport(const OuterLoop& loop, proto::CalibrationResult* result) {
 Status TestImuIntrinsics(const proto::CalibrateParams& params, CalibrationState* state,
                          OuterLoop* loop, std::ostream* log) {
   const proto::ImuIntrinsicsParams& intrinsics = params.imu_intrinsics();
-  TILTCAL_RETURN_IF_ERROR(ScoreTestImuIntrinsics(loop->problem->problem(), state, intrinsics,
+  TILTCAL_RETURN_IF_ERROR(ScoreTestImuIntrinsics(ReportProblem(*loop)->problem(), state, intrinsics,
                                                  static_cast<int>(params.num_threads()),
                                                  &loop->intrinsics_score));
   const ImuIntrinsicsScore& score = loop->intrinsics_score;
@@ -465,10 +502,13 @@ void FillTimeOffsetDrift(const proto::CalibrateParams& params,
 // *clock_rate_row: rho's row of the covariance (covariance_report.h), scaled
 // as the 7x7 (its prior of sigma clock_rate_prior_sigma, 0 = none, kept like
 // the translation's), when the drift is estimated; else empty.
+// The information is `problem`'s, the variance factor `noise_problem`'s (the
+// residuals of the default sample: ReportProblem).
 void FillCovariance(const CalibrateInputs& inputs, const proto::CalibrateParams& params,
-                    CalibrationProblem* problem, CalibrationState* state,
-                    double clock_rate_prior_sigma, proto::CalibrationResult* result,
-                    Eigen::MatrixXd* intrinsics_covariance, std::vector<double>* clock_rate_row) {
+                    CalibrationProblem* problem, CalibrationProblem* noise_problem,
+                    CalibrationState* state, double clock_rate_prior_sigma,
+                    proto::CalibrationResult* result, Eigen::MatrixXd* intrinsics_covariance,
+                    std::vector<double>* clock_rate_row) {
   const auto start = Clock::now();
   intrinsics_covariance->resize(0, 0);
   clock_rate_row->clear();
@@ -479,7 +519,7 @@ void FillCovariance(const CalibrateInputs& inputs, const proto::CalibrateParams&
         &cov, intrinsics_covariance,
         ClockRateInProblem(*state, *problem->problem()) ? clock_rate_row : nullptr);
     if (cs.ok()) {
-      const VarianceFactor factor = ComputeVarianceFactor(problem->problem());
+      const VarianceFactor factor = ComputeVarianceFactor(noise_problem->problem());
       result->set_variance_factor(factor.sigma0_squared);
       result->set_redundancy(factor.redundancy);
       // Low-passed IMU readings (imu_vibration.h) are not white: their
@@ -741,7 +781,8 @@ Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& pa
   bool settled = false;
   int max_rounds = static_cast<int>(params.outer_loop().iterations());
   while (loop.rounds < max_rounds && !settled) {
-    TILTCAL_RETURN_IF_ERROR(RunOuterRound(setup, &state, &loop, &settled, log));
+    TILTCAL_RETURN_IF_ERROR(
+        RunOuterRound(setup, params.association(), 0, &state, &loop, &settled, log));
     if (intrinsics.mode() == proto::ImuIntrinsicsParams::AUTO &&
         !problem_options.estimate_imu_intrinsics) {
       TILTCAL_RETURN_IF_ERROR(TestImuIntrinsics(params, &state, &loop, log));
@@ -752,6 +793,16 @@ Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& pa
         max_rounds = std::max(max_rounds, loop.rounds + 1);
       }
     }
+  }
+  if (params.outer_loop().has_final_association()) {
+    // The final round: a denser sample, weighted as the default one
+    // (DenseSampleLidarParams); the default sample's problem is kept for the
+    // variance factor, the residual statistics and the score test.
+    Log(log, "final round: the denser association (outer_loop.final_association)");
+    const size_t sample_residuals = loop.lidar.size();
+    loop.sample_problem = std::move(loop.problem);
+    TILTCAL_RETURN_IF_ERROR(RunOuterRound(setup, params.outer_loop().final_association(),
+                                          sample_residuals, &state, &loop, &settled, log));
   }
   if (intrinsics.mode() == proto::ImuIntrinsicsParams::OFF) {
     TILTCAL_RETURN_IF_ERROR(TestImuIntrinsics(params, &state, &loop, log));
@@ -765,14 +816,16 @@ Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& pa
                  MeasureBothMapSharpnesses, std::cref(inputs), std::cref(params), std::cref(state));
   Eigen::MatrixXd intrinsics_covariance;
   std::vector<double> clock_rate_row;
-  FillCovariance(inputs, params, loop.problem.get(), &state, problem_options.clock_rate_prior_sigma,
-                 result, &intrinsics_covariance, &clock_rate_row);
+  FillCovariance(inputs, params, loop.problem.get(), ReportProblem(loop), &state,
+                 problem_options.clock_rate_prior_sigma, result, &intrinsics_covariance,
+                 &clock_rate_row);
   FillImuIntrinsics(intrinsics, loop, problem_options.estimate_imu_intrinsics, state,
                     intrinsics_covariance, result);
-  FillVerdictFacts(inputs, params, init, loop.problem.get(), state, sharpness.get(), result);
+  FillVerdictFacts(inputs, params, init, ReportProblem(loop), state, sharpness.get(), result);
   AddImuIntrinsicsNote(result, log);
   FillTimeOffsetDrift(params, drift, span, state, *loop.problem, clock_rate_row, result, log);
   loop.problem.reset();
+  loop.sample_problem.reset();
 
   ReexpressInFirstImuFrame(&state);
   FillEstimate(state, ground_used, ground_reason, result);

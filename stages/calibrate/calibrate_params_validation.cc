@@ -76,9 +76,10 @@ Status ValidateLidarOdometryParams(const proto::LidarOdometryParams& params) {
   return Status::Ok();
 }
 
-Status ValidateAssociationParams(const proto::AssociationParams& params) {
-  TILTCAL_RETURN_IF_ERROR(MustBePositive(params.max_distance_m(), "association.max_distance_m"));
-  return MustBePositive(params.deskew_node_spacing_s(), "association.deskew_node_spacing_s");
+Status ValidateAssociationParams(const proto::AssociationParams& params,
+                                 const std::string& name) {
+  TILTCAL_RETURN_IF_ERROR(MustBePositive(params.max_distance_m(), name + ".max_distance_m"));
+  return MustBePositive(params.deskew_node_spacing_s(), name + ".deskew_node_spacing_s");
 }
 
 Status ValidateGroundResidualsParams(const proto::GroundResidualsParams& params) {
@@ -113,7 +114,11 @@ Status ValidateCalibrateParams(const proto::CalibrateParams& params) {
   TILTCAL_RETURN_IF_ERROR(ValidateInitParams(params.init()));
   TILTCAL_RETURN_IF_ERROR(ValidateLidarOdometryParams(params.odometry()));
   TILTCAL_RETURN_IF_ERROR(ValidateSurfelMapParams(params.map(), "map"));
-  TILTCAL_RETURN_IF_ERROR(ValidateAssociationParams(params.association()));
+  TILTCAL_RETURN_IF_ERROR(ValidateAssociationParams(params.association(), "association"));
+  if (params.outer_loop().has_final_association()) {
+    TILTCAL_RETURN_IF_ERROR(ValidateAssociationParams(params.outer_loop().final_association(),
+                                                      "outer_loop.final_association"));
+  }
   TILTCAL_RETURN_IF_ERROR(ValidateGroundResidualsParams(params.ground()));
   TILTCAL_RETURN_IF_ERROR(ValidateImuVibrationParams(params.imu_vibration()));
   return ValidateVerdictParams(params.verdict());

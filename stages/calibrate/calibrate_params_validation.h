@@ -24,7 +24,7 @@ Status ValidateInitParams(const proto::InitParams& params);
 Status ValidateSurfelMapParams(const proto::SurfelMapParams& params, const std::string& path);
 // odometry.quality_map, and odometry.voxel_icp when the method is VOXEL_ICP.
 Status ValidateLidarOdometryParams(const proto::LidarOdometryParams& params);
-Status ValidateAssociationParams(const proto::AssociationParams& params);
+Status ValidateAssociationParams(const proto::AssociationParams& params, const std::string& name);
 Status ValidateGroundResidualsParams(const proto::GroundResidualsParams& params);
 Status ValidateVerdictParams(const proto::VerdictParams& params);
 Status ValidateImuVibrationParams(const proto::ImuVibrationParams& params);
