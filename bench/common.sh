@@ -10,7 +10,8 @@
 #
 # bench_parse reads --flag VALUE and --flag=VALUE alike. Every script has
 #   --build_dir DIR  the build whose bin/ runs (BUILD_DIR, BIN; default
-#                    <repo>/build, or $BENCH_BUILD_DIR when the script sets it)
+#                    <repo>/build, or <repo>/$BENCH_BUILD_DIR when the script
+#                    sets that before sourcing)
 #   --scratch DIR    work folder (SCRATCH), kept; default a fresh folder under
 #                    ${TMPDIR:-/tmp}, removed on exit unless --keep
 #   --keep           keep the fresh scratch folder (its path is printed)
@@ -46,7 +47,7 @@ bench_list() {
 bench_args() { _bench_args_usage="$1  $2"; }
 bench_on_exit() { _bench_on_exit+="$1"$'\n'; }
 
-bench_flag --build_dir BUILD_DIR "${BENCH_BUILD_DIR:-$REPO/build}" "the build whose bin/ runs"
+bench_flag --build_dir BUILD_DIR "$REPO/${BENCH_BUILD_DIR:-build}" "the build whose bin/ runs"
 bench_flag --scratch SCRATCH "" "work folder, kept (default: a fresh one, removed on exit)"
 bench_switch --keep KEEP "keep the fresh scratch folder"
 
@@ -58,12 +59,12 @@ bench_usage() {
   local f
   for f in "${_bench_flags[@]}"; do
     case ${_bench_kind[$f]} in
-      value) printf '  %-24s %s\n' "$f ${_bench_var[$f]}" "${_bench_help[$f]}" ;;
-      list) printf '  %-24s %s\n' "$f ${_bench_var[$f]}" "${_bench_help[$f]} (repeatable)" ;;
-      switch) printf '  %-24s %s\n' "$f" "${_bench_help[$f]}" ;;
+      value) printf '  %-30s %s\n' "$f ${_bench_var[$f]}" "${_bench_help[$f]}" ;;
+      list) printf '  %-30s %s\n' "$f ${_bench_var[$f]}" "${_bench_help[$f]} (repeatable)" ;;
+      switch) printf '  %-30s %s\n' "$f" "${_bench_help[$f]}" ;;
     esac
   done
-  printf '  %-24s %s\n' "--help" "this text"
+  printf '  %-30s %s\n' "--help" "this text"
   [ -z "$_bench_args_usage" ] || printf '  %s\n' "$_bench_args_usage"
 }
 
