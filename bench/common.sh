@@ -51,6 +51,12 @@ bench_flag --build_dir BUILD_DIR "$REPO/${BENCH_BUILD_DIR:-build}" "the build wh
 bench_flag --scratch SCRATCH "" "work folder, kept (default: a fresh one, removed on exit)"
 bench_switch --keep KEEP "keep the fresh scratch folder"
 
+# _bench_option NAME HELP: one option of the usage, HELP wrapped at 80 columns.
+_bench_option() {
+  printf '  %s\n' "$1"
+  printf '%s\n' "$2" | fold -s -w 70 | sed -e 's/ *$//' -e 's/^/          /'
+}
+
 bench_usage() {
   # The header: the comment lines after the shebang, up to the first other line.
   sed -n '2,${/^#/!q;s/^# \{0,1\}//;p}' "$0"
@@ -59,13 +65,13 @@ bench_usage() {
   local f
   for f in "${_bench_flags[@]}"; do
     case ${_bench_kind[$f]} in
-      value) printf '  %-30s %s\n' "$f ${_bench_var[$f]}" "${_bench_help[$f]}" ;;
-      list) printf '  %-30s %s\n' "$f ${_bench_var[$f]}" "${_bench_help[$f]} (repeatable)" ;;
-      switch) printf '  %-30s %s\n' "$f" "${_bench_help[$f]}" ;;
+      value) _bench_option "$f ${_bench_var[$f]}" "${_bench_help[$f]}" ;;
+      list) _bench_option "$f ${_bench_var[$f]}" "${_bench_help[$f]} (repeatable)" ;;
+      switch) _bench_option "$f" "${_bench_help[$f]}" ;;
     esac
   done
-  printf '  %-30s %s\n' "--help" "this text"
-  [ -z "$_bench_args_usage" ] || printf '  %s\n' "$_bench_args_usage"
+  _bench_option --help "this text"
+  [ -z "$_bench_args_usage" ] || _bench_option "${_bench_args_usage%%  *}" "${_bench_args_usage#*  }"
 }
 
 bench_die() { echo "$BENCH_NAME: $*" >&2; exit 2; }
