@@ -14,7 +14,8 @@
 #                    sets that before sourcing)
 #   --scratch DIR    work folder (SCRATCH), kept; default a fresh folder under
 #                    ${TMPDIR:-/tmp}, removed on exit unless --keep
-#   --keep           keep the fresh scratch folder (its path is printed)
+#   --keep           keep the fresh scratch folder (its path is printed;
+#                    BENCH_SCRATCH_REMOVED is 1 when it goes at exit)
 #   --help           the script's header comment and the flags, exit 0
 # Positional arguments land in BENCH_ARGS when the script called bench_args.
 # Scripts add their own exit work with bench_on_exit 'COMMAND' (not trap).
@@ -22,6 +23,7 @@
 REPO=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 BENCH_NAME=$(basename "$0")
 BENCH_ARGS=()
+BENCH_SCRATCH_REMOVED=0  # 1: SCRATCH is removed on exit
 _bench_flags=()
 _bench_args_usage=""
 _bench_on_exit=""
@@ -113,6 +115,7 @@ bench_parse() {
       echo "$BENCH_NAME: scratch kept in $SCRATCH" >&2
     else
       _bench_on_exit+="rm -rf '$SCRATCH'"$'\n'
+      BENCH_SCRATCH_REMOVED=1
     fi
   else
     mkdir -p "$SCRATCH"

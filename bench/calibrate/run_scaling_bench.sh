@@ -63,3 +63,5 @@ echo "load after:  $(uptime)"
 PYTHON=/usr/bin/python3
 [ -x "$PYTHON" ] || PYTHON=python3
 "$PYTHON" "$REPO/bench/calibrate/scaling_report.py" "$RESULTS" --plot "$SCRATCH/scaling.png"
+[ "$BENCH_SCRATCH_REMOVED" = 0 ] ||
+  echo "(the scratch folder is removed now: --keep or --scratch DIR keeps the plot)"
