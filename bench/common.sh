@@ -114,7 +114,7 @@ bench_parse() {
     if [ "$KEEP" = 1 ]; then
       echo "$BENCH_NAME: scratch kept in $SCRATCH" >&2
     else
-      _bench_on_exit+="rm -rf '$SCRATCH'"$'\n'
+      _bench_on_exit+="rm -rf -- $(printf %q "$SCRATCH")"$'\n'
       BENCH_SCRATCH_REMOVED=1
     fi
   else
