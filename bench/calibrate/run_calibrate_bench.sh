@@ -12,51 +12,26 @@
 # duration_s / calibrate wall). Targets: whole stage <= 60 s wall on 2 cores,
 # <= 0.25 s per LM iteration.
 #
-# Usage: bench/calibrate/run_calibrate_bench.sh [options]
-#   --build_dir DIR    build with the stage binaries (default <repo>/build-bench)
-#   --scratch DIR      work directory (default /tmp/tiltcal_calibrate_bench)
-#   --scenario FILE    simulate params (default flat_vlp16.txtpb)
-#   --model MODEL      override the LiDAR model (VLP_16, VLP_32C, OS1_32)
-#   --seed N           override the simulator seed (noise and world)
-#   --params FILE      calibrate params (default stages/calibrate/default_params.txtpb)
-#   --threads N        num_threads of the calibrator (default 2)
-#   --ground MODE      off (default: LiDAR + IMU only, the setting the accuracy
-#                      targets are stated for) or auto (ground residuals as the params say;
-#                      g_f comes with the rig, from the simulator, so tilted
-#                      scenarios need no flat reference run)
+# Usage: bench/calibrate/run_calibrate_bench.sh [options] (below); the
+# stage binaries are built into --build_dir (Release) when it has none.
 set -euo pipefail
 
-REPO=$(cd "$(dirname "$0")/../.." && pwd)
-BUILD_DIR="$REPO/build-bench"
-SCRATCH=/tmp/tiltcal_calibrate_bench
-SCENARIO="$REPO/stages/simulate/scenarios/flat_vlp16.txtpb"
-MODEL=""
-SEED=""
-PARAMS="$REPO/stages/calibrate/default_params.txtpb"
-THREADS=2
-GROUND=off
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --build_dir) BUILD_DIR=$2; shift 2 ;;
-    --scratch) SCRATCH=$2; shift 2 ;;
-    --scenario) SCENARIO=$2; shift 2 ;;
-    --model) MODEL=$2; shift 2 ;;
-    --seed) SEED=$2; shift 2 ;;
-    --params) PARAMS=$2; shift 2 ;;
-    --threads) THREADS=$2; shift 2 ;;
-    --ground) GROUND=$2; shift 2 ;;
-    -h|--help) sed -n '2,/^set -euo/p' "$0" | sed '$d'; exit 0 ;;
-    *) echo "run_calibrate_bench: unknown argument $1" >&2; exit 2 ;;
-  esac
-done
+BENCH_BUILD_DIR=build-bench
+. "$(dirname "$0")/../common.sh"
+bench_flag --scenario SCENARIO "$REPO/stages/simulate/scenarios/flat_vlp16.txtpb" "simulate params"
+bench_flag --model MODEL "" "override the LiDAR model (VLP_16, VLP_32C, OS1_32)"
+bench_flag --seed SEED "" "override the simulator seed (noise and world)"
+bench_flag --params PARAMS "$REPO/stages/calibrate/default_params.txtpb" "calibrate params"
+bench_flag --threads THREADS 2 "num_threads of the calibrator"
+bench_flag --ground GROUND off "off (LiDAR + IMU only, as the accuracy targets) or auto (ground residuals as the params say; g_f comes with the simulated rig)"
+bench_parse "$@"
 
 TARGETS="tiltcal_simulate tiltcal_decode tiltcal_ground tiltcal_gravity tiltcal_calibrate"
 if [ ! -x "$BUILD_DIR/bin/tiltcal_calibrate" ]; then
   cmake -S "$REPO" -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
   cmake --build "$BUILD_DIR" --target $TARGETS -j2
 fi
-BIN="$BUILD_DIR/bin"
-mkdir -p "$SCRATCH"
+require_binaries $TARGETS
 W="$SCRATCH"
 
 scenario="$W/scenario.txtpb"

@@ -12,18 +12,17 @@
 # rotation_error_in_imu_deg and faults { imu_gyro_unit } and a
 # rig.time_offset_s beyond 1 s.
 #
-# Usage: bench/calibrate/run_clock_rig_bench.sh [BUILD_DIR [SCRATCH [CASE...]]]
-#   defaults: <repo>/build, /tmp/tiltcal_clock_rig_bench, every case.
+# Usage: bench/calibrate/run_clock_rig_bench.sh [--build_dir DIR]
+#          [--scratch DIR] [CASE...]   (default every case)
 set -euo pipefail
 
-REPO=$(cd "$(dirname "$0")/../.." && pwd)
-BIN=${1:-$REPO/build}/bin
-SCRATCH=${2:-/tmp/tiltcal_clock_rig_bench}
-shift $(( $# > 2 ? 2 : $# )) || true
-CASES=("$@")
+. "$(dirname "$0")/../common.sh"
+bench_args "[CASE...]" "tau12ms tau80ms tau300ms tau2s tau10min yaw90 upside_down gyro_degps (default all)"
+bench_parse "$@"
+require_binaries tiltcal_simulate tiltcal_decode tiltcal_calibrate
+CASES=(${BENCH_ARGS[@]+"${BENCH_ARGS[@]}"})
 [ ${#CASES[@]} -eq 0 ] && CASES=(tau12ms tau80ms tau300ms tau2s tau10min yaw90 upside_down gyro_degps)
 BASE="$REPO/stages/simulate/scenarios/flat_vlp16_40s.txtpb"
-mkdir -p "$SCRATCH"
 
 # Scenario of a case: the base with one edit (sed expression).
 edit_for() {

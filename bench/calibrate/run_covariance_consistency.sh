@@ -5,13 +5,17 @@
 # one rig), runs Makefile.pipeline with the default params, and prints the
 # NEES and z-scores of the errors against the truth in units of the reported
 # covariance (bench/calibrate/covariance_consistency.py).
-#   run_covariance_consistency.sh BUILD_DIR [N=6] [DURATION=20] [WORK=/tmp/tiltcal_nees]
+# Sequences in <scratch>/flat are reused when the scratch is.
+#   bench/calibrate/run_covariance_consistency.sh [--build_dir DIR]
+#       [--sequences N] [--duration S] [--scratch DIR]
 set -euo pipefail
-SRC=$(cd "$(dirname "$0")/../.." && pwd)
-BIN=$(cd "${1:?usage: run_covariance_consistency.sh BUILD_DIR [N] [DURATION] [WORK]}" && pwd)/bin
-N=${2:-6}
-DURATION=${3:-20}
-WORK=${4:-/tmp/tiltcal_nees}
+. "$(dirname "$0")/../common.sh"
+bench_flag --sequences N 6 "how many sequences"
+bench_flag --duration DURATION 20 "sequence length, s"
+bench_parse "$@"
+require_binaries tiltcal_simulate tiltcal_decode tiltcal_ground tiltcal_gravity tiltcal_calibrate
+SRC=$REPO
+WORK=$SCRATCH
 DATA=$WORK/flat
 mkdir -p "$DATA"
 for i in $(seq 1 "$N"); do

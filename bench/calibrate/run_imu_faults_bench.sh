@@ -32,45 +32,25 @@
 #       [--vibration_gyro=0.05] [--drift_ppm=50] [--duration_s=40]
 # e.g. bench/calibrate/run_imu_faults_bench.sh --fault=drift --seeds=101 --duration_s=160
 set -euo pipefail
-SRC=$(cd "$(dirname "$0")/../.." && pwd)
-BUILD=$SRC/build
-SCRATCH=""
-SEEDS=101,102,103
-FAULT=consumer
-SCALE=10000
-MIS=0.5
-HZ=37
-ACCEL=1.5
-GYRO=0.05
-DRIFT=50
-DURATION=40
-for arg in "$@"; do
-  case "$arg" in
-    --build_dir=*) BUILD=${arg#*=} ;;
-    --scratch=*) SCRATCH=${arg#*=} ;;
-    --seeds=*) SEEDS=${arg#*=} ;;
-    --fault=*) FAULT=${arg#*=} ;;
-    --scale_ppm=*) SCALE=${arg#*=} ;;
-    --misalignment_deg=*) MIS=${arg#*=} ;;
-    --vibration_hz=*) HZ=${arg#*=} ;;
-    --vibration_accel=*) ACCEL=${arg#*=} ;;
-    --vibration_gyro=*) GYRO=${arg#*=} ;;
-    --drift_ppm=*) DRIFT=${arg#*=} ;;
-    --duration_s=*) DURATION=${arg#*=} ;;
-    --help) sed -n '2,/^set -euo/p' "$0" | sed '$d' | sed 's/^# \{0,1\}//'; exit 0 ;;
-    *) echo "unknown argument $arg (see --help)" >&2; exit 2 ;;
-  esac
-done
+. "$(dirname "$0")/../common.sh"
+SRC=$REPO
+bench_flag --seeds SEEDS 101,102,103 "simulator seeds, comma separated"
+bench_flag --fault FAULT consumer "consumer, vibration, idle_vibration or drift"
+bench_flag --scale_ppm SCALE 10000 "largest scale error, ppm (consumer)"
+bench_flag --misalignment_deg MIS 0.5 "largest axis misalignment, deg (consumer)"
+bench_flag --vibration_hz HZ 37 "vibration frequency, Hz"
+bench_flag --vibration_accel ACCEL 1.5 "vibration amplitude, m/s^2 per axis"
+bench_flag --vibration_gyro GYRO 0.05 "vibration amplitude, rad/s per axis"
+bench_flag --drift_ppm DRIFT 50 "LiDAR clock drift, ppm (drift)"
+bench_flag --duration_s DURATION 40 "sequence length, s"
+bench_parse "$@"
 case "$FAULT" in
   consumer) BLOCK=imu_intrinsics ;;
   vibration|idle_vibration) BLOCK=imu_vibration ;;
   drift) BLOCK=time_offset_drift ;;
   *) echo "unknown fault $FAULT (see --help)" >&2; exit 2 ;;
 esac
-BIN=$(cd "$BUILD" && pwd)/bin
-[ -x "$BIN/tiltcal_calibrate" ] || { echo "no $BIN/tiltcal_calibrate: build first" >&2; exit 1; }
-if [ -z "$SCRATCH" ]; then SCRATCH=$(mktemp -d); trap 'rm -rf "$SCRATCH"' EXIT; fi
-mkdir -p "$SCRATCH"
+require_binaries tiltcal_simulate tiltcal_decode tiltcal_ground tiltcal_gravity tiltcal_calibrate
 PY=/usr/bin/python3
 
 # scenario KIND SEED: the demo's Husky scenario with the fault.

@@ -14,39 +14,22 @@
 # RMS and maximum over the seeds and the seeds whose verdict was not OK.
 #
 # Usage: bench/calibrate/run_mid360_seeds.sh [options]
-#   --build_dir DIR    the build whose bin/ runs (default <repo>/build)
-#   --params FILE      calibrate params, repeatable (default the stage's
-#                      default_params.txtpb); each is labelled by its file name
-#   --seeds "N.."      simulator seeds (default "1 2 ... 8")
-#   --scratch DIR      work directory (default /tmp/tiltcal_mid360_seeds)
+# Pass --scratch DIR to reuse the simulated inputs across runs.
 set -euo pipefail
 
-REPO=$(cd "$(dirname "$0")/../.." && pwd)
-BUILD_DIR="$REPO/build"
-PARAMS=()
-SEEDS=$(seq -s ' ' 1 8)
-SCRATCH=/tmp/tiltcal_mid360_seeds
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --build_dir) BUILD_DIR=$2; shift 2 ;;
-    --params) PARAMS+=("$2"); shift 2 ;;
-    --seeds) SEEDS=$2; shift 2 ;;
-    --scratch) SCRATCH=$2; shift 2 ;;
-    -h|--help) sed -n '2,/^set -euo/p' "$0" | sed '$d'; exit 0 ;;
-    *) echo "run_mid360_seeds: unknown argument $1" >&2; exit 2 ;;
-  esac
-done
+. "$(dirname "$0")/../common.sh"
+bench_list --params PARAMS "calibrate params, each labelled by its file name (default the stage's default_params.txtpb)"
+bench_flag --seeds SEEDS "$(seq -s ' ' 1 8)" "simulator seeds"
+bench_parse "$@"
 [ ${#PARAMS[@]} -gt 0 ] || PARAMS=("$REPO/stages/calibrate/default_params.txtpb")
 labels=$(for params in "${PARAMS[@]}"; do basename "$params" .txtpb; done)
 if [ "$(echo "$labels" | sort | uniq -d)" != "" ]; then
   echo "run_mid360_seeds: two --params files share a file name (the label): $(echo "$labels" | sort | uniq -d)" >&2
   exit 2
 fi
-BIN="$BUILD_DIR/bin"
 . "$REPO/bench/calibrate/simulated_inputs.sh"
-require_binaries "$BIN" ""
+require_binaries tiltcal_simulate tiltcal_decode tiltcal_ground tiltcal_gravity tiltcal_calibrate
 SCENARIO="$REPO/tests/stages/calibrate/short_flat_mid360.txtpb"
-mkdir -p "$SCRATCH"
 RESULTS="$SCRATCH/results.tsv"
 : > "$RESULTS"
 for seed in $SEEDS; do

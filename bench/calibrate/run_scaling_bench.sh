@@ -11,53 +11,28 @@
 # then per binary the exponent b of a log-log fit wall = a duration^b
 # (1 = linear) and the anchor / this ratios, and plots the time and the
 # peak memory per second of data against the duration into
-# <scratch>/scaling.png. The machine load (uptime) is
+# <scratch>/scaling.png (kept with --keep or --scratch DIR). The machine
+# load (uptime) is
 # printed before and after: the machine is shared, so compare the ratios of
 # one run, not absolute times across runs.
 #
 # Usage: bench/calibrate/run_scaling_bench.sh [options]
-#   --build_dir DIR    this build (default <repo>/build)
-#   --anchor_bin DIR   the anchor's bin/ directory (default: none, this build only)
-#   --durations "S.."  sequence durations, s (default "20 40 80 160")
-#   --scenario FILE    simulate params (default flat_vlp16_40s.txtpb)
-#   --seed N           simulator seed (default: the scenario's)
-#   --params FILE      calibrate params of this build (default its default_params.txtpb)
-#   --anchor_params F  calibrate params of the anchor (default: --params)
-#   --threads N        num_threads of the calibrator (default 2)
-#   --scratch DIR      work directory (default /tmp/tiltcal_scaling_bench)
 # Ground residuals are off (LiDAR + IMU only), as in run_calibrate_bench.sh.
 set -euo pipefail
 
-REPO=$(cd "$(dirname "$0")/../.." && pwd)
-BUILD_DIR="$REPO/build"
-ANCHOR_BIN=""
-DURATIONS="20 40 80 160"
-SCENARIO="$REPO/stages/simulate/scenarios/flat_vlp16_40s.txtpb"
-SEED=""
-PARAMS="$REPO/stages/calibrate/default_params.txtpb"
-ANCHOR_PARAMS=""
-THREADS=2
-SCRATCH=/tmp/tiltcal_scaling_bench
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --build_dir) BUILD_DIR=$2; shift 2 ;;
-    --anchor_bin) ANCHOR_BIN=$2; shift 2 ;;
-    --durations) DURATIONS=$2; shift 2 ;;
-    --scenario) SCENARIO=$2; shift 2 ;;
-    --seed) SEED=$2; shift 2 ;;
-    --params) PARAMS=$2; shift 2 ;;
-    --anchor_params) ANCHOR_PARAMS=$2; shift 2 ;;
-    --threads) THREADS=$2; shift 2 ;;
-    --scratch) SCRATCH=$2; shift 2 ;;
-    -h|--help) sed -n '2,/^set -euo/p' "$0" | sed '$d'; exit 0 ;;
-    *) echo "run_scaling_bench: unknown argument $1" >&2; exit 2 ;;
-  esac
-done
+. "$(dirname "$0")/../common.sh"
+bench_flag --anchor_bin ANCHOR_BIN "" "the anchor's bin/ directory (default: none, this build only)"
+bench_flag --durations DURATIONS "20 40 80 160" "sequence durations, s"
+bench_flag --scenario SCENARIO "$REPO/stages/simulate/scenarios/flat_vlp16_40s.txtpb" "simulate params"
+bench_flag --seed SEED "" "simulator seed (default: the scenario's)"
+bench_flag --params PARAMS "$REPO/stages/calibrate/default_params.txtpb" "calibrate params of this build"
+bench_flag --anchor_params ANCHOR_PARAMS "" "calibrate params of the anchor (default: --params)"
+bench_flag --threads THREADS 2 "num_threads of the calibrator"
+bench_parse "$@"
 [ -n "$ANCHOR_PARAMS" ] || ANCHOR_PARAMS=$PARAMS
-BIN="$BUILD_DIR/bin"
 . "$REPO/bench/calibrate/simulated_inputs.sh"
-require_binaries "$BIN" "$ANCHOR_BIN"
-mkdir -p "$SCRATCH"
+require_binaries tiltcal_simulate tiltcal_decode tiltcal_ground tiltcal_gravity tiltcal_calibrate
+require_anchor "$ANCHOR_BIN"
 
 echo "load before: $(uptime)"
 RESULTS="$SCRATCH/results.tsv"
@@ -88,3 +63,5 @@ echo "load after:  $(uptime)"
 PYTHON=/usr/bin/python3
 [ -x "$PYTHON" ] || PYTHON=python3
 "$PYTHON" "$REPO/bench/calibrate/scaling_report.py" "$RESULTS" --plot "$SCRATCH/scaling.png"
+[ "$BENCH_SCRATCH_REMOVED" = 0 ] ||
+  echo "(the scratch folder is removed now: --keep or --scratch DIR keeps the plot)"

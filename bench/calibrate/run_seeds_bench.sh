@@ -7,8 +7,8 @@
 #
 # For each seed (default 1-16) it simulates the scenario (default the 40 s
 # VLP-16 figure-eight, flat_vlp16_40s.txtpb) and runs decode -> ground ->
-# gravity once into <scratch>/s<seed> (kept and reused while the scenario
-# file is the same); then, --passes times, tiltcal_calibrate of this build
+# gravity once into <scratch>/s<seed> (reused, with --scratch DIR, while
+# the scenario file is the same); then, --passes times, tiltcal_calibrate of this build
 # and of the anchor (--anchor_bin) on each seed, alternating which runs
 # first, each under GNU time -v, with the CPU time the hypervisor gave to
 # other guests meanwhile (steal, /proc/stat): on a shared VM a run that lost
@@ -18,58 +18,27 @@
 # max over the seeds) and the anchor / this ratios.
 #
 # Usage: bench/calibrate/run_seeds_bench.sh [options]
-#   --build_dir DIR    this build (default <repo>/build)
-#   --anchor_bin DIR   the anchor's bin/ directory (default: none, this build
-#                      only; this build when only --anchor_params is given)
-#   --seeds "N.."      simulator seeds (default "1 2 ... 16")
-#   --passes N         runs of every binary on every seed (default 1)
-#   --scenario FILE    simulate params (default flat_vlp16_40s.txtpb)
-#   --params FILE      calibrate params of this build (default its default_params.txtpb)
-#   --anchor_params F  calibrate params of the anchor (default: --params)
-#   --threads N        num_threads of the calibrator (default 2)
-#   --wall_goal S      the wall time the report counts runs over (default 10)
-#   --scratch DIR      work directory (default /tmp/tiltcal_seeds_bench)
-#   --ground_residuals keep the ground residuals as the params set them
 # Ground residuals are off (LiDAR + IMU only) unless --ground_residuals, as
 # in run_calibrate_bench.sh.
 set -euo pipefail
 
-REPO=$(cd "$(dirname "$0")/../.." && pwd)
-BUILD_DIR="$REPO/build"
-ANCHOR_BIN=""
-SEEDS=$(seq -s ' ' 1 16)
-PASSES=1
-SCENARIO="$REPO/stages/simulate/scenarios/flat_vlp16_40s.txtpb"
-PARAMS="$REPO/stages/calibrate/default_params.txtpb"
-ANCHOR_PARAMS=""
-THREADS=2
-WALL_GOAL=10
-SCRATCH=/tmp/tiltcal_seeds_bench
-GROUND_RESIDUALS=0
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --build_dir) BUILD_DIR=$2; shift 2 ;;
-    --anchor_bin) ANCHOR_BIN=$2; shift 2 ;;
-    --seeds) SEEDS=$2; shift 2 ;;
-    --passes) PASSES=$2; shift 2 ;;
-    --scenario) SCENARIO=$2; shift 2 ;;
-    --params) PARAMS=$2; shift 2 ;;
-    --anchor_params) ANCHOR_PARAMS=$2; shift 2 ;;
-    --threads) THREADS=$2; shift 2 ;;
-    --wall_goal) WALL_GOAL=$2; shift 2 ;;
-    --scratch) SCRATCH=$2; shift 2 ;;
-    --ground_residuals) GROUND_RESIDUALS=1; shift ;;
-    -h|--help) sed -n '2,/^set -euo/p' "$0" | sed '$d'; exit 0 ;;
-    *) echo "run_seeds_bench: unknown argument $1" >&2; exit 2 ;;
-  esac
-done
-BIN="$BUILD_DIR/bin"
+. "$(dirname "$0")/../common.sh"
+bench_flag --anchor_bin ANCHOR_BIN "" "the anchor's bin/ directory (default: none, this build only; this build when only --anchor_params is given)"
+bench_flag --seeds SEEDS "$(seq -s ' ' 1 16)" "simulator seeds"
+bench_flag --passes PASSES 1 "runs of every binary on every seed"
+bench_flag --scenario SCENARIO "$REPO/stages/simulate/scenarios/flat_vlp16_40s.txtpb" "simulate params"
+bench_flag --params PARAMS "$REPO/stages/calibrate/default_params.txtpb" "calibrate params of this build"
+bench_flag --anchor_params ANCHOR_PARAMS "" "calibrate params of the anchor (default: --params)"
+bench_flag --threads THREADS 2 "num_threads of the calibrator"
+bench_flag --wall_goal WALL_GOAL 10 "the wall time, s, the report counts runs over"
+bench_switch --ground_residuals GROUND_RESIDUALS "keep the ground residuals as the params set them"
+bench_parse "$@"
 # Params alone compared: the anchor is this build with --anchor_params.
 [ -n "$ANCHOR_PARAMS" ] && [ -z "$ANCHOR_BIN" ] && ANCHOR_BIN=$BIN
 [ -n "$ANCHOR_PARAMS" ] || ANCHOR_PARAMS=$PARAMS
 . "$REPO/bench/calibrate/simulated_inputs.sh"
-require_binaries "$BIN" "$ANCHOR_BIN"
-mkdir -p "$SCRATCH"
+require_binaries tiltcal_simulate tiltcal_decode tiltcal_ground tiltcal_gravity tiltcal_calibrate
+require_anchor "$ANCHOR_BIN"
 calibrate_params "$PARAMS" "$SCRATCH/params_this.txtpb" "$THREADS" "$GROUND_RESIDUALS"
 calibrate_params "$ANCHOR_PARAMS" "$SCRATCH/params_anchor.txtpb" "$THREADS" "$GROUND_RESIDUALS"
 

@@ -1,8 +1,8 @@
-# Sourced by the calibrate benchmarks (run_scaling_bench.sh,
-# run_seeds_bench.sh): the calibrator's inputs for one simulated sequence,
+# Sourced, after bench/common.sh, by the calibrate benchmarks
+# (run_scaling_bench.sh, run_seeds_bench.sh, run_mid360_seeds.sh): the calibrator's inputs for one simulated sequence,
 # its params with the thread count set and the ground residuals off (LiDAR +
 # IMU only, the setting the accuracy targets are stated for), the check of
-# the binaries, one calibrate run under GNU time, and the steal counter.
+# the anchor's binary, one calibrate run under GNU time, and the steal counter.
 
 # simulate_inputs BIN REPO SCENARIO WORKDIR [SEED [DURATION_S]]: simulates the
 # scenario (gravity_flat written, no gravity reference; seed and duration
@@ -42,16 +42,11 @@ steal_ticks() {
   awk '/^cpu / {print $9}' /proc/stat
 }
 
-# require_binaries BIN ANCHOR_BIN: the stage binaries in BIN and, when
-# ANCHOR_BIN is not empty, its tiltcal_calibrate; exits 2 naming a missing one.
-require_binaries() {
-  local b
-  for b in tiltcal_simulate tiltcal_decode tiltcal_ground tiltcal_gravity tiltcal_calibrate; do
-    [ -x "$1/$b" ] || { echo "$(basename "$0"): $1/$b missing (build it first)" >&2; exit 2; }
-  done
-  if [ -n "$2" ] && [ ! -x "$2/tiltcal_calibrate" ]; then
-    echo "$(basename "$0"): $2/tiltcal_calibrate missing" >&2; exit 2
-  fi
+# require_anchor ANCHOR_BIN: its tiltcal_calibrate, when ANCHOR_BIN is not
+# empty; exits 2 naming it when missing.
+require_anchor() {
+  [ -z "$1" ] || [ -x "$1/tiltcal_calibrate" ] ||
+    bench_die "$1/tiltcal_calibrate (--anchor_bin) missing"
 }
 
 # run_calibrate NAME BIN PARAMS WORKDIR: BIN/tiltcal_calibrate on WORKDIR's

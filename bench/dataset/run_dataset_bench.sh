@@ -9,13 +9,17 @@
 # Prints bench/dataset/dataset_errors.py for both, and the wall time of the
 # joint step against one sequence's calibration.
 #
-# Usage: bench/dataset/run_dataset_bench.sh [BUILD_DIR [WORK [DURATION_S]]]
-#   defaults: <repo>/build, /tmp/tiltcal_dataset_bench, 40.
+# Bags in --scratch DIR are reused by the next run with the same DIR.
+#
+# Usage: bench/dataset/run_dataset_bench.sh [--build_dir DIR] [--scratch DIR]
+#          [--duration_s S]
 set -euo pipefail
-REPO=$(cd "$(dirname "$0")/../.." && pwd)
-BIN=$(cd "${1:-$REPO/build}" && pwd)/bin
-WORK=${2:-/tmp/tiltcal_dataset_bench}
-DURATION_S=${3:-40}
+. "$(dirname "$0")/../common.sh"
+bench_flag --duration_s DURATION_S 40 "sequence length, s"
+bench_parse "$@"
+require_binaries tiltcal_simulate tiltcal_decode tiltcal_ground tiltcal_gravity tiltcal_calibrate \
+  tiltcal_gravity_reference tiltcal_dataset_calibration
+WORK=$SCRATCH
 FLAT=$WORK/husky_flat
 TILTED=$WORK/husky_incline
 mkdir -p "$FLAT" "$TILTED"

@@ -15,55 +15,25 @@
 # also run on a smaller bag to show that its peak memory does not grow with
 # the bag size. Runs are on a warm page cache (each bag is read once first).
 #
-# Usage: bench/decode/run_decode_bench.sh [options]
-#   --scratch DIR        where bags and outputs go (default /tmp)
-#   --size_gb X          large bag size, 1e9 bytes (default 1.0)
-#   --small_gb X         small bag size for the memory check (default 0.25)
-#   --repeats N          runs of tiltcal_decode and the C++ reader; the table
-#                        shows the median wall and the largest RSS (default 3)
-#   --python_points M    read_points | numpy | both (default both)
-#   --python_max_bytes N read_points on a prefix carrying N bytes of point
-#                        data only (default 0 = whole bag)
-#   --build_dir DIR      (default <repo>/build-bench)
-#   --ros2 0|1           the MCAP and sqlite3 rows (default 1)
-#   --ros2_large 0|1     also the large bag as MCAP (zstd chunks), for the memory
-#                        of the MCAP path against the bag size (default 1)
-#   --split_parts N      the small bag split by time into N bags in one folder,
-#                        decoded as one sequence (default 4; 0 = no split row)
-#   --clean              delete the generated bags at the end
+# Usage: bench/decode/run_decode_bench.sh [options]; tiltcal_decode is built
+# into --build_dir (Release). The bags are reused from --scratch DIR when
+# given (a fresh scratch is removed on exit, unless --keep).
 # Exit status is non-zero when a step fails; the table is still printed for
 # the steps that ran.
 set -euo pipefail
 
-REPO=$(cd "$(dirname "$0")/../.." && pwd)
-SCRATCH=/tmp
-SIZE_GB=1.0
-SMALL_GB=0.25
-REPEATS=3
-PYTHON_POINTS=both
-PYTHON_MAX_BYTES=0
-BUILD_DIR="$REPO/build-bench"
-CLEAN=0
-ROS2=1
-ROS2_LARGE=1
-SPLIT_PARTS=4
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --scratch) SCRATCH=$2; shift 2 ;;
-    --size_gb) SIZE_GB=$2; shift 2 ;;
-    --small_gb) SMALL_GB=$2; shift 2 ;;
-    --repeats) REPEATS=$2; shift 2 ;;
-    --python_points) PYTHON_POINTS=$2; shift 2 ;;
-    --python_max_bytes) PYTHON_MAX_BYTES=$2; shift 2 ;;
-    --build_dir) BUILD_DIR=$2; shift 2 ;;
-    --ros2) ROS2=$2; shift 2 ;;
-    --ros2_large) ROS2_LARGE=$2; shift 2 ;;
-    --split_parts) SPLIT_PARTS=$2; shift 2 ;;
-    --clean) CLEAN=1; shift ;;
-    -h|--help) sed -n '2,/^set -euo/p' "$0" | sed '$d'; exit 0 ;;
-    *) echo "run_decode_bench: unknown argument $1" >&2; exit 2 ;;
-  esac
-done
+BENCH_BUILD_DIR=build-bench
+. "$(dirname "$0")/../common.sh"
+bench_flag --size_gb SIZE_GB 1.0 "large bag size, 1e9 bytes"
+bench_flag --small_gb SMALL_GB 0.25 "small bag size for the memory check"
+bench_flag --repeats REPEATS 3 "runs of tiltcal_decode and the C++ reader; the table shows the median wall and the largest RSS"
+bench_flag --python_points PYTHON_POINTS both "read_points | numpy | both"
+bench_flag --python_max_bytes PYTHON_MAX_BYTES 0 "read_points on a prefix carrying N bytes of point data only (0 = whole bag)"
+bench_flag --ros2 ROS2 1 "the MCAP and sqlite3 rows (0|1)"
+bench_flag --ros2_large ROS2_LARGE 1 "also the large bag as MCAP (zstd chunks), for the memory of the MCAP path against the bag size (0|1)"
+bench_flag --split_parts SPLIT_PARTS 4 "the small bag split by time into N bags in one folder, decoded as one sequence (0 = no split row)"
+bench_switch --clean CLEAN "delete the generated bags of --scratch at the end"
+bench_parse "$@"
 
 DEBIAN_PYTHON=/usr/bin/python3
 BENCH_DIR="$REPO/bench/decode"

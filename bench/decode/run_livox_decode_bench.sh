@@ -10,30 +10,14 @@
 # the Livox points/s to the VLP-16's in the same run, with the load average.
 #
 # Usage: bench/decode/run_livox_decode_bench.sh [--build_dir DIR] [--repeats N] [--scratch DIR]
-#   --build_dir DIR  a build with tiltcal_simulate and tiltcal_decode (default <repo>/build)
-#   --repeats N      decodes per bag, median shown (default 5)
-#   --scratch DIR    where bags and outputs go (default /tmp)
 set -euo pipefail
 
-REPO=$(cd "$(dirname "$0")/../.." && pwd)
-BUILD_DIR="$REPO/build"
-REPEATS=5
-SCRATCH=/tmp
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --build_dir) BUILD_DIR=$2; shift 2 ;;
-    --repeats) REPEATS=$2; shift 2 ;;
-    --scratch) SCRATCH=$2; shift 2 ;;
-    -h|--help) sed -n '2,/^set -euo/p' "$0" | sed '$d'; exit 0 ;;
-    *) echo "run_livox_decode_bench: unknown argument $1" >&2; exit 2 ;;
-  esac
-done
-BIN="$BUILD_DIR/bin"
-for tool in tiltcal_simulate tiltcal_decode; do
-  [ -x "$BIN/$tool" ] || { echo "run_livox_decode_bench: build $tool first ($BIN)" >&2; exit 1; }
-done
+. "$(dirname "$0")/../common.sh"
+bench_flag --repeats REPEATS 5 "decodes per bag, median shown"
+bench_parse "$@"
+require_binaries tiltcal_simulate tiltcal_decode
 WORK=$(mktemp -d "$SCRATCH/tiltcal_livox_bench.XXXXXX")
-trap 'rm -rf "$WORK"' EXIT
+bench_on_exit 'rm -rf "$WORK"'
 
 # The two bags.
 "$BIN/tiltcal_simulate" --quiet --params="$REPO/tests/stages/calibrate/short_flat_vlp16.txtpb" \

@@ -30,7 +30,7 @@
 #include "common/io/params.h"
 #include "stages/ground/default_params_text.h"
 #include "stages/ground/scan_processor.h"
-#include "tests/stages/ground/synthetic_lidar.h"
+#include "tests/testing/synthetic_lidar.h"
 
 namespace {
 

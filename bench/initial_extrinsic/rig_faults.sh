@@ -16,23 +16,11 @@
 # per axis (mm) and tau (ms) errors against the truth, seconds of make.
 #   bench/initial_extrinsic/rig_faults.sh [--build_dir=DIR] [--scratch=DIR] [--seed=N]
 set -euo pipefail
-SRC=$(cd "$(dirname "$0")/../.." && pwd)
-BUILD=$SRC/build
-SCRATCH=""
-SEED=105
-for arg in "$@"; do
-  case "$arg" in
-    --build_dir=*) BUILD=${arg#*=} ;;
-    --scratch=*) SCRATCH=${arg#*=} ;;
-    --seed=*) SEED=${arg#*=} ;;
-    --help) sed -n '2,17p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
-    *) echo "unknown argument $arg (see --help)" >&2; exit 2 ;;
-  esac
-done
-BIN=$(cd "$BUILD" && pwd)/bin
-[ -x "$BIN/tiltcal_initial_extrinsic" ] || { echo "no $BIN/tiltcal_initial_extrinsic: build first" >&2; exit 1; }
-if [ -z "$SCRATCH" ]; then SCRATCH=$(mktemp -d); trap 'rm -rf "$SCRATCH"' EXIT; fi
-mkdir -p "$SCRATCH"
+. "$(dirname "$0")/../common.sh"
+SRC=$REPO
+bench_flag --seed SEED 105 "simulator seed"
+bench_parse "$@"
+require_binaries tiltcal_simulate tiltcal_initial_extrinsic tiltcal_inspect tiltcal_calibrate
 PY=/usr/bin/python3
 
 # scenario KIND TF_STATIC_BLOCK: the demo's Husky scenario, flat or tilted.

@@ -9,37 +9,23 @@
 # cpu_s (user + sys) is shown too: on a shared, loaded machine it is the
 # steadier figure (wall ≈ cpu_s / threads on idle cores).
 #
-# Usage: bench/simulate/run_simulate_bench.sh [options]
-#   --build_dir DIR   build with tiltcal_simulate (default <repo>/build-bench)
-#   --scratch DIR     where bags go (default /tmp)
-#   --threads "1 2"   values of num_threads to run (default "1 2")
-#   --compressions "NONE LZ4 BZ2"   (default "NONE LZ4")
-#   --duration S      sequence length, s (default 60)
+# Usage: bench/simulate/run_simulate_bench.sh [options]; tiltcal_simulate is
+# built into --build_dir (Release) when it has none.
 set -euo pipefail
 
-REPO=$(cd "$(dirname "$0")/../.." && pwd)
-BUILD_DIR="$REPO/build-bench"
-SCRATCH=/tmp
-THREADS="1 2"
-COMPRESSIONS="NONE LZ4"
-DURATION=60
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --build_dir) BUILD_DIR=$2; shift 2 ;;
-    --scratch) SCRATCH=$2; shift 2 ;;
-    --threads) THREADS=$2; shift 2 ;;
-    --compressions) COMPRESSIONS=$2; shift 2 ;;
-    --duration) DURATION=$2; shift 2 ;;
-    -h|--help) sed -n '2,/^set -euo/p' "$0" | sed '$d'; exit 0 ;;
-    *) echo "run_simulate_bench: unknown argument $1" >&2; exit 2 ;;
-  esac
-done
+BENCH_BUILD_DIR=build-bench
+. "$(dirname "$0")/../common.sh"
+bench_flag --threads THREADS "1 2" "values of num_threads to run"
+bench_flag --compressions COMPRESSIONS "NONE LZ4" "chunk compressions to run (NONE LZ4 BZ2)"
+bench_flag --duration DURATION 60 "sequence length, s"
+bench_parse "$@"
 
 if [ ! -x "$BUILD_DIR/bin/tiltcal_simulate" ]; then
   cmake -S "$REPO" -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
   cmake --build "$BUILD_DIR" --target tiltcal_simulate -j2
 fi
-SIM="$BUILD_DIR/bin/tiltcal_simulate"
+require_binaries tiltcal_simulate
+SIM="$BIN/tiltcal_simulate"
 WORK="$SCRATCH/tiltcal_simulate_bench"
 mkdir -p "$WORK"
 SCENARIO="$REPO/stages/simulate/scenarios/tilted_husky_vlp16.txtpb"

@@ -1,7 +1,7 @@
 // Micro-benchmark of the calibrator's spline residuals: evaluations per
 // second of each analytic cost function with all Jacobians, against
 // fixed-size ceres::AutoDiffCostFunction twins measured in the same run
-// (tests/stages/calibrate/cost_function_twins.h):
+// (tests/testing/cost_function_twins.h):
 //   anchor     = autodiff of the same Sommer-recursion formulas (what a
 //                careful Ceres-autodiff implementation would run);
 //   prod-rule  = autodiff of the quaternion product-rule derivatives
@@ -40,7 +40,7 @@
 #include "stages/calibrate/accel_cost_function.h"
 #include "stages/calibrate/gyro_cost_function.h"
 #include "stages/calibrate/point_to_plane_cost_function.h"
-#include "tests/stages/calibrate/cost_function_twins.h"
+#include "tests/testing/cost_function_twins.h"
 
 namespace tiltcal {
 namespace {

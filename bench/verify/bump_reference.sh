@@ -3,12 +3,14 @@
 # mount: C_bl' = Exp(theta) C_bl (theta about the IMU's axes, frame b),
 # r' = r + delta (frame b), tau' = tau + delta_tau; everything else (the
 # covariance included) as it was.
-#   bump_reference.sh IN OUT ROT_X_DEG ROT_Y_DEG ROT_Z_DEG DX_M DY_M DZ_M DTAU_S
+#   bench/verify/bump_reference.sh IN OUT ROT_X_DEG ROT_Y_DEG ROT_Z_DEG DX_M DY_M DZ_M DTAU_S
+# (no binaries: --build_dir and --scratch are not used)
 set -euo pipefail
-if [ "${1:-}" = --help ] || [ $# -ne 9 ]; then
-  sed -n '2,6p' "$0" | sed 's/^# \{0,1\}//'
-  [ "${1:-}" = --help ]; exit
-fi
+. "$(dirname "$0")/../common.sh"
+bench_args "IN OUT RX RY RZ DX DY DZ DTAU" "the calibration, the bumped one, the bump (deg, m, s)"
+bench_parse "$@"
+[ ${#BENCH_ARGS[@]} -eq 9 ] || bench_die "needs 9 arguments (see --help)"
+set -- "${BENCH_ARGS[@]}"
 in=$1 out=$2
 awk -v rx="$3" -v ry="$4" -v rz="$5" -v dx="$6" -v dy="$7" -v dz="$8" -v dt="$9" '
   function num(v) { return sprintf("%.17g", v) }

@@ -21,46 +21,22 @@
 # sequence reports it would detect (detectable_*, median and max).
 #
 # Usage: bench/verify/run_verify_bench.sh [options]
-#   --build_dir DIR        the build (default <repo>/build)
-#   --scenario FILE        simulate params (default flat_vlp16_40s.txtpb)
-#   --seeds "N.."          unbumped sequences (default "1 2 ... 20")
-#   --reference_seeds "N.." sequences of the reference (default "201 202 203 204")
-#   --bump_seeds N         how many of --seeds are checked against each bump (default 3)
-#   --rotations_deg "..."  bump sizes about each axis (default "0.1 0.2 0.3")
-#   --translations_m "..." bump sizes along each axis (default "0.005 0.01 0.02")
-#   --time_offsets_s "..." tau bumps (default "0.0005 0.001 0.002")
-#   --scratch DIR          work directory, kept and reused (default /tmp/tiltcal_verify_bench)
+# Pass --scratch DIR to keep the work and reuse it in the next run.
 # Runs everything under nice -n 10 (a shared machine).
 set -euo pipefail
 
-REPO=$(cd "$(dirname "$0")/../.." && pwd)
-BUILD_DIR="$REPO/build"
-SCENARIO="$REPO/stages/simulate/scenarios/flat_vlp16_40s.txtpb"
-SEEDS=$(seq -s ' ' 1 20)
-REFERENCE_SEEDS="201 202 203 204"
-BUMP_SEEDS=3
-ROTATIONS="0.1 0.2 0.3"
-TRANSLATIONS="0.005 0.01 0.02"
-TIME_OFFSETS="0.0005 0.001 0.002"
-SCRATCH=/tmp/tiltcal_verify_bench
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --build_dir) BUILD_DIR=$2; shift 2 ;;
-    --scenario) SCENARIO=$2; shift 2 ;;
-    --seeds) SEEDS=$2; shift 2 ;;
-    --reference_seeds) REFERENCE_SEEDS=$2; shift 2 ;;
-    --bump_seeds) BUMP_SEEDS=$2; shift 2 ;;
-    --rotations_deg) ROTATIONS=$2; shift 2 ;;
-    --translations_m) TRANSLATIONS=$2; shift 2 ;;
-    --time_offsets_s) TIME_OFFSETS=$2; shift 2 ;;
-    --scratch) SCRATCH=$2; shift 2 ;;
-    --help|-h) sed -n '2,/^set -euo/p' "$0" | sed '$d' | sed 's/^# \{0,1\}//'; exit 0 ;;
-    *) echo "unknown option $1 (see --help)" >&2; exit 2 ;;
-  esac
-done
-BIN=$(cd "$BUILD_DIR/bin" && pwd)
+. "$(dirname "$0")/../common.sh"
+bench_flag --scenario SCENARIO "$REPO/stages/simulate/scenarios/flat_vlp16_40s.txtpb" "simulate params"
+bench_flag --seeds SEEDS "$(seq -s ' ' 1 20)" "unbumped sequences"
+bench_flag --reference_seeds REFERENCE_SEEDS "201 202 203 204" "sequences of the reference"
+bench_flag --bump_seeds BUMP_SEEDS 3 "how many of --seeds are checked against each bump"
+bench_flag --rotations_deg ROTATIONS "0.1 0.2 0.3" "bump sizes about each axis"
+bench_flag --translations_m TRANSLATIONS "0.005 0.01 0.02" "bump sizes along each axis"
+bench_flag --time_offsets_s TIME_OFFSETS "0.0005 0.001 0.002" "tau bumps"
+bench_parse "$@"
+require_binaries tiltcal_simulate tiltcal_decode tiltcal_ground tiltcal_gravity tiltcal_calibrate \
+  tiltcal_dataset_calibration tiltcal_verify
 NICE=(nice -n 10)
-mkdir -p "$SCRATCH"
 
 # simulate_dataset DIR SEEDS: one bag per seed (s<seed>.bag) and the rig.
 simulate_dataset() {

@@ -1,5 +1,5 @@
 // Analytic spline residuals of the calibrator vs their autodiff twins
-// (tests/stages/calibrate/cost_function_twins.h) and vs ceres::GradientChecker
+// (tests/testing/cost_function_twins.h) and vs ceres::GradientChecker
 // (numeric differences through the manifolds), at several knot spacings and
 // normalised times including segment ends, and the time-offset window
 // behaviour of the point-to-plane residual at a segment boundary; the
@@ -28,7 +28,7 @@
 #include "stages/calibrate/interval_manifold.h"
 #include "stages/calibrate/point_to_plane_cost_function.h"
 #include "stages/calibrate/stacked_cost_function.h"
-#include "tests/stages/calibrate/cost_function_twins.h"
+#include "tests/testing/cost_function_twins.h"
 #include "tests/stages/calibrate/jacobian_checks.h"
 #include "tests/testing/random_vector.h"
 

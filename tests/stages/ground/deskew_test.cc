@@ -13,7 +13,7 @@
 
 #include "stages/ground/scan_processor.h"
 #include "tests/stages/ground/ground_test_util.h"
-#include "tests/stages/ground/synthetic_lidar.h"
+#include "tests/testing/synthetic_lidar.h"
 
 namespace tiltcal::ground {
 namespace {

@@ -14,7 +14,7 @@
 #include "common/io/record_stream.h"
 #include "common/io/text_proto.h"
 #include "tests/stages/ground/ground_test_util.h"
-#include "tests/stages/ground/synthetic_lidar.h"
+#include "tests/testing/synthetic_lidar.h"
 #include "tiltcal/proto/ground.pb.h"
 #include "tiltcal/proto/imu.pb.h"
 #include "tiltcal/proto/rig.pb.h"

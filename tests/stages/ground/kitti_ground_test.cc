@@ -17,7 +17,7 @@
 #include "tiltcal/proto/imu.pb.h"
 #include "tiltcal/proto/rig.pb.h"
 #include "tests/stages/ground/ground_test_util.h"
-#include "tests/stages/ground/synthetic_lidar.h"
+#include "tests/testing/synthetic_lidar.h"
 
 namespace tiltcal::ground {
 namespace {

@@ -12,7 +12,7 @@
 
 #include "common/io/eigen_proto.h"
 #include "tests/stages/ground/ground_test_util.h"
-#include "tests/stages/ground/synthetic_lidar.h"
+#include "tests/testing/synthetic_lidar.h"
 
 namespace tiltcal::ground {
 namespace {

@@ -3,7 +3,7 @@
 // (verdict reasons, residual types, the dataset's sequence names, reasons
 // and disagreements) carrying HTML, a javascript: URL, newlines, quotes and
 // commas. The page is loaded in headless chromium; the CSV is read by
-// Python's csv module and by scripts/plot_extrinsics.py.
+// Python's csv module and by stages/report/plot_extrinsics.py.
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -135,7 +135,7 @@ TEST_F(ReportInjectionTest, CsvKeepsColumnsAndNames) {
     GTEST_SKIP() << testing::kDebianPython << " has no matplotlib (python3-matplotlib)";
   }
   ASSERT_EQ(testing::RunCommand(std::string(testing::kDebianPython) + " " +
-                                    testing::SourceDir() + "/scripts/plot_extrinsics.py --csv=" +
+                                    testing::SourceDir() + "/stages/report/plot_extrinsics.py --csv=" +
                                     paths_.out_csv + " --out_dir=" + dir_.path(),
                                 &output),
             0)

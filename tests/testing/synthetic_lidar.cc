@@ -1,4 +1,4 @@
-#include "tests/stages/ground/synthetic_lidar.h"
+#include "tests/testing/synthetic_lidar.h"
 
 #include <cmath>
 #include <limits>

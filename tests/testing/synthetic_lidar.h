@@ -1,5 +1,5 @@
-#ifndef TILTCAL_TESTS_STAGES_GROUND_SYNTHETIC_LIDAR_H_
-#define TILTCAL_TESTS_STAGES_GROUND_SYNTHETIC_LIDAR_H_
+#ifndef TILTCAL_TESTS_TESTING_SYNTHETIC_LIDAR_H_
+#define TILTCAL_TESTS_TESTING_SYNTHETIC_LIDAR_H_
 
 #include <cstdint>
 #include <vector>
@@ -61,4 +61,4 @@ SyntheticScene StreetScene(uint32_t seed);
 
 }  // namespace tiltcal::testing
 
-#endif  // TILTCAL_TESTS_STAGES_GROUND_SYNTHETIC_LIDAR_H_
+#endif  // TILTCAL_TESTS_TESTING_SYNTHETIC_LIDAR_H_

@@ -1,5 +1,5 @@
-#ifndef TILTCAL_TESTS_STAGES_CALIBRATE_COST_FUNCTION_TWINS_H_
-#define TILTCAL_TESTS_STAGES_CALIBRATE_COST_FUNCTION_TWINS_H_
+#ifndef TILTCAL_TESTS_TESTING_COST_FUNCTION_TWINS_H_
+#define TILTCAL_TESTS_TESTING_COST_FUNCTION_TWINS_H_
 
 // Autodiff twins of the analytic residuals in stages/calibrate, for tests and
 // the benchmark anchor ONLY (never used in production). They evaluate the
@@ -149,4 +149,4 @@ using PointToPlaneTwin = PointToPlaneTwinT<false>;
 
 }  // namespace tiltcal::testing
 
-#endif  // TILTCAL_TESTS_STAGES_CALIBRATE_COST_FUNCTION_TWINS_H_
+#endif  // TILTCAL_TESTS_TESTING_COST_FUNCTION_TWINS_H_

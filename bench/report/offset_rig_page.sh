@@ -8,15 +8,19 @@
 # rig's extrinsic and with the estimate (calibration.txtpb) and where the
 # page is. About 5 minutes on 2 cores.
 #
-# Usage: scripts/offset_rig_page.sh [DATASET_DIR]   (default /tmp/tiltcal_offset_rig)
+# The dataset is <scratch>/dataset (made afresh), or DATASET_DIR when given.
+# The scratch folder is kept (the page is the result): its path is printed.
+#
+# Usage: bench/report/offset_rig_page.sh [--build_dir DIR] [--scratch DIR] [DATASET_DIR]
 set -euo pipefail
-cd "$(dirname "$0")/.."
-DATASET=${1:-/tmp/tiltcal_offset_rig}
-BIN=build/bin
-for tool in tiltcal_simulate tiltcal_decode tiltcal_ground tiltcal_gravity tiltcal_calibrate \
-  tiltcal_dataset_calibration tiltcal_report; do
-  [ -x "$BIN/$tool" ] || { echo "build $tool first (scripts/build.sh)" >&2; exit 1; }
-done
+. "$(dirname "$0")/../common.sh"
+bench_args "[DATASET_DIR]" "the dataset folder, made afresh (default <scratch>/dataset)"
+KEEP=1
+bench_parse "$@"
+require_binaries tiltcal_simulate tiltcal_decode tiltcal_ground tiltcal_gravity tiltcal_calibrate \
+  tiltcal_dataset_calibration tiltcal_report
+DATASET=${BENCH_ARGS[0]:-$SCRATCH/dataset}
+cd "$REPO"
 rm -rf "$DATASET"
 mkdir -p "$DATASET/scenarios"
 for seed in 1 2; do
@@ -29,7 +33,7 @@ for seed in 1 2; do
   "$BIN/tiltcal_simulate" --quiet --params="$DATASET/scenarios/offset_$seed.txtpb" \
     --out_bag="$DATASET/offset_$seed.bag" --out_truth="$DATASET/offset_$seed.truth.txtpb" $rig_flag
 done
-make -s -f Makefile.pipeline DATASET="$DATASET" -j2 report
+make -s -f Makefile.pipeline DATASET="$DATASET" BIN="$BIN" -j2 report
 echo
 printf '%-10s %22s %22s %8s %10s\n' sequence "rig: thickness/surfels" "estimate: thick/surf" ratio verdict
 for seq in offset_1 offset_2; do

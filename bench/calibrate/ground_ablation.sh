@@ -14,40 +14,47 @@
 # "flatL2") is that residual without its robust loss (cauchy_scale 0), which
 # shows what the Cauchy loss hides: the flat residual's bias on tilted ground.
 #
-# With ABLATION_SEEDS="1 2 3", the whole study runs once per seed (in
-# $ABLATION_DIR/seed_<n>, tables printed as they come) and a last table gives
+# With --seeds "1 2 3", the whole study runs once per seed (in
+# <scratch>/seed_<n>, tables printed as they come) and a last table gives
 # the largest |error| of every row over the seeds.
 #
-#   scripts/ground_ablation.sh [BIN_DIR]
-#   ABLATION_DIR=/tmp/ablation ABLATION_DURATION_S=30 ABLATION_SEED=2 \
-#     ABLATION_SETS="none dist" ABLATION_MISINIT=0 scripts/ground_ablation.sh build-x/bin
-#   ABLATION_SEEDS="1 2 3" scripts/ground_ablation.sh
+#   bench/calibrate/ground_ablation.sh [--build_dir DIR]
+#   bench/calibrate/ground_ablation.sh --scratch /tmp/ablation --duration_s 30 \
+#     --seed 2 --sets "none dist" --misinit 0
+#   bench/calibrate/ground_ablation.sh --seeds "1 2 3"
+# The environment variables of the older form (ABLATION_DIR, ABLATION_SEED,
+# ABLATION_SEEDS, ABLATION_DURATION_S, ABLATION_SETS, ABLATION_MISINIT,
+# ABLATION_MISINIT_SETS) still give the defaults, and a BIN_DIR argument the
+# binaries.
 #
-# Outputs in $ABLATION_DIR: the sequences, base_calibrate_params.txtpb (the
+# Outputs in the scratch folder: the sequences, base_calibrate_params.txtpb (the
 # defaults every run starts from, copied once), runs/<name>/{params,
 # calibration,truth}.txtpb, errors.csv (tiltcal_report), table.txt (printed);
 # with ABLATION_SEEDS also table_over_seeds.txt.
-# Existing sequences and runs in $ABLATION_DIR are reused.
+# Existing sequences and runs in --scratch DIR are reused.
 set -euo pipefail
-cd "$(dirname "$0")/.."
-ROOT=$(pwd)
-BIN=$(cd "${1:-$ROOT/build/bin}" && pwd)
-WORK=${ABLATION_DIR:-/tmp/tiltcal_ground_ablation}
-DURATION_S=${ABLATION_DURATION_S:-30}
-SEED=${ABLATION_SEED:-1}  # simulator seed of both sequences (noise, world)
-SETS=${ABLATION_SETS:-"none flat flatL2 dist incl dist+incl dist+up flat+dist"}
-MISINIT=${ABLATION_MISINIT:-1}
-MISINIT_SETS=${ABLATION_MISINIT_SETS:-"none dist incl dist+incl dist+up"}
+. "$(dirname "$0")/../common.sh"
+ROOT=$REPO
+bench_flag --duration_s DURATION_S "${ABLATION_DURATION_S:-30}" "sequence length, s"
+bench_flag --seed SEED "${ABLATION_SEED:-1}" "simulator seed of both sequences (noise, world)"
+bench_flag --seeds SEEDS "${ABLATION_SEEDS:-}" "run the study once per seed, then the worst case over them"
+bench_flag --sets SETS "${ABLATION_SETS:-none flat flatL2 dist incl dist+incl dist+up flat+dist}" "residual sets"
+bench_flag --misinit MISINIT "${ABLATION_MISINIT:-1}" "the misinitialisation study (0|1)"
+bench_flag --misinit_sets MISINIT_SETS "${ABLATION_MISINIT_SETS:-none dist incl dist+incl dist+up}" "its residual sets"
+bench_args "[BIN_DIR]" "the binaries (older form of --build_dir)"
+[ -z "${ABLATION_DIR:-}" ] || SCRATCH=$ABLATION_DIR
+bench_parse "$@"
+[ ${#BENCH_ARGS[@]} -eq 0 ] || BIN=$(cd "${BENCH_ARGS[0]}" && pwd)
+WORK=$SCRATCH
 MISINIT_OFFSET=(-0.6 1.0 0.6)  # m, added to the rig's r_b^{lb}
-
-SEEDS=${ABLATION_SEEDS:-}
 
 if [ -n "$SEEDS" ]; then
   # One study per seed, then the worst case of every row over the seeds.
   tables=()
   for seed in $SEEDS; do
-    ABLATION_SEEDS="" ABLATION_SEED=$seed ABLATION_DIR="$WORK/seed_$seed" \
-      "$ROOT/scripts/ground_ablation.sh" "$BIN"
+    "$0" --build_dir "$BUILD_DIR" --scratch "$WORK/seed_$seed" --seeds "" --seed "$seed" \
+      --duration_s "$DURATION_S" --sets "$SETS" --misinit "$MISINIT" \
+      --misinit_sets "$MISINIT_SETS" ${BENCH_ARGS[@]+"${BENCH_ARGS[@]}"}
     echo
     tables+=("$WORK/seed_$seed/table.txt")
   done
@@ -73,10 +80,8 @@ if [ -n "$SEEDS" ]; then
   exit 0
 fi
 
-for tool in simulate decode ground gravity calibrate report; do
-  [ -x "$BIN/tiltcal_$tool" ] || { echo "ground_ablation: $BIN/tiltcal_$tool missing (build it)" >&2; exit 1; }
-done
-mkdir -p "$WORK"
+require_binaries tiltcal_simulate tiltcal_decode tiltcal_ground tiltcal_gravity tiltcal_calibrate \
+  tiltcal_report
 log() { echo "ground_ablation: $*" >&2; }
 # Every run starts from the same snapshot of the calibrate defaults.
 [ -s "$WORK/base_calibrate_params.txtpb" ] ||
