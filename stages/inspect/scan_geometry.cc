@@ -57,7 +57,7 @@ ScanGeometry MeasureScanGeometry(const std::vector<float>& x, const std::vector<
   if (gx.size() < 10) return g;
   geometry::RobustPlaneOptions fit_options;
   fit_options.inlier_distance_m = options.ground_inlier_distance_m;
-  fit_options.max_iterations = 5;
+  fit_options.max_iterations = options.ground_fit_max_iterations;
   std::vector<uint8_t> inlier;
   const geometry::PlaneFit plane =
       geometry::FitPlaneRobust(gx.data(), gy.data(), gz.data(), gx.size(), fit_options, &inlier);

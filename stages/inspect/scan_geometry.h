@@ -15,6 +15,7 @@ struct ScanGeometryOptions {
   double ground_inlier_distance_m;
   double ground_max_tilt_deg;
   double min_ground_fraction;
+  int ground_fit_max_iterations;  // refits of the robust ground plane
   double structure_min_height_m;
   double structure_max_range_m;
 };

@@ -188,6 +188,7 @@ TEST(ScanGeometry, FindsTheGroundAndTheStructureAlongUp) {
   options.ground_inlier_distance_m = 0.1;
   options.ground_max_tilt_deg = 25.0;
   options.min_ground_fraction = 0.1;
+  options.ground_fit_max_iterations = 5;
   options.structure_min_height_m = 0.5;
   options.structure_max_range_m = 30.0;
   const ScanGeometry g = MeasureScanGeometry(x, y, z, Eigen::Vector3d(0, 0, -1), options);
