@@ -7,6 +7,7 @@
 
 #include "bag/ros1/messages.h"
 #include "bag/ros2/messages.h"
+#include "common/geometry/angles.h"
 #include "common/geometry/euler_angles.h"
 #include "common/io/eigen_proto.h"
 
@@ -145,7 +146,7 @@ void Summarise(StaticTransforms* s) {
   Eigen::Quaterniond q = c.target_from_source_rotation;
   if (q.w() < 0) q.coeffs() = -q.coeffs();  // as written to the provenance
   const Eigen::Vector3d euler_deg =
-      geometry::Euler123FromRotation(q.toRotationMatrix()) * (180.0 / M_PI);
+      geometry::Euler123FromRotation(q.toRotationMatrix()) * geometry::kDegPerRad;
   const Eigen::Vector3d& r = c.target_from_source_translation;
   s->summary = fmt::format(
       "imu_from_lidar along {}: rotation (w x y z) {:.6f} {:.6f} {:.6f} {:.6f} "

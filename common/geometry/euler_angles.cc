@@ -1,4 +1,5 @@
 #include "common/geometry/euler_angles.h"
+#include "common/geometry/angles.h"
 
 #include <algorithm>
 #include <cmath>
@@ -22,7 +23,7 @@ Eigen::Matrix3d RotationFromEuler123(const Eigen::Vector3d& angles_rad) {
 }
 
 Eigen::Matrix3d RotationFromEuler123Deg(const Eigen::Vector3d& angles_deg) {
-  return RotationFromEuler123(angles_deg * (M_PI / 180.0));
+  return RotationFromEuler123(angles_deg * kRadPerDeg);
 }
 
 Eigen::Vector3d Euler123FromRotation(const Eigen::Matrix3d& c) {

@@ -103,9 +103,9 @@ float MeanOfLowest(const float* v, size_t n, const uint8_t* active, size_t k, fl
 
 // Options of FitPlaneRobust.
 struct RobustPlaneOptions {
-  double inlier_distance_m = 0.1;  // inliers: |n·p + d| < this
-  int max_iterations = 3;          // refits after the initial fit
-  double min_spread_m2 = 1e-8;     // see FitPlane
+  double inlier_distance_m;     // inliers: |n·p + d| < this; no default (params)
+  int max_iterations;           // refits after the initial fit; no default (params)
+  double min_spread_m2 = 1e-8;  // see FitPlane
 };
 
 // Plane through the points 0..n−1 of the columns (x, y, z): an initial PCA

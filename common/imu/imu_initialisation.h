@@ -19,11 +19,12 @@ namespace tiltcal::imu {
 // along gravity would show (as |mean f| ≠ |g|); its other components cannot
 // be told from a gravity direction change. It is therefore zero here, and the
 // norm mismatch is reported for diagnosis only.
+// No defaults: every field is set from the params file (calibrate and gravity params).
 struct ImuInitialisationOptions {
   StaticDetectionOptions static_detection;
-  double gravity_norm_mps2 = 9.81;  // |g_a|
+  double gravity_norm_mps2;  // |g_a|
   // Without a static start, g_a comes from the first this-many seconds.
-  double fallback_window_s = 2.0;
+  double fallback_window_s;
 };
 
 struct ImuInitialisation {

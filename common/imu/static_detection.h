@@ -10,13 +10,14 @@
 
 namespace tiltcal::imu {
 
+// No defaults: every field is set from the params file (each stage's static_detection params).
 struct StaticDetectionOptions {
-  double window_s = 0.5;              // length of one test window, s
-  double hop_s = 0.1;                 // window step, s (resolution of the interval ends)
-  double max_gyro_std_radps = 0.01;   // per-axis standard deviation bound, rad/s
-  double max_accel_std_mps2 = 0.05;   // per-axis standard deviation bound, m/s²
-  double max_gyro_mean_radps = 0.05;  // |mean gyro| bound (rules out steady turning), rad/s
-  double min_duration_s = 1.0;        // shorter static runs are not reported
+  double window_s;  // length of one test window, s
+  double hop_s;  // window step, s (resolution of the interval ends)
+  double max_gyro_std_radps;  // per-axis standard deviation bound, rad/s
+  double max_accel_std_mps2;  // per-axis standard deviation bound, m/s²
+  double max_gyro_mean_radps;  // |mean gyro| bound (rules out steady turning), rad/s
+  double min_duration_s;  // shorter static runs are not reported
 };
 
 // A time interval in which the IMU stood still: [begin_s, end_s] and the

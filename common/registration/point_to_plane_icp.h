@@ -27,14 +27,15 @@
 
 namespace tiltcal::registration {
 
+// No defaults: every field is set from the params file (calibrate params: lidar_odometry, voxel_icp).
 struct PointToPlaneIcpOptions {
-  int max_iterations = 20;
-  double max_correspondence_m = 1.0;       // nearest-neighbour gate, m
-  double kernel_scale_m = 0.1;             // Geman-McClure s, m
-  double convergence_rotation_rad = 1e-4;
-  double convergence_translation_m = 1e-4;
-  int min_correspondences = 20;
-  int num_threads = 1;
+  int max_iterations;
+  double max_correspondence_m;  // nearest-neighbour gate, m
+  double kernel_scale_m;  // Geman-McClure s, m
+  double convergence_rotation_rad;
+  double convergence_translation_m;
+  int min_correspondences;
+  int num_threads;
 };
 
 struct PointToPlaneIcpResult {

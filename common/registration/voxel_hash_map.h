@@ -23,12 +23,13 @@
 
 namespace tiltcal::registration {
 
+// No defaults: every field is set from the params file (calibrate params: lidar_odometry.voxel_icp).
 struct VoxelHashMapOptions {
-  double voxel_m = 1.0;                // cube edge, m
-  int max_points_per_voxel = 20;
-  int min_plane_points = 5;
-  double max_plane_thickness_m = 0.05;  // sqrt(smallest covariance eigenvalue), m
-  double min_plane_spread_ratio = 0.05;  // middle / largest covariance eigenvalue
+  double voxel_m;  // cube edge, m
+  int max_points_per_voxel;
+  int min_plane_points;
+  double max_plane_thickness_m;  // sqrt(smallest covariance eigenvalue), m
+  double min_plane_spread_ratio;  // middle / largest covariance eigenvalue
 };
 
 // The nearest map point to a query and the plane of its voxel.

@@ -11,6 +11,7 @@
 #include <ceres/solver.h>
 #include <fmt/format.h>
 
+#include "common/geometry/angles.h"
 #include "common/geometry/translation_prior.h"
 #include "common/io/atomic_file.h"
 #include "common/io/eigen_proto.h"
@@ -325,8 +326,8 @@ Status RunOuterRound(const OuterLoopSetup& setup, const proto::AssociationParams
                        q.z()));
   loop->rounds = round;
   loop->moved_deg =
-      Eigen::AngleAxisd(rotation_before.conjugate() * state->ImuFromLidarRotation()).angle() *
-      180.0 / M_PI;
+      geometry::RadToDeg(
+          Eigen::AngleAxisd(rotation_before.conjugate() * state->ImuFromLidarRotation()).angle());
   // Without the distance residual the translation along the motion's
   // rotation axis is held only by its prior (planar motion): it wanders by
   // millimetres per round and takes no part in the stop test.
@@ -631,7 +632,7 @@ void FillStartingExtrinsicNotes(const proto::Rig& rig, const CalibrationState& s
   const Eigen::Quaterniond c_bl = state.ImuFromLidarRotation();
   const Eigen::Vector3d r_bl = state.ImuFromLidarTranslation();
   auto rotation_deg = [&](const Rigid3d& t) {
-    return Eigen::AngleAxisd(t.rotation.conjugate() * c_bl).angle() * 180.0 / M_PI;
+    return geometry::RadToDeg(Eigen::AngleAxisd(t.rotation.conjugate() * c_bl).angle());
   };
   std::string line = "starting extrinsic: " + start.summary();
   if (start.has_guess()) {
@@ -676,13 +677,13 @@ void FillVerdictFacts(const CalibrateInputs& inputs, const proto::CalibrateParam
   const Eigen::Quaterniond c_bl = state.ImuFromLidarRotation();
   *result->mutable_rig_imu_from_lidar() = ToProto(rig);
   result->set_rotation_from_rig_deg(
-      Eigen::AngleAxisd(rig.rotation.conjugate() * c_bl).angle() * 180.0 / M_PI);
+      geometry::RadToDeg(Eigen::AngleAxisd(rig.rotation.conjugate() * c_bl).angle()));
   result->set_translation_from_rig_m((state.ImuFromLidarTranslation() - rig.translation).norm());
   result->set_hand_eye_used(init.rotation_from_hand_eye);
   if (init.rotation_from_hand_eye) {
     result->set_hand_eye_disagreement_deg(
-        Eigen::AngleAxisd(init.hand_eye.imu_from_lidar_rotation.conjugate() * c_bl).angle() *
-        180.0 / M_PI);
+        geometry::RadToDeg(
+            Eigen::AngleAxisd(init.hand_eye.imu_from_lidar_rotation.conjugate() * c_bl).angle()));
   }
   result->set_static_start(init.imu.from_static_start);
   result->set_static_samples(init.imu.num_samples_averaged * inputs.imu_decimation);
@@ -776,7 +777,7 @@ Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& pa
   problem_options.estimate_imu_intrinsics = intrinsics.mode() == proto::ImuIntrinsicsParams::ON;
   problem_options.intrinsics_scale_prior_sigma = intrinsics.scale_prior_ppm() * 1e-6;
   problem_options.intrinsics_misalignment_prior_sigma_rad =
-      intrinsics.misalignment_prior_deg() * M_PI / 180.0;
+      geometry::DegToRad(intrinsics.misalignment_prior_deg());
   OuterLoop loop;
   bool settled = false;
   int max_rounds = static_cast<int>(params.outer_loop().iterations());

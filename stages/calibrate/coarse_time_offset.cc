@@ -47,8 +47,10 @@ Status EstimateCoarseTimeOffset(const std::vector<imu::TimedValue>& gyro_speed,
   options.min_overlap_s = params.coarse_time_offset_min_overlap_fraction() *
                           (lidar_speed.back().time_s - lidar_speed.front().time_s);
   // The ratio of two slow rotations is noise: scale from LiDAR speeds above
-  // 0.05 rad/s (3 deg/s; a turning vehicle is well above).
-  options.min_reference_speed = 0.05;
+  // coarse_time_offset_min_reference_speed_radps (absent: 0.05 rad/s).
+  options.min_reference_speed = params.has_coarse_time_offset_min_reference_speed_radps()
+                                    ? params.coarse_time_offset_min_reference_speed_radps()
+                                    : 0.05;
   TILTCAL_RETURN_IF_ERROR(
       imu::AlignAngularSpeeds(gyro_speed, lidar_speed, options, &result->alignment));
   const imu::AngularSpeedAlignment& a = result->alignment;

@@ -12,6 +12,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/SparseCore>
 
+#include "common/geometry/angles.h"
 #include "stages/calibrate/marginal_covariance.h"
 
 namespace tiltcal::calibrate {
@@ -224,7 +225,7 @@ void AddGroup(const Eigen::Matrix3d& cov_block, const Eigen::Matrix3d& to_b, int
     for (int j = 0; j < 3; ++j) d->set_direction(offset + j, v[j]);
     d->set_sigma(sigma);
     d->set_weak(sigma > threshold);
-    const double angle_deg = std::acos(std::min(1.0, cos_axis)) * 180.0 / M_PI;
+    const double angle_deg = geometry::RadToDeg(std::acos(std::min(1.0, cos_axis)));
     char buf[256];
     std::snprintf(buf, sizeof(buf), "%s along b-%s, %.0f deg from the motion's rotation axis%s: "
                   "sigma %.4g %s%s",
@@ -245,7 +246,7 @@ void FillCovarianceReport(const Matrix7d& covariance, const Eigen::Matrix3d& c_b
   for (int i = 0; i < 7; ++i) {
     for (int j = 0; j < 7; ++j) result->add_covariance(covariance(i, j));
   }
-  const double rad_to_deg = 180.0 / M_PI;
+  const double rad_to_deg = geometry::kDegPerRad;
   proto::Vector3* rs = result->mutable_rotation_sigma_deg();
   rs->set_x(std::sqrt(std::max(0.0, covariance(0, 0))) * rad_to_deg);
   rs->set_y(std::sqrt(std::max(0.0, covariance(1, 1))) * rad_to_deg);

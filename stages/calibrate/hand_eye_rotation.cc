@@ -1,4 +1,5 @@
 #include "stages/calibrate/hand_eye_rotation.h"
+#include "common/geometry/angles.h"
 
 #include <cmath>
 
@@ -8,7 +9,7 @@
 namespace tiltcal::calibrate {
 namespace {
 
-constexpr double kRadToDeg = 180.0 / M_PI;
+using geometry::kDegPerRad;
 
 Eigen::Matrix3d Skew(const Eigen::Vector3d& v) {
   Eigen::Matrix3d m;
@@ -63,7 +64,7 @@ HandEyeResult EstimateHandEyeRotation(const std::vector<RotationPair>& pairs,
   for (std::size_t i = 0; i < pairs.size(); ++i) {
     const Eigen::Quaterniond qb = pairs[i].imu_delta.normalized();
     const Eigen::Quaterniond ql = pairs[i].lidar_delta.normalized();
-    const double difference_deg = std::abs(Angle(qb) - Angle(ql)) * kRadToDeg;
+    const double difference_deg = std::abs(Angle(qb) - Angle(ql)) * kDegPerRad;
     const double h = difference_deg <= params.consistent_angle_deg() ? 1.0 : 1.0 / difference_deg;
     // Same sign convention (w >= 0) for both: conjugation keeps w, so the
     // consistent pair satisfies the equation without a sign flip.
@@ -99,7 +100,7 @@ HandEyeResult EstimateHandEyeRotation(const std::vector<RotationPair>& pairs,
     const double angle = Angle(e.normalized());
     sum_sq += angle * angle;
   }
-  result.rms_residual_deg = std::sqrt(sum_sq / static_cast<double>(pairs.size())) * kRadToDeg;
+  result.rms_residual_deg = std::sqrt(sum_sq / static_cast<double>(pairs.size())) * kDegPerRad;
   return result;
 }
 

@@ -6,6 +6,7 @@
 
 #include <Eigen/Cholesky>
 
+#include "common/geometry/angles.h"
 #include "common/imu/triad_errors.h"
 #include "common/io/eigen_proto.h"
 #include "stages/calibrate/covariance_report.h"
@@ -13,7 +14,7 @@
 namespace tiltcal::calibrate {
 namespace {
 
-constexpr double kIntrinsicsDegPerRad = 180.0 / M_PI;
+using geometry::kDegPerRad;
 
 // Row-major indices of the 3 x 3 entries; the upper triangles (1, 2, 5)
 // are held by the problem's manifold.
@@ -34,7 +35,8 @@ const std::vector<int>& GyroErrorEntries() { return kGyroEntries; }
 const std::vector<int>& AccelErrorEntries() { return kAccelEntries; }
 
 double IntrinsicPriorSigma(int row, int col, const proto::ImuIntrinsicsParams& params) {
-  return row == col ? params.scale_prior_ppm() * 1e-6 : params.misalignment_prior_deg() / kIntrinsicsDegPerRad;
+  return row == col ? params.scale_prior_ppm() * 1e-6
+                    : params.misalignment_prior_deg() / kDegPerRad;
 }
 
 Status ScoreTestImuIntrinsics(ceres::Problem* problem, CalibrationState* state,
@@ -117,9 +119,9 @@ proto::ImuTriadEstimate DescribeTriad(const std::array<double, 9>& errors,
   *out.mutable_scale_ppm() = ToProto(Eigen::Vector3d((t.diagonal().array() - 1.0) * 1e6));
   *out.mutable_scale_sigma_ppm() = ToProto(Eigen::Vector3d(sigma.diagonal() * 1e6));
   *out.mutable_misalignment_deg() =
-      ToProto(Eigen::Vector3d(t(1, 0), t(2, 0), t(2, 1)) * kIntrinsicsDegPerRad);
+      ToProto(Eigen::Vector3d(t(1, 0), t(2, 0), t(2, 1)) * kDegPerRad);
   *out.mutable_misalignment_sigma_deg() =
-      ToProto(Eigen::Vector3d(sigma(1, 0), sigma(2, 0), sigma(2, 1)) * kIntrinsicsDegPerRad);
+      ToProto(Eigen::Vector3d(sigma(1, 0), sigma(2, 0), sigma(2, 1)) * kDegPerRad);
   for (int i = 0; i < 3; ++i) {
     for (int j = 0; j < 3; ++j) {
       out.add_measured_from_true(t(i, j));

@@ -8,6 +8,7 @@
 
 #include <fmt/format.h>
 
+#include "common/geometry/angles.h"
 #include "common/io/eigen_proto.h"
 #include "common/io/imu_stream.h"
 #include "common/io/rig.h"
@@ -107,8 +108,8 @@ Status FindSequenceRig(const InitialExtrinsicPaths& paths, const proto::Calibrat
     return status.not_determined() ? Status::NotDetermined(message) : Status::Error(message);
   }
   const double change_deg =
-      guess ? Eigen::AngleAxisd(found.imu_from_lidar * guess->rotation.conjugate()).angle() *
-                  180.0 / M_PI
+      guess ? geometry::RadToDeg(
+                  Eigen::AngleAxisd(found.imu_from_lidar * guess->rotation.conjugate()).angle())
             : 0.0;
   start.set_rotation_change_deg(change_deg);
   const std::string about_axis =

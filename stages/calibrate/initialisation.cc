@@ -11,6 +11,7 @@
 
 #include <fmt/format.h>
 
+#include "common/geometry/angles.h"
 #include "common/imu/gyro_integrator.h"
 #include "common/io/static_detection_params.h"
 #include "common/spline/cubic_basis.h"
@@ -208,7 +209,7 @@ double RefineRotationSpline(const std::vector<double>& times_s,
   const spline::UniformKnotGrid& grid = traj.grid();
   CalibrationProblem problem(state, FitImuNoise(params), params.lidar(), FitOptions(params, *state));
   problem.AddImuResiduals(imu_samples, /*gyro=*/true, /*accel=*/false);
-  const double sigma = params.init().odometry_rotation_sigma_deg() * M_PI / 180.0;
+  const double sigma = geometry::DegToRad(params.init().odometry_rotation_sigma_deg());
   Status status = problem.AddExtraResiduals([&](CalibrationState* s, ceres::Problem* p, int* added) {
     for (size_t k = 0; k < times_s.size(); ++k) {
       spline::KnotWindow w;
@@ -335,7 +336,7 @@ Status InitialExtrinsicRotation(const OdometryRun& run, const std::vector<LidarS
     // Planar motion: the rotation axis is still seen by both sensors.
     const Eigen::Quaterniond aligned = AlignRotationAxes(pairs, c_bl_init);
     const double correction_deg =
-        Eigen::AngleAxisd(aligned * c_bl_init.conjugate()).angle() * 180.0 / M_PI;
+        geometry::RadToDeg(Eigen::AngleAxisd(aligned * c_bl_init.conjugate()).angle());
     if (correction_deg <= max_deg) {
       c_bl_init = aligned;
       report->axis_alignment_deg = correction_deg;
@@ -343,7 +344,8 @@ Status InitialExtrinsicRotation(const OdometryRun& run, const std::vector<LidarS
     }
   }
   report->rig_rotation_correction_deg =
-      Eigen::AngleAxisd(c_bl_init * measured_imu_from_lidar.conjugate()).angle() * 180.0 / M_PI;
+      geometry::RadToDeg(
+          Eigen::AngleAxisd(c_bl_init * measured_imu_from_lidar.conjugate()).angle());
   *c_bl = c_bl_init;
   return Status::Ok();
 }

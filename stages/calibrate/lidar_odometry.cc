@@ -1,5 +1,6 @@
 #include "stages/calibrate/lidar_odometry.h"
 
+#include "common/geometry/angles.h"
 #include "common/registration/point_to_plane_icp.h"
 #include "common/registration/voxel_downsample.h"
 #include "common/registration/voxel_hash_map.h"
@@ -424,7 +425,8 @@ const LidarOdometryPose& LidarOdometry::AddPrepared(
     const Eigen::Isometry3d since_keyframe = m.last_keyframe_pose.inverse() * pose.l0_from_lidar;
     if (pose.registered &&
         (since_keyframe.translation().norm() > m.params.keyframe_distance_m() ||
-         RotationAngle(since_keyframe.linear()) * 180.0 / M_PI > m.params.keyframe_angle_deg())) {
+         geometry::RadToDeg(RotationAngle(since_keyframe.linear())) >
+             m.params.keyframe_angle_deg())) {
       m.AddKeyframe(source, scan.cropped, pose.l0_from_lidar);
       pose.keyframe = true;
     }

@@ -7,12 +7,13 @@
 
 #include <fmt/format.h>
 
+#include "common/geometry/angles.h"
 #include "common/spline/so3_spline.h"
 
 namespace tiltcal::calibrate {
 namespace {
 
-constexpr double kDegPerRad = 180.0 / M_PI;
+using geometry::kDegPerRad;
 
 // Linear interpolation of (times, values) at t; t within the span.
 Eigen::Vector3d Interpolate(const std::vector<double>& times,

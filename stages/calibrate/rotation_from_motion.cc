@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include "common/geometry/angles.h"
 #include "stages/calibrate/calibration_state.h"
 #include "stages/calibrate/init_odometry.h"
 #include "stages/calibrate/initialisation.h"
@@ -15,7 +16,7 @@ namespace tiltcal::calibrate {
 namespace {
 
 double AngleDeg(const Eigen::Quaterniond& a, const Eigen::Quaterniond& b) {
-  return Eigen::AngleAxisd(a * b.conjugate()).angle() * 180.0 / M_PI;
+  return geometry::RadToDeg(Eigen::AngleAxisd(a * b.conjugate()).angle());
 }
 
 // The initialisation's params with the search's odometry (every
@@ -122,7 +123,7 @@ Status FindImuFromLidarRotation(const std::vector<imu::ImuReading>& imu_samples,
                                                   used.positions_l0, result->axis_b,
                                                   params.init());
       if (r.acceleration.decided) {
-        next = Eigen::AngleAxisd(r.acceleration.yaw_error_deg * M_PI / 180.0, result->axis_b) *
+        next = Eigen::AngleAxisd(geometry::DegToRad(r.acceleration.yaw_error_deg), result->axis_b) *
                next;
         result->about_axis_decided = true;
       } else if (!guess.has_value()) {

@@ -4,6 +4,7 @@
 #include <cassert>
 #include <cmath>
 
+#include "common/geometry/angles.h"
 #include "stages/calibrate/point_priority.h"
 
 namespace tiltcal::calibrate {
@@ -155,7 +156,7 @@ bool SurfelMap::PassesPlanarityGate(const PcaResult& pca, int fit_count,
     return false;
   }
   *normal_sigma_rad = std::sqrt(l3 / (fit_count * l2));
-  if (*normal_sigma_rad > params_.max_normal_sigma_deg() * M_PI / 180.0) {
+  if (*normal_sigma_rad > geometry::DegToRad(params_.max_normal_sigma_deg())) {
     ++summary->rejected_uncertain_normal;
     return false;
   }

@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 #include <fmt/format.h>
 
+#include "common/geometry/angles.h"
 #include "common/io/eigen_proto.h"
 
 namespace tiltcal::calibrate {
@@ -219,7 +220,8 @@ void CheckWeakDirections(const proto::CalibrationResult& r, Findings* f) {
 
 std::string FormatRigid(const proto::Rigid3& t) {
   const Eigen::Quaterniond q = ToEigen(t.rotation()).normalized();
-  const Eigen::Vector3d rpy = q.toRotationMatrix().eulerAngles(2, 1, 0).reverse() * 180.0 / M_PI;
+  const Eigen::Vector3d rpy =
+      geometry::RadToDeg(q.toRotationMatrix().eulerAngles(2, 1, 0).reverse());
   return fmt::format("q (w {:.4f}, x {:.4f}, y {:.4f}, z {:.4f}) [zyx {:.2f}, {:.2f}, {:.2f} "
                      "deg], r ({:.4f}, {:.4f}, {:.4f}) m",
                      q.w(), q.x(), q.y(), q.z(), rpy.z(), rpy.y(), rpy.x(),

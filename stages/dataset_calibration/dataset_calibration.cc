@@ -11,6 +11,7 @@
 
 #include "common/calibration/calibration_checks.h"
 #include "common/calibration/extrinsic_estimate.h"
+#include "common/geometry/angles.h"
 #include "common/geometry/extrinsic_fusion.h"
 #include "common/io/eigen_proto.h"
 #include "common/io/provenance.h"
@@ -25,7 +26,7 @@ using calibration::PriorInformation;
 using calibration::ReasonRefused;
 using calibration::ToEstimate;
 using geometry::ExtrinsicEstimate;
-constexpr double kDegPerRad = 180.0 / M_PI;
+using geometry::kDegPerRad;
 
 int Dimension(const proto::DatasetCalibrationParams& params) {
   return params.time_offset_shared() ? 7 : 6;

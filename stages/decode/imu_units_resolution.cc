@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 #include <fmt/format.h>
 
+#include "common/geometry/angles.h"
 #include "common/imu/imu_units.h"
 #include "common/imu/static_detection.h"
 #include "common/io/eigen_proto.h"
@@ -15,7 +16,7 @@ namespace tiltcal::decode {
 
 namespace {
 
-constexpr double kDegreesPerRadian = 180.0 / M_PI;
+using geometry::kDegPerRad;
 
 std::string SamplesText(size_t num_samples, bool from_static_samples) {
   return from_static_samples ? fmt::format("over {} static samples", num_samples)
@@ -137,7 +138,7 @@ Status ResolveAccelUnit(const std::vector<imu::ImuReading>& published,
 
 double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   const double cosine = a.normalized().dot(b.normalized());
-  return std::acos(std::clamp(cosine, -1.0, 1.0)) * kDegreesPerRadian;
+  return std::acos(std::clamp(cosine, -1.0, 1.0)) * kDegPerRad;
 }
 
 // The sign of the specific force: its mean at rest must point up. Up in the

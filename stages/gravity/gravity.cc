@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "common/checked_conversion.h"
+#include "common/geometry/angles.h"
 #include "common/imu/gyro_integrator.h"
 #include "common/imu/imu_initialisation.h"
 #include "common/io/atomic_file.h"
@@ -23,10 +24,10 @@ namespace tiltcal::gravity {
 
 namespace {
 
-constexpr double kRadToDeg = 180.0 / M_PI;
+using geometry::kDegPerRad;
 
 double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  return kRadToDeg * std::atan2(a.cross(b).norm(), a.dot(b));
+  return kDegPerRad * std::atan2(a.cross(b).norm(), a.dot(b));
 }
 
 // Linear-interpolated percentile (0..100) of non-empty `values`.

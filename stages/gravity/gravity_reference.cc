@@ -8,6 +8,7 @@
 
 #include <Eigen/Core>
 
+#include "common/geometry/angles.h"
 #include "common/io/eigen_proto.h"
 #include "common/io/provenance.h"
 #include "common/io/text_proto.h"
@@ -15,7 +16,7 @@
 namespace tiltcal::gravity {
 namespace {
 
-constexpr double kDegPerRad = 180.0 / M_PI;
+using geometry::kDegPerRad;
 
 double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   return std::atan2(a.cross(b).norm(), a.dot(b)) * kDegPerRad;

@@ -4,13 +4,14 @@
 #include <cmath>
 #include <limits>
 
+#include "common/geometry/angles.h"
 #include "common/geometry/plane_fit.h"
 
 namespace tiltcal::ground {
 
 namespace {
 
-constexpr double kDegToRad = M_PI / 180.0;
+using geometry::kRadPerDeg;
 constexpr float kTwoPi = 6.28318530717958647692f;
 
 }  // namespace
@@ -65,7 +66,7 @@ GroundSegmenter::GroundSegmenter(const proto::ZoneModelParams& zone_model,
   seed_margin_ = static_cast<float>(region_fit.seed_height_margin_m());
   plane_distance_ = static_cast<float>(region_fit.plane_distance_m());
   min_points_per_bin_ = std::max<uint32_t>(3, region_fit.min_points_per_bin());
-  cos_max_tilt_ = static_cast<float>(std::cos(region_fit.max_bin_tilt_deg() * kDegToRad));
+  cos_max_tilt_ = static_cast<float>(std::cos(region_fit.max_bin_tilt_deg() * kRadPerDeg));
   max_flatness_ = static_cast<float>(region_fit.max_flatness());
   max_elongation_ = static_cast<float>(region_fit.max_bin_elongation());
   far_max_elevation_ = static_cast<float>(region_fit.max_elevation_m());

@@ -5,13 +5,14 @@
 
 #include <fmt/format.h>
 
+#include "common/geometry/angles.h"
 #include "common/io/eigen_proto.h"
 
 namespace tiltcal::ground {
 
 namespace {
 
-constexpr double kRadToDeg = 180.0 / M_PI;
+using geometry::kDegPerRad;
 
 // Range histograms: 5 cm bins.
 constexpr float kRangeBinM = 0.05f;
@@ -67,7 +68,7 @@ ScanPlane ScanPlaneFitter::Fit(const GroundSegmenter& segmenter,
   MeasureInliers(segmenter, &out, inlier);
   out.rms_m = std::sqrt(std::max(0.0, out.fit.eigenvalues(0)));
   out.covariance = PlaneCovarianceWithFloors(out.fit, covariance_floor_);
-  out.tilt_from_up_deg = std::acos(std::clamp(out.fit.normal.z(), -1.0, 1.0)) * kRadToDeg;
+  out.tilt_from_up_deg = std::acos(std::clamp(out.fit.normal.z(), -1.0, 1.0)) * kDegPerRad;
   ApplyScanPlaneGates(gates_, height_prior_m, &out);
   return out;
 }
@@ -185,7 +186,7 @@ Eigen::Matrix4d PlaneCovarianceWithFloors(const geometry::PlaneFit& fit,
                                           const proto::PlaneCovarianceFloorParams& floor) {
   Eigen::Matrix4d covariance =
       geometry::PlaneCovariance(fit, geometry::PlaneNoiseVariance(fit));
-  const double floor_rad = floor.normal_deg() * M_PI / 180.0;
+  const double floor_rad = geometry::DegToRad(floor.normal_deg());
   covariance.topLeftCorner<3, 3>() +=
       floor_rad * floor_rad * (Eigen::Matrix3d::Identity() - fit.normal * fit.normal.transpose());
   covariance(3, 3) += floor.height_m() * floor.height_m();
@@ -248,7 +249,7 @@ void ApplyTiltJumpGate(const proto::TiltJumpGateParams& gate,
     }
     if (count < 2 || !(sum.norm() > 0.0)) continue;
     const double cos_angle = std::clamp(sum.normalized().dot(normals[i]), -1.0, 1.0);
-    const double jump_deg = std::acos(cos_angle) * kRadToDeg;
+    const double jump_deg = std::acos(cos_angle) * kDegPerRad;
     proto::GroundPlane& p = (*planes)[i];
     p.set_tilt_jump_deg(jump_deg);
     if (max_jump_deg > 0.0 && jump_deg > max_jump_deg) {

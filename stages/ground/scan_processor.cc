@@ -7,6 +7,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
+#include "common/geometry/angles.h"
 #include "common/io/eigen_proto.h"
 
 namespace tiltcal::ground {
@@ -174,7 +175,7 @@ void ScanProcessor::SetPlaneInLidar(const ScanPlane& plane, proto::GroundPlane* 
   *out->mutable_centroid_in_lidar() = ToProto(c_l);
   out->set_height_m(plane.fit.offset);
   out->set_rms_m(plane.rms_m);
-  out->set_tilt_deg(std::acos(std::clamp(n_l.z(), -1.0, 1.0)) * 180.0 / M_PI);
+  out->set_tilt_deg(geometry::RadToDeg(std::acos(std::clamp(n_l.z(), -1.0, 1.0))));
   out->set_eigenvalue_min(plane.fit.eigenvalues(0));
   out->set_eigenvalue_mid(plane.fit.eigenvalues(1));
   out->set_eigenvalue_max(plane.fit.eigenvalues(2));
@@ -185,7 +186,7 @@ void ScanProcessor::SetPlaneInLidar(const ScanPlane& plane, proto::GroundPlane* 
                                 cov.topLeftCorner<3, 3>(), Eigen::EigenvaluesOnly)
                                 .eigenvalues()
                                 .maxCoeff();
-  out->set_normal_std_deg(std::sqrt(std::max(0.0, normal_var)) * 180.0 / M_PI);
+  out->set_normal_std_deg(geometry::RadToDeg(std::sqrt(std::max(0.0, normal_var))));
   out->set_height_std_m(std::sqrt(std::max(0.0, cov(3, 3))));
 }
 

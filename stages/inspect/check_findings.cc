@@ -132,6 +132,8 @@ ScanGeometryOptions ToScanGeometryOptions(const proto::LidarCheckParams& p) {
   o.ground_inlier_distance_m = p.ground_inlier_distance_m();
   o.ground_max_tilt_deg = p.ground_max_tilt_deg();
   o.min_ground_fraction = p.min_ground_fraction();
+  o.ground_fit_max_iterations =
+      p.has_ground_fit_max_iterations() ? static_cast<int>(p.ground_fit_max_iterations()) : 5;
   o.structure_min_height_m = p.structure_min_height_m();
   o.structure_max_range_m = p.structure_max_range_m();
   return o;

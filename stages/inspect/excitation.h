@@ -18,10 +18,11 @@ std::vector<double> MovingAverage(const std::vector<double>& values, int window)
 // change of an established state counts.
 int CountSignChanges(const std::vector<double>& values, double hysteresis);
 
+// No defaults: every field is set from the params file (check params: excitation).
 struct ExcitationOptions {
-  double smoothing_window_s = 0.5;
-  double yaw_rate_hysteresis_radps = 0.05;
-  double lateral_accel_hysteresis_mps2 = 0.2;
+  double smoothing_window_s;
+  double yaw_rate_hysteresis_radps;
+  double lateral_accel_hysteresis_mps2;
 };
 
 // How the motion excites the calibration, from SI readings in the IMU frame b.

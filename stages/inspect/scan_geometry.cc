@@ -4,6 +4,7 @@
 
 #include <Eigen/Geometry>
 
+#include "common/geometry/angles.h"
 #include "common/geometry/plane_fit.h"
 
 namespace tiltcal::inspect {
@@ -56,7 +57,7 @@ ScanGeometry MeasureScanGeometry(const std::vector<float>& x, const std::vector<
   if (gx.size() < 10) return g;
   geometry::RobustPlaneOptions fit_options;
   fit_options.inlier_distance_m = options.ground_inlier_distance_m;
-  fit_options.max_iterations = 5;
+  fit_options.max_iterations = options.ground_fit_max_iterations;
   std::vector<uint8_t> inlier;
   const geometry::PlaneFit plane =
       geometry::FitPlaneRobust(gx.data(), gy.data(), gz.data(), gx.size(), fit_options, &inlier);
@@ -65,7 +66,7 @@ ScanGeometry MeasureScanGeometry(const std::vector<float>& x, const std::vector<
       geometry::CountWithinBand(gx.data(), gy.data(), gz.data(), gx.size(), 1, plane.normal,
                                 plane.offset, options.ground_inlier_distance_m);
   g.ground_fraction = static_cast<double>(num_on_plane) / static_cast<double>(x.size());
-  g.ground_tilt_deg = std::acos(std::min(1.0, std::abs(plane.normal.z()))) * 180.0 / M_PI;
+  g.ground_tilt_deg = geometry::RadToDeg(std::acos(std::min(1.0, std::abs(plane.normal.z()))));
   g.has_ground = g.ground_tilt_deg <= options.ground_max_tilt_deg &&
                  g.ground_fraction >= options.min_ground_fraction;
   return g;

@@ -8,14 +8,16 @@
 
 namespace tiltcal::inspect {
 
+// No defaults: every field is set from the params file (check params: lidar).
 struct ScanGeometryOptions {
-  double ground_min_depth_m = 0.3;
-  double ground_max_range_m = 15.0;
-  double ground_inlier_distance_m = 0.1;
-  double ground_max_tilt_deg = 25.0;
-  double min_ground_fraction = 0.1;
-  double structure_min_height_m = 0.5;
-  double structure_max_range_m = 30.0;
+  double ground_min_depth_m;
+  double ground_max_range_m;
+  double ground_inlier_distance_m;
+  double ground_max_tilt_deg;
+  double min_ground_fraction;
+  int ground_fit_max_iterations;  // refits of the robust ground plane
+  double structure_min_height_m;
+  double structure_max_range_m;
 };
 
 // What one scan offers the calibration. Heights h = u · p along the unit up

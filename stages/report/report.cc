@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "common/geometry/angles.h"
 #include "common/geometry/euler_angles.h"
 #include "common/geometry/rotation_statistics.h"
 #include "common/geometry/so3.h"
@@ -19,7 +20,7 @@ namespace tiltcal::report {
 
 namespace {
 
-constexpr double kRadToDeg = 180.0 / M_PI;
+using geometry::kDegPerRad;
 
 Row MakeRow(const std::string& label, const proto::Rigid3& imu_from_lidar, double time_offset_s) {
   const Rigid3d extrinsic = ToEigen(imu_from_lidar);
@@ -27,7 +28,7 @@ Row MakeRow(const std::string& label, const proto::Rigid3& imu_from_lidar, doubl
   row.label = label;
   row.translation_cm = 100.0 * extrinsic.translation;
   row.euler123_deg =
-      kRadToDeg * geometry::Euler123FromRotation(extrinsic.rotation.toRotationMatrix());
+      kDegPerRad * geometry::Euler123FromRotation(extrinsic.rotation.toRotationMatrix());
   row.time_offset_ms = 1e3 * time_offset_s;
   return row;
 }
@@ -38,7 +39,7 @@ void AddErrors(const proto::SimulationTruth& truth, const proto::CalibrationResu
   const Rigid3d tru = ToEigen(truth.imu_from_lidar());
   row->has_errors = true;
   row->rotation_error_deg =
-      kRadToDeg * geometry::LogMatrix((tru.rotation.conjugate() * est.rotation).toRotationMatrix())
+      kDegPerRad * geometry::LogMatrix((tru.rotation.conjugate() * est.rotation).toRotationMatrix())
                       .norm();
   row->translation_error_cm = 100.0 * (est.translation - tru.translation);
   row->time_offset_error_ms = 1e3 * (estimate.time_offset_s() - truth.time_offset_s());
@@ -137,8 +138,8 @@ Repeatability ComputeRepeatability(const std::vector<SequenceResult>& results,
     const auto other = geometry::ComputeVectorStatistics(others);
     const auto error = geometry::ComputeVectorStatistics(errors);
     out.rotation_mean_converged = rotation.converged;
-    out.mean.euler123_deg = kRadToDeg * geometry::Euler123FromRotation(rotation.mean);
-    out.sigma.euler123_deg = kRadToDeg * rotation.sigma;
+    out.mean.euler123_deg = kDegPerRad * geometry::Euler123FromRotation(rotation.mean);
+    out.sigma.euler123_deg = kDegPerRad * rotation.sigma;
     out.mean.translation_cm = translation.mean;
     out.sigma.translation_cm = translation.sigma;
     out.mean.time_offset_ms = other.mean.x();

@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include "common/geometry/angles.h"
 #include "common/geometry/euler_angles.h"
 #include "common/io/eigen_proto.h"
 #include "stages/export/escaping.h"
@@ -84,7 +85,7 @@ std::string RepeatabilityTable(const Repeatability& r) {
 std::string ExtrinsicTable(const proto::CalibrationResult& c) {
   const Rigid3d t = ToEigen(c.imu_from_lidar());
   const Eigen::Vector3d euler_deg =
-      geometry::Euler123FromRotation(t.rotation.toRotationMatrix()) * 180.0 / M_PI;
+      geometry::RadToDeg(geometry::Euler123FromRotation(t.rotation.toRotationMatrix()));
   const auto& rs = c.rotation_sigma_deg();
   const auto& ts = c.translation_sigma_m();
   return fmt::format(

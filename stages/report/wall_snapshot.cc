@@ -1,4 +1,5 @@
 #include "stages/report/wall_snapshot.h"
+#include "common/geometry/angles.h"
 
 #include <algorithm>
 #include <cmath>
@@ -89,7 +90,7 @@ std::optional<WallSlab> FindWall(const std::vector<Eigen::Vector3f>& points,
                 std::abs(cell.normal.dot(up)) < params.max_normal_up();
   }
   // Region growing over the wall cells.
-  const double min_cos = std::cos(params.max_normal_angle_deg() * M_PI / 180.0);
+  const double min_cos = std::cos(geometry::DegToRad(params.max_normal_angle_deg()));
   std::vector<Moments> clusters;
   std::vector<int> cluster_cells;
   for (size_t seed = 0; seed < cells.size(); ++seed) {

@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include "common/geometry/angles.h"
 #include "common/io/eigen_proto.h"
 #include "stages/simulate/random.h"
 
@@ -12,7 +13,7 @@ namespace tiltcal::simulate {
 
 namespace {
 
-constexpr double kDegToRad = M_PI / 180.0;
+using geometry::kRadPerDeg;
 constexpr double kMaxScalePpm = 1e5;
 constexpr double kMaxMisalignmentDeg = 5.0;
 
@@ -33,7 +34,7 @@ TriadErrors Draw(const proto::SimTriadErrors& p, Rng* rng) {
   }
   for (int a = 0; a < 3; ++a) {
     e.misalignment_rad[a] =
-        GivenPlusDraw(misalignment_deg[a], p.misalignment_max_deg(), rng) * kDegToRad;
+        GivenPlusDraw(misalignment_deg[a], p.misalignment_max_deg(), rng) * kRadPerDeg;
   }
   return e;
 }
@@ -78,7 +79,7 @@ void DrawImuIntrinsics(const proto::SimFaultParams& faults, uint64_t seed, Triad
 proto::TruthTriadErrors ToTruth(const TriadErrors& errors) {
   proto::TruthTriadErrors t;
   *t.mutable_scale_ppm() = ToProto(Eigen::Vector3d(errors.scale * 1e6));
-  *t.mutable_misalignment_deg() = ToProto(Eigen::Vector3d(errors.misalignment_rad / kDegToRad));
+  *t.mutable_misalignment_deg() = ToProto(Eigen::Vector3d(errors.misalignment_rad / kRadPerDeg));
   const Eigen::Matrix3d k = errors.MeasuredFromTrue();
   for (int r = 0; r < 3; ++r) {
     for (int c = 0; c < 3; ++c) t.add_measured_from_true(k(r, c));

@@ -1,4 +1,5 @@
 #include "stages/simulate/lidar_model.h"
+#include "common/geometry/angles.h"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +9,7 @@ namespace tiltcal::simulate {
 
 namespace {
 
-constexpr double kDegToRad = M_PI / 180.0;
+using geometry::kRadPerDeg;
 constexpr double kVelodyneSequenceS = 55.296e-6;
 constexpr double kVelodyneSlotS = 2.304e-6;
 
@@ -33,7 +34,7 @@ LidarModel Vlp16Model() {
   m.name = "VLP-16";
   m.kind = LidarModel::Kind::kVelodyne;
   for (int i = 0; i < 16; ++i) {
-    m.elevation_rad.push_back(kElevationDeg[i] * kDegToRad);
+    m.elevation_rad.push_back(kElevationDeg[i] * kRadPerDeg);
     m.firing_offset_s.push_back(i * kVelodyneSlotS);
   }
   m.ring = RingsByElevation(m.elevation_rad);
@@ -53,7 +54,7 @@ LidarModel Vlp32cModel() {
   m.name = "VLP-32C";
   m.kind = LidarModel::Kind::kVelodyne;
   for (int i = 0; i < 32; ++i) {
-    m.elevation_rad.push_back(kElevationDeg[i] * kDegToRad);
+    m.elevation_rad.push_back(kElevationDeg[i] * kRadPerDeg);
     m.firing_offset_s.push_back((i / 2) * kVelodyneSlotS);
   }
   m.ring = RingsByElevation(m.elevation_rad);
@@ -67,7 +68,7 @@ LidarModel Os132Model(int columns) {
   m.name = "OS1-32";
   m.kind = LidarModel::Kind::kOuster;
   for (int i = 0; i < 32; ++i) {
-    m.elevation_rad.push_back((22.5 - 45.0 * i / 31.0) * kDegToRad);
+    m.elevation_rad.push_back((22.5 - 45.0 * i / 31.0) * kRadPerDeg);
     m.ring.push_back(i);
     m.firing_offset_s.push_back(0.0);
   }
@@ -85,8 +86,8 @@ LidarModel LivoxAviaModel() {
   m.livox.point_rate_hz = 240000.0;
   m.livox.f1_hz = 97.3;
   m.livox.f2_hz = -97.3 * std::sqrt(2.0) * 0.61;
-  m.livox.half_azimuth_rad = 35.2 * kDegToRad;
-  m.livox.half_elevation_rad = 38.6 * kDegToRad;
+  m.livox.half_azimuth_rad = 35.2 * kRadPerDeg;
+  m.livox.half_elevation_rad = 38.6 * kRadPerDeg;
   return m;
 }
 
@@ -99,8 +100,8 @@ LidarModel LivoxMid360Model() {
   m.livox.point_rate_hz = 200000.0;
   m.livox.f1_hz = 10.0 * std::sqrt(1.03);
   m.livox.f2_hz = 1000.0 / std::sqrt(2.0);
-  m.livox.min_elevation_rad = -7.0 * kDegToRad;
-  m.livox.max_elevation_rad = 52.0 * kDegToRad;
+  m.livox.min_elevation_rad = -7.0 * kRadPerDeg;
+  m.livox.max_elevation_rad = 52.0 * kRadPerDeg;
   return m;
 }
 

@@ -13,6 +13,7 @@
 #include "bag/ros1/bag_writer.h"
 #include "bag/ros1/message_encoding.h"
 #include "common/cli/command_line.h"
+#include "common/geometry/angles.h"
 #include "common/geometry/euler_angles.h"
 #include "common/imu/imu_units.h"
 #include "common/io/atomic_file.h"
@@ -32,8 +33,8 @@ namespace tiltcal::simulate {
 
 namespace {
 
-constexpr double kDegToRad = M_PI / 180.0;
-constexpr double kRadToDeg = 180.0 / M_PI;
+using geometry::kRadPerDeg;
+using geometry::kDegPerRad;
 // Largest stamp a ROS time can hold.
 constexpr int64_t kMaxRosTimeNs = 4294967295LL * 1000000000LL;
 
@@ -46,7 +47,7 @@ proto::Rigid3 RigidToProto(const Eigen::Matrix3d& rotation, const Eigen::Vector3
 }
 
 double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  return std::atan2(a.cross(b).norm(), a.dot(b)) * kRadToDeg;
+  return std::atan2(a.cross(b).norm(), a.dot(b)) * kDegPerRad;
 }
 
 // Places the random boxes and pillars inside the room, outside the track's
@@ -115,13 +116,13 @@ TrajectoryConfig MakeTrajectoryConfig(const proto::SimulateParams& params) {
   tc.speed_mps = tp.speed_mps();
   tc.static_start_s = tp.static_start_s();
   tc.ramp_s = tp.ramp_s();
-  tc.vibration_roll_rad = tp.vibration_roll_deg() * kDegToRad;
-  tc.vibration_pitch_rad = tp.vibration_pitch_deg() * kDegToRad;
+  tc.vibration_roll_rad = tp.vibration_roll_deg() * kRadPerDeg;
+  tc.vibration_pitch_rad = tp.vibration_pitch_deg() * kRadPerDeg;
   tc.vibration_frequency_hz = tp.vibration_frequency_hz();
-  tc.heading_rad = tp.heading_deg() * kDegToRad;
+  tc.heading_rad = tp.heading_deg() * kRadPerDeg;
   tc.max_yaw_rate_radps = tp.max_yaw_rate_radps();
-  tc.ground_roll_rad = params.ground_roll_deg() * kDegToRad;
-  tc.ground_pitch_rad = params.ground_pitch_deg() * kDegToRad;
+  tc.ground_roll_rad = params.ground_roll_deg() * kRadPerDeg;
+  tc.ground_pitch_rad = params.ground_pitch_deg() * kRadPerDeg;
   tc.imu_height_m = params.rig().imu_height_m();
   tc.vehicle_from_imu =
       geometry::RotationFromEuler123Deg(ToEigen(params.rig().imu_rotation_in_vehicle_deg()));

@@ -15,6 +15,7 @@
 
 #include "common/calibration/calibration_checks.h"
 #include "common/calibration/extrinsic_estimate.h"
+#include "common/geometry/angles.h"
 #include "common/geometry/extrinsic_fusion.h"
 #include "common/geometry/so3.h"
 #include "common/io/eigen_proto.h"
@@ -22,7 +23,7 @@
 namespace tiltcal::verify {
 namespace {
 
-constexpr double kDegPerRad = 180.0 / M_PI;
+using geometry::kDegPerRad;
 // Eigenvalues of W below this fraction of the group's largest count as no
 // information (the difference's degrees of freedom leave them out).
 constexpr double kRelativeEigenvalueFloor = 1e-12;

@@ -8,9 +8,12 @@
 #include <gtest/gtest.h>
 
 #include "tests/common/imu/synthetic_imu.h"
+#include "tests/common/imu/imu_test_options.h"
 
 namespace tiltcal::imu {
 namespace {
+
+using testing::StaticDetectionTestOptions;
 
 // Still for [0, 3) s, turning for [3, 6) s, still for [6, 8) s, turning after.
 Eigen::Vector3d Omega(double t) {
@@ -22,7 +25,7 @@ TEST(StaticDetection, FindsEveryStillIntervalWithItsMeans) {
   const Eigen::Vector3d bias(0.002, -0.001, 0.003);
   const auto readings = testing::SyntheticImu(200, 10, Omega, Eigen::Quaterniond::Identity(),
                                               {0, 0, -9.81}, bias, 0.001, 0.01, nullptr);
-  StaticDetectionOptions options;
+  StaticDetectionOptions options = StaticDetectionTestOptions();
   const auto intervals = DetectStaticIntervals(readings, options);
   ASSERT_EQ(intervals.size(), 2u);
   EXPECT_NEAR(intervals[0].begin_s, 0.0, 1e-9);
@@ -46,8 +49,9 @@ TEST(StaticDetection, NoStaticStartWhenMovingFromTheBeginning) {
   const auto readings = testing::SyntheticImu(
       200, 4, [](double) { return Eigen::Vector3d(0, 0, 0.3); }, Eigen::Quaterniond::Identity(),
       {0, 0, -9.81}, Eigen::Vector3d::Zero(), 0.001, 0.01, nullptr);
-  EXPECT_TRUE(DetectStaticIntervals(readings, {}).empty());  // steady turn is not still
-  EXPECT_FALSE(DetectStaticStart(readings, {}).found);
+  // A steady turn is not still.
+  EXPECT_TRUE(DetectStaticIntervals(readings, StaticDetectionTestOptions()).empty());
+  EXPECT_FALSE(DetectStaticStart(readings, StaticDetectionTestOptions()).found);
 }
 
 TEST(StaticDetection, ShortStillnessIsIgnored) {
@@ -55,7 +59,7 @@ TEST(StaticDetection, ShortStillnessIsIgnored) {
       200, 4, [](double t) { return t < 0.7 ? Eigen::Vector3d::Zero() : Eigen::Vector3d(0, 0, 1); },
       Eigen::Quaterniond::Identity(), {0, 0, -9.81}, Eigen::Vector3d::Zero(), 0.001, 0.01,
       nullptr);
-  EXPECT_FALSE(DetectStaticStart(readings, {}).found);
+  EXPECT_FALSE(DetectStaticStart(readings, StaticDetectionTestOptions()).found);
 }
 
 // The detector before it stepped over empty windows: every window of the
@@ -148,9 +152,9 @@ TEST(StaticDetection, GapsGiveTheSameIntervalsAsEveryWindow) {
     r.time_s += 500.0;
     readings.push_back(r);
   }
-  const auto intervals = DetectStaticIntervals(readings, {});
+  const auto intervals = DetectStaticIntervals(readings, StaticDetectionTestOptions());
   EXPECT_EQ(intervals.size(), 4u);
-  ExpectSameIntervals(intervals, EveryWindowReference(readings, {}));
+  ExpectSameIntervals(intervals, EveryWindowReference(readings, StaticDetectionTestOptions()));
 }
 
 TEST(StaticDetection, StampFarInTheFutureIsBoundedWork) {
@@ -160,11 +164,11 @@ TEST(StaticDetection, StampFarInTheFutureIsBoundedWork) {
   std::vector<ImuReading> readings = StillAndTurning(9);
   readings.push_back(readings.back());
   readings.back().time_s = 100.0;
-  const auto reference = EveryWindowReference(readings, {});
+  const auto reference = EveryWindowReference(readings, StaticDetectionTestOptions());
   EXPECT_EQ(reference.size(), 2u);
   readings.back().time_s = 4294967295.0;
   ASSERT_TRUE(ValidateImuReadings(readings).ok());
-  ExpectSameIntervals(DetectStaticIntervals(readings, {}), reference);
+  ExpectSameIntervals(DetectStaticIntervals(readings, StaticDetectionTestOptions()), reference);
 }
 
 TEST(ImuReadings, ValidationNamesTheSample) {

@@ -6,10 +6,14 @@
 #include <gtest/gtest.h>
 
 #include "common/geometry/so3.h"
+#include "tests/common/registration/registration_test_options.h"
 #include "tests/common/registration/synthetic_scene.h"
 
 namespace tiltcal::registration {
 namespace {
+
+using testing::PointToPlaneIcpTestOptions;
+using testing::VoxelHashMapTestOptions;
 
 Eigen::Isometry3d Pose(const Eigen::Vector3d& rotation_vector_rad, const Eigen::Vector3d& t_m) {
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
@@ -45,12 +49,12 @@ TEST(PointToPlaneIcpTest, JacobianMatchesFiniteDifferences) {
 
 struct Scene {
   std::vector<Eigen::Vector3d> source;  // the room seen from the source frame
-  VoxelHashMap map{VoxelHashMapOptions{}};
+  VoxelHashMap map{VoxelHashMapTestOptions()};
   Eigen::Isometry3d truth;               // map_from_source
 };
 
 Scene MakeScene(const Eigen::Isometry3d& truth, double noise_m,
-                const VoxelHashMapOptions& map_options = VoxelHashMapOptions{}) {
+                const VoxelHashMapOptions& map_options = VoxelHashMapTestOptions()) {
   Scene scene{{}, VoxelHashMap(map_options), truth};
   scene.map.AddPoints(testing::SyntheticRoom(0.1, noise_m, 1));
   const Eigen::Isometry3d source_from_map = truth.inverse();
@@ -64,11 +68,11 @@ TEST(PointToPlaneIcpTest, RecoversAKnownRigidTransform) {
   // Noise-free planes: only voxels on one plane pass a 5 mm thickness gate,
   // and a 1 cm kernel scale leaves out pairs across a corner (a wall point
   // whose nearest map point lies on the floor).
-  VoxelHashMapOptions map_options;
+  VoxelHashMapOptions map_options = VoxelHashMapTestOptions();
   map_options.max_plane_thickness_m = 0.005;
   const Scene scene =
       MakeScene(Pose({0.02, -0.03, 0.25}, {0.4, -0.3, 0.1}), 0.0, map_options);
-  PointToPlaneIcpOptions options;
+  PointToPlaneIcpOptions options = PointToPlaneIcpTestOptions();
   options.kernel_scale_m = 0.01;
   options.max_iterations = 30;
   options.convergence_rotation_rad = 1e-7;
@@ -88,7 +92,7 @@ TEST(PointToPlaneIcpTest, RecoversAKnownRigidTransform) {
 
 TEST(PointToPlaneIcpTest, NoisyScanLandsWithinTheNoise) {
   const Scene scene = MakeScene(Pose({0.0, 0.01, -0.4}, {-1.0, 0.5, 0.0}), 0.01);
-  PointToPlaneIcpOptions options;
+  PointToPlaneIcpOptions options = PointToPlaneIcpTestOptions();
   const Eigen::Isometry3d initial = Pose({0.0, 0.0, 0.03}, {0.1, 0.1, 0.0}) * scene.truth;
   const PointToPlaneIcpResult result =
       AlignPointToPlane(scene.source, scene.map, initial, options);
@@ -100,7 +104,7 @@ TEST(PointToPlaneIcpTest, NoisyScanLandsWithinTheNoise) {
 
 TEST(PointToPlaneIcpTest, TooFewCorrespondencesIsNotRegistered) {
   const Scene scene = MakeScene(Eigen::Isometry3d::Identity(), 0.0);
-  PointToPlaneIcpOptions options;
+  PointToPlaneIcpOptions options = PointToPlaneIcpTestOptions();
   // 100 m away: no map point within the gate.
   const PointToPlaneIcpResult result = AlignPointToPlane(
       scene.source, scene.map, Pose({0, 0, 0}, {100.0, 0.0, 0.0}), options);

@@ -4,10 +4,13 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/common/registration/registration_test_options.h"
 #include "tests/common/registration/synthetic_scene.h"
 
 namespace tiltcal::registration {
 namespace {
+
+using testing::VoxelHashMapTestOptions;
 
 TEST(VoxelHashMapTest, VoxelOfFloorsNegativeCoordinates) {
   EXPECT_EQ(VoxelOf({-0.1, 0.0, 1.99}, 1.0), Eigen::Vector3i(-1, 0, 1));
@@ -15,7 +18,7 @@ TEST(VoxelHashMapTest, VoxelOfFloorsNegativeCoordinates) {
 }
 
 TEST(VoxelHashMapTest, CapsPointsPerVoxelAndFitsThinPlanes) {
-  VoxelHashMapOptions options;
+  VoxelHashMapOptions options = VoxelHashMapTestOptions();
   options.voxel_m = 1.0;
   options.max_points_per_voxel = 4;  // points at least 1 / sqrt(4) = 0.5 m apart
   options.min_plane_points = 4;
@@ -47,7 +50,7 @@ TEST(VoxelHashMapTest, CapsPointsPerVoxelAndFitsThinPlanes) {
 }
 
 TEST(VoxelHashMapTest, ALineOfPointsHasNoPlane) {
-  VoxelHashMapOptions options;
+  VoxelHashMapOptions options = VoxelHashMapTestOptions();
   options.min_plane_points = 5;
   options.max_points_per_voxel = 100;  // points at least 0.1 m apart
   VoxelHashMap map(options);
@@ -59,7 +62,7 @@ TEST(VoxelHashMapTest, ALineOfPointsHasNoPlane) {
 }
 
 TEST(VoxelHashMapTest, ThickOrSparseVoxelsHaveNoPlane) {
-  VoxelHashMapOptions options;
+  VoxelHashMapOptions options = VoxelHashMapTestOptions();
   options.max_plane_thickness_m = 0.05;
   VoxelHashMap map(options);
   std::vector<Eigen::Vector3d> blob;  // a 3D lattice: thickness ~0.3 m
@@ -75,7 +78,7 @@ TEST(VoxelHashMapTest, ThickOrSparseVoxelsHaveNoPlane) {
 }
 
 TEST(VoxelHashMapTest, RemovesFarVoxels) {
-  VoxelHashMap map(VoxelHashMapOptions{});
+  VoxelHashMap map(VoxelHashMapTestOptions());
   map.AddPoints(testing::SyntheticRoom(0.2, 0.0, 1));
   const size_t before = map.num_voxels();
   map.RemoveFarFrom(Eigen::Vector3d(8, 0, 0), 5.0);

@@ -183,6 +183,14 @@ TEST(ScanGeometry, FindsTheGroundAndTheStructureAlongUp) {
   std::vector<float> x, y, z;
   GroundAndWall(&x, &y, &z);
   ScanGeometryOptions options;
+  options.ground_min_depth_m = 0.3;
+  options.ground_max_range_m = 15.0;
+  options.ground_inlier_distance_m = 0.1;
+  options.ground_max_tilt_deg = 25.0;
+  options.min_ground_fraction = 0.1;
+  options.ground_fit_max_iterations = 5;
+  options.structure_min_height_m = 0.5;
+  options.structure_max_range_m = 30.0;
   const ScanGeometry g = MeasureScanGeometry(x, y, z, Eigen::Vector3d(0, 0, -1), options);
   EXPECT_TRUE(g.has_ground);
   EXPECT_NEAR(g.ground_tilt_deg, 0.0, 1e-3);

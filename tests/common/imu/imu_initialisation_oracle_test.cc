@@ -10,6 +10,7 @@
 #include <random>
 
 #include <gtest/gtest.h>
+#include "tests/common/imu/imu_test_options.h"
 #include "tests/testing/angles.h"
 #include "tests/testing/random_vector.h"
 
@@ -145,7 +146,7 @@ TEST(CalibrateImuReadingsTest, RejectsNonMonotonicAndNonFinite) {
   EXPECT_FALSE(ValidateImuReadings(samples).ok());
   EXPECT_FALSE(ValidateImuReadings({}).ok());
   ImuInitialisation init;
-  EXPECT_FALSE(InitialiseImu({}, ImuInitialisationOptions(), &init).ok());
+  EXPECT_FALSE(InitialiseImu({}, imu::testing::ImuInitialisationTestOptions(), &init).ok());
 }
 
 TEST(CalibrateImuInitialisationTest, StaticStartGivesBiasAndGravityWithinNoise) {
@@ -162,7 +163,7 @@ TEST(CalibrateImuInitialisationTest, StaticStartGivesBiasAndGravityWithinNoise) 
   const double gyro_sigma = 0.002, accel_sigma = 0.02;
   const std::vector<ImuReading> samples = SimulateImu(m, 10.0, 200.0, bias, gyro_sigma, accel_sigma, 3);
 
-  ImuInitialisationOptions options;
+  ImuInitialisationOptions options = imu::testing::ImuInitialisationTestOptions();
   options.gravity_norm_mps2 = 9.81;
   ImuInitialisation init;
   ASSERT_TRUE(InitialiseImu(samples, options, &init).ok());
@@ -198,7 +199,7 @@ TEST(CalibrateImuInitialisationTest, DetectsNoStaticStartWhenMovingAndFallsBack)
   const Eigen::Vector3d bias(0.003, 0.002, -0.004);
   const std::vector<ImuReading> samples = SimulateImu(m, 8.0, 200.0, bias, 0.002, 0.02, 4);
   ImuInitialisation init;
-  ASSERT_TRUE(InitialiseImu(samples, ImuInitialisationOptions(), &init).ok());
+  ASSERT_TRUE(InitialiseImu(samples, imu::testing::ImuInitialisationTestOptions(), &init).ok());
   EXPECT_FALSE(init.static_start.found);
   EXPECT_FALSE(init.from_static_start);
   EXPECT_EQ(init.gyro_bias_radps, Eigen::Vector3d::Zero());
@@ -216,9 +217,9 @@ TEST(CalibrateImuInitialisationTest, ShortStaticStartIsNotUsed) {
   m.yaw_amp = 0.8;
   m.yaw_w = 2.0;
   const std::vector<ImuReading> samples = SimulateImu(m, 4.0, 200.0, Eigen::Vector3d::Zero(), 0.001, 0.01, 5);
-  const StaticInterval interval = DetectStaticStart(samples, StaticDetectionOptions());
+  const StaticInterval interval = DetectStaticStart(samples, imu::testing::StaticDetectionTestOptions());
   EXPECT_FALSE(interval.found);
-  StaticDetectionOptions shorter;
+  StaticDetectionOptions shorter = imu::testing::StaticDetectionTestOptions();
   shorter.min_duration_s = 0.5;
   const StaticInterval found = DetectStaticStart(samples, shorter);
   ASSERT_TRUE(found.found);
