@@ -22,6 +22,7 @@
 #include "common/io/text_proto.h"
 #include "common/timing/clock_rate.h"
 #include "stages/calibrate/covariance_report.h"
+#include "stages/calibrate/dense_sample_weight.h"
 #include "stages/calibrate/ground_residuals.h"
 #include "stages/calibrate/imu_intrinsics.h"
 #include "stages/calibrate/imu_vibration.h"
@@ -198,10 +199,10 @@ struct OuterLoop {
   std::unique_ptr<CalibrationProblem> problem;
   // The last round drawn with AssociationParams `association`, kept when the
   // final round (OuterLoopParams.final_association) solves a denser sample:
-  // the covariance, the residual statistics and the intrinsics' score test
-  // read it at the final estimate (ReportProblem), because the dense
-  // sample's points are correlated (neighbours on one surfel in one scan)
-  // and its own covariance would claim more than the data hold.
+  // the variance factor, the residual statistics and the intrinsics' score
+  // test read it at the final estimate (ReportProblem); the final problem's
+  // residuals are down-weighted (dense_sample_weight.h), so their RMS says
+  // nothing of the noise.
   std::unique_ptr<CalibrationProblem> sample_problem;
   ceres::Solver::Summary summary;
   std::vector<LidarPointResidual> lidar;
@@ -240,30 +241,12 @@ struct OuterLoopSetup {
   bool translation_along_axis_observed;
 };
 
-// The LiDAR residuals' params for a sample of n residuals that stands for
-// one of n_reference (0: itself): the points of a denser sample are
-// correlated (neighbours on one surfel in one scan share its plane's error),
-// so its information is taken as (n / n_reference)^e times the reference
-// sample's, e = `information_exponent`: sigma_m scaled by
-// (n / n_reference)^((1 - e) / 2), the Cauchy scale (in units of sigma)
-// divided by the same so that the loss bends at the same distance in metres.
-proto::LidarResidualParams DenseSampleLidarParams(const proto::LidarResidualParams& lidar,
-                                                  size_t n, size_t n_reference,
-                                                  double information_exponent) {
-  proto::LidarResidualParams out = lidar;
-  if (n_reference == 0 || n <= n_reference) return out;
-  const double scale = std::pow(static_cast<double>(n) / static_cast<double>(n_reference),
-                                0.5 * (1.0 - information_exponent));
-  out.set_sigma_m(lidar.sigma_m() * scale);
-  out.set_cauchy_scale(lidar.cauchy_scale() / scale);
-  return out;
-}
-
 // One round: surfel map + association with the current state, problem
 // build, LM solve. `association` draws the LiDAR sample; with
 // reference_lidar_residuals > 0 it stands for a sample of that size
-// (DenseSampleLidarParams). Sets *settled when the round moved the extrinsic by less
-// than the OuterLoopParams stop thresholds (from the second round on).
+// (dense_sample_weight.h). Sets *settled when the round moved the extrinsic
+// by less than the OuterLoopParams stop thresholds (from the second round
+// on).
 Status RunOuterRound(const OuterLoopSetup& setup, const proto::AssociationParams& association,
                      size_t reference_lidar_residuals, CalibrationState* state, OuterLoop* loop,
                      bool* settled, std::ostream* log) {
@@ -796,9 +779,10 @@ Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& pa
     }
   }
   if (params.outer_loop().has_final_association()) {
-    // The final round: a denser sample, weighted as the default one
-    // (DenseSampleLidarParams); the default sample's problem is kept for the
-    // variance factor, the residual statistics and the score test.
+    // The final round: a denser sample, weighted as (n / n_default)^e times
+    // the default sample's information (dense_sample_weight.h); the default
+    // sample's problem is kept for the variance factor, the residual
+    // statistics and the score test.
     Log(log, "final round: the denser association (outer_loop.final_association)");
     const size_t sample_residuals = loop.lidar.size();
     loop.sample_problem = std::move(loop.problem);

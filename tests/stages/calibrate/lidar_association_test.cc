@@ -11,10 +11,31 @@
 
 #include <gtest/gtest.h>
 
+#include "stages/calibrate/dense_sample_weight.h"
 #include "tests/stages/calibrate/calibrate_params_text.h"
 
 namespace tiltcal::calibrate {
 namespace {
+
+// The final round's weight: four times the points at exponent 0.5 carry
+// twice the information (sigma x 2^(1/2), so 4 / 2 = 2 times the summed
+// 1 / sigma^2); the Cauchy loss bends at the same distance in metres.
+TEST(DenseSampleLidarParams, InformationGrowsAsTheDensityToTheExponent) {
+  proto::LidarResidualParams lidar;
+  lidar.set_sigma_m(0.02);
+  lidar.set_cauchy_scale(2.0);
+  const proto::LidarResidualParams dense = DenseSampleLidarParams(lidar, 4000, 1000, 0.5);
+  const double information_ratio =
+      (4000.0 / (dense.sigma_m() * dense.sigma_m())) / (1000.0 / (0.02 * 0.02));
+  EXPECT_NEAR(information_ratio, 2.0, 1e-12);
+  EXPECT_NEAR(dense.cauchy_scale() * dense.sigma_m(), 2.0 * 0.02, 1e-15);
+  // Exponent 1: every point counts in full; 0: the reference's information.
+  EXPECT_DOUBLE_EQ(DenseSampleLidarParams(lidar, 4000, 1000, 1.0).sigma_m(), 0.02);
+  EXPECT_NEAR(DenseSampleLidarParams(lidar, 4000, 1000, 0.0).sigma_m(), 0.04, 1e-15);
+  // No reference, or no denser: unchanged.
+  EXPECT_DOUBLE_EQ(DenseSampleLidarParams(lidar, 4000, 0, 0.5).sigma_m(), 0.02);
+  EXPECT_DOUBLE_EQ(DenseSampleLidarParams(lidar, 900, 1000, 0.5).cauchy_scale(), 2.0);
+}
 
 // A LiDAR driving at 1 m/s along x and yawing at 0.2 rad/s through a room
 // (floor z = -1.5, walls y = +-6, x = 20), 40 scans at 10 Hz of 2,000
