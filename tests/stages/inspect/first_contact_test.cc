@@ -1,11 +1,13 @@
 // tiltcal_inspect on a first bag, as a user runs it: `check` reads every
 // input decode reads and finds the same in a simulated sequence written as
 // a ROS 1 bag (tiltcal_simulate with /tf_static), as MCAP and as a rosbag2
-// sqlite3 folder (tests/oracle/ros1_bag_to_ros2_jsonl.py, write_ros2_bags.mjs),
+// sqlite3 folder (tests/oracle/ros1_bag_to_ros2_jsonl.py, write_ros2_bags.mjs)
+// and as a Livox CustomMsg bag (tests/oracle/pointcloud2_bag_to_livox.py),
 // including the extrinsic of /tf_static; `rig` drafts a rig.txtpb that
 // parses as a Rig and that tiltcal_decode accepts once imu_height_m is
 // filled in, with /tf_static's extrinsic or, without it, a comment.
 #include <string>
+#include <utility>
 
 #include <gtest/gtest.h>
 
@@ -63,7 +65,7 @@ class InspectFirstContact : public ::testing::Test {
   testing::TempDir dir_;
 };
 
-TEST_F(InspectFirstContact, CheckFindsTheSameInRos1McapAndRosbag2) {
+TEST_F(InspectFirstContact, CheckFindsTheSameInRos1McapRosbag2AndLivox) {
   if (const std::string missing = testing::Ros2OracleMissing(); !missing.empty()) {
     GTEST_SKIP() << missing;
   }
@@ -89,6 +91,25 @@ TEST_F(InspectFirstContact, CheckFindsTheSameInRos1McapAndRosbag2) {
   EXPECT_NE(ros1.find("verdict: can be calibrated"), std::string::npos) << ros1;
   EXPECT_EQ(CheckFindings(dir_.File("run.mcap")), ros1);
   EXPECT_EQ(CheckFindings(dir_.File("run_ros2")), ros1);
+
+  // The same clouds as livox_ros_driver/CustomMsg: only the two lines that
+  // name the format's own fields for the point time and the ring differ.
+  ASSERT_EQ(testing::RunCommand(std::string(testing::kDebianPython) + " " +
+                                testing::SourceDir() +
+                                "/tests/oracle/pointcloud2_bag_to_livox.py " + bag + " " +
+                                dir_.File("run_livox.bag")),
+            0);
+  std::string livox = CheckFindings(dir_.File("run_livox.bag"));
+  const std::pair<std::string, std::string> format_fields[] = {
+      {"offset_time UINT32 (ns after timebase (Livox CustomMsg))\n",
+       "time FLOAT32 (s after the stamp)\n"},
+      {"line UINT8\n", "ring UINT16\n"}};
+  for (const auto& [livox_field, pointcloud2_field] : format_fields) {
+    const size_t at = livox.find(livox_field);
+    ASSERT_NE(at, std::string::npos) << livox;
+    livox.replace(at, livox_field.size(), pointcloud2_field);
+  }
+  EXPECT_EQ(livox, ros1);
 }
 
 TEST_F(InspectFirstContact, RigDraftIsARigThatDecodeAccepts) {
