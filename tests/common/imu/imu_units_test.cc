@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
+#include "tests/common/imu/imu_test_options.h"
 #include "tests/common/imu/synthetic_imu.h"
 
 namespace tiltcal::imu {
@@ -20,21 +21,10 @@ std::vector<ImuReading> Readings() {
                                Eigen::Vector3d(0.002, -0.001, 0.003), 0.002, 0.03, nullptr);
 }
 
-StaticDetectionOptions StaticOptions() {
-  StaticDetectionOptions options;
-  options.window_s = 0.5;
-  options.hop_s = 0.1;
-  options.max_gyro_std_radps = 0.01;
-  options.max_accel_std_mps2 = 0.05;
-  options.max_gyro_mean_radps = 0.05;
-  options.min_duration_s = 1.0;
-  return options;
-}
-
 TEST(DetectAccelUnit, MetresPerSecondSquared) {
   const std::vector<ImuReading> readings = Readings();
-  const AccelUnitEvidence evidence =
-      DetectAccelUnit(readings, DetectStaticIntervals(readings, StaticOptions()), UnitBand());
+  const AccelUnitEvidence evidence = DetectAccelUnit(
+      readings, DetectStaticIntervals(readings, testing::StaticDetectionTestOptions()), UnitBand());
   EXPECT_TRUE(evidence.from_static_samples);
   EXPECT_NEAR(evidence.median_norm, 9.81, 0.02);
   ASSERT_TRUE(evidence.unit.has_value());
@@ -99,8 +89,8 @@ TEST(DetectGyroUnitFromRates, NeitherUnitFitsATooFastGyro) {
 // the start attitude of Readings() (0.14 rad).
 TEST(MeanRestForce, StaticSamplesElseAll) {
   const std::vector<ImuReading> readings = Readings();
-  const RestForce rest =
-      MeanRestForce(readings, DetectStaticIntervals(readings, StaticOptions()));
+  const RestForce rest = MeanRestForce(
+      readings, DetectStaticIntervals(readings, testing::StaticDetectionTestOptions()));
   EXPECT_TRUE(rest.from_static_samples);
   EXPECT_GT(rest.num_samples, 350u);  // about 3 s at 200 Hz
   EXPECT_LT(rest.num_samples, 700u);
