@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
-# End to end on a short simulated dataset: tiltcal_simulate writes two flat
-# sequences (real ROS1 bags + truth) and the rig, Makefile.pipeline runs every
-# stage with -j2, and the repeatability report must list both sequences with
-# their errors against the truth within loose bounds; then the verify target
+# End to end on a short simulated dataset: two flat sequences (real ROS1
+# bags + truth) and the rig that tiltcal_simulate wrote, run through every
+# stage by Makefile.pipeline with -j2 (both by the CTest fixture
+# pipeline_flat_pair, flat_pair_fixture.sh), and the repeatability report
+# must list both sequences with their errors against the truth within loose
+# bounds; then the verify target
 # checks the dataset's calibration against the sequences (it holds; bumped by
 # 2 deg of yaw and 3 cm it moved, named), a dataset of one bag ends with its
 # dataset calibration, its page and its check, and short drives that turn
@@ -10,18 +12,19 @@
 #   end_to_end_test.sh BUILD_DIR
 set -euo pipefail
 SRC=$(cd "$(dirname "$0")/../.." && pwd)
-BIN=$(cd "${1:?usage: end_to_end_test.sh BUILD_DIR}" && pwd)/bin
+BUILD=$(cd "${1:?usage: end_to_end_test.sh BUILD_DIR}" && pwd)
+BIN=$BUILD/bin
 WORK=$(mktemp -d)
 trap 'rm -rf "$WORK"' EXIT
 DATA=$WORK/flat
-mkdir -p "$DATA"
 fail() { echo "FAIL: $*" >&2; exit 1; }
 
+# The fixture's run, copied (the checks below write into the dataset).
 source "$(dirname "$0")/flat_pair_dataset.sh"
-simulate_flat_pair "$BIN" "$SRC" "$WORK" "$DATA"
-
-make --no-print-directory -s -f "$SRC/Makefile.pipeline" DATASET="$DATA" BIN="$BIN" -j2 \
-  > "$WORK/make.log" 2>&1 || { tail -20 "$WORK/make.log"; fail "the pipeline failed"; }
+FIXTURE=$(flat_pair_fixture "$BUILD")
+[ -d "$FIXTURE/local/flat/out" ] ||
+  fail "no $FIXTURE/local/flat/out: ctest runs tests/pipeline/flat_pair_fixture.sh first"
+cp -a "$FIXTURE/local/flat" "$DATA"
 
 for s in seq_1 seq_2; do
   for f in imu.binpb scans.binpb.lz4 ground.binpb gravity.txtpb calibration.txtpb ground.csv; do

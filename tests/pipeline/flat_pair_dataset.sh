@@ -17,3 +17,15 @@ simulate_flat_pair() {
       --out_truth="$data/seq_$i.truth.txtpb" "${rig[@]}" 2> /dev/null || return 1
   done
 }
+
+# flat_pair_fixture BUILD_DIR: the folder of the CTest fixture
+# pipeline_flat_pair (flat_pair_fixture.sh), which holds
+#   dataset/      the two sequences and the rig as simulated
+#   local/flat/   a copy of dataset/ with Makefile.pipeline's run of goals all
+#                 and gravity-reference (-j2) in out/, made from local/ with
+#                 DATASET=flat: a relative dataset path, so that a run of
+#                 another copy named flat, from another folder, records the
+#                 same paths in its outputs.
+flat_pair_fixture() {
+  echo "$1/test_data/pipeline_flat_pair"
+}

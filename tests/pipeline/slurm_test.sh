@@ -1,17 +1,19 @@
 #!/usr/bin/env bash
 # Makefile.pipeline through a real Slurm controller: a one-node cluster on
 # this machine (scripts/slurm_local_cluster.sh), two short simulated
-# sequences run with LAUNCH="srun -N1 -n1 …" -j2, then the same dataset run
-# locally (no LAUNCH). Every $(LAUNCH) recipe must have run as one Slurm job
-# that completed (the controller's job completion log), and every output must
-# equal the local run's but for what the clock decides (created_utc, the
-# calibration's timings). About 45 s on 2 cores.
+# sequences run with LAUNCH="srun -N1 -n1 …" -j2; the CTest fixture
+# pipeline_flat_pair (flat_pair_fixture.sh) holds the same sequences and
+# their local run (no LAUNCH). Every $(LAUNCH) recipe must have run as one
+# Slurm job that completed (the controller's job completion log), and every
+# output must equal the local run's but for what the clock decides
+# (created_utc, the calibration's timings).
 #   slurm_test.sh BUILD_DIR
 # Exit 77 (skipped) without root or without Slurm and munge
 # (scripts/setup.sh --cluster installs them).
 set -euo pipefail
 SRC=$(cd "$(dirname "$0")/../.." && pwd)
-BIN=$(cd "${1:?usage: slurm_test.sh BUILD_DIR}" && pwd)/bin
+BUILD=$(cd "${1:?usage: slurm_test.sh BUILD_DIR}" && pwd)
+BIN=$BUILD/bin
 fail() { echo "FAIL: $*" >&2; exit 1; }
 export PATH=$PATH:/usr/sbin:/sbin  # the daemons
 
@@ -30,22 +32,25 @@ cleanup() {
 trap cleanup EXIT
 trap 'exit 143' TERM INT HUP
 
-# Two flat 20 s sequences, as in end_to_end_test.sh, kept pristine in $WORK/dataset.
+# The two flat 20 s sequences of end_to_end_test.sh and their local run:
+# the fixture's dataset and local/flat (flat_pair_dataset.sh).
 source "$(dirname "$0")/flat_pair_dataset.sh"
-simulate_flat_pair "$BIN" "$SRC" "$WORK" "$WORK/dataset"
+FIXTURE=$(flat_pair_fixture "$BUILD")
+[ -d "$FIXTURE/local/flat/out" ] ||
+  fail "no $FIXTURE/local/flat/out: ctest runs tests/pipeline/flat_pair_fixture.sh first"
 
 bash "$SRC/scripts/slurm_local_cluster.sh" start "$CLUSTER"
 export SLURM_CONF=$CLUSTER/slurm.conf
 
-# Both runs use the same dataset path ($WORK/flat, copied afresh from the
-# pristine one), so the paths the outputs record are the same too.
-DATA=$WORK/flat
+# A copy of the fixture's dataset named flat, run from $WORK/slurm_run with
+# DATASET=flat as the local run was from local/: the paths the outputs
+# record are the same.
 GOALS=(all gravity-reference)  # every recipe of Makefile.pipeline that has $(LAUNCH)
-cp -a "$WORK/dataset" "$DATA"
-make --no-print-directory -f "$SRC/Makefile.pipeline" DATASET="$DATA" BIN="$BIN" -j2 \
-  LAUNCH="srun -N1 -n1 --time=10 --quiet" "${GOALS[@]}" > "$WORK/slurm.log" 2>&1 ||
+mkdir -p "$WORK/slurm_run"
+cp -a "$FIXTURE/dataset" "$WORK/slurm_run/flat"
+(cd "$WORK/slurm_run" && make --no-print-directory -f "$SRC/Makefile.pipeline" DATASET=flat \
+  BIN="$BIN" -j2 LAUNCH="srun -N1 -n1 --time=10 --quiet" "${GOALS[@]}") > "$WORK/slurm.log" 2>&1 ||
   { tail -20 "$WORK/slurm.log"; fail "the pipeline failed under Slurm"; }
-mv "$DATA" "$WORK/slurm_run"
 bash "$SRC/scripts/slurm_local_cluster.sh" stop "$CLUSTER"
 
 # One completed job per $(LAUNCH) recipe: five stages per sequence, then the
@@ -63,15 +68,12 @@ not_completed=$(grep -v ' JobState=COMPLETED .* ExitCode=0:0' "$jobs_file" || tr
 [ -z "$not_completed" ] || fail "jobs that did not complete: $not_completed"
 echo "Slurm jobs: $(wc -l < "$jobs_file") completed ($(echo $ran))"
 
-cp -a "$WORK/dataset" "$DATA"
-make --no-print-directory -f "$SRC/Makefile.pipeline" DATASET="$DATA" BIN="$BIN" -j2 \
-  "${GOALS[@]}" > "$WORK/local.log" 2>&1 ||
-  { tail -20 "$WORK/local.log"; fail "the pipeline failed locally"; }
-
 # The same files, each byte-equal or equal but for what the clock decides
 # (what differs between two runs of one binary on one input).
-(cd "$WORK/slurm_run/out" && find . -type f -printf '%P\n' | sort) > "$WORK/slurm_files"
-(cd "$DATA/out" && find . -type f -printf '%P\n' | sort) > "$WORK/local_files"
+SLURM_OUT=$WORK/slurm_run/flat/out
+LOCAL_OUT=$FIXTURE/local/flat/out
+(cd "$SLURM_OUT" && find . -type f -printf '%P\n' | sort) > "$WORK/slurm_files"
+(cd "$LOCAL_OUT" && find . -type f -printf '%P\n' | sort) > "$WORK/local_files"
 diff "$WORK/slurm_files" "$WORK/local_files" > /dev/null ||
   fail "Slurm and local runs wrote different files: $(diff "$WORK/slurm_files" "$WORK/local_files" | grep '^[<>]' | xargs)"
 grep -qx 'seq_1/calibration\.txtpb' "$WORK/slurm_files" || fail "no out/seq_1/calibration.txtpb"
@@ -81,7 +83,7 @@ grep -qx 'seq_1/calibration\.txtpb' "$WORK/slurm_files" || fail "no out/seq_1/ca
 # an input that is another output (a calibration.txtpb, whose timings change
 # its size; it is compared itself).
 without_run_times() {
-  awk -v out="$DATA/out/" '
+  awk -v out="flat/out/" '
     /^[[:space:]]*(created_utc|seconds_per_iteration): / { next }
     /^timings \{/ { in_timings = 1 }
     /^\}/ { in_timings = 0 }
@@ -106,8 +108,8 @@ streams_equal_but_created_utc() {
 }
 byte_equal=0
 while read -r f; do
-  a=$WORK/slurm_run/out/$f
-  b=$DATA/out/$f
+  a=$SLURM_OUT/$f
+  b=$LOCAL_OUT/$f
   if cmp -s "$a" "$b"; then
     byte_equal=$((byte_equal + 1))
   elif [[ "$f" == *.txtpb ]]; then
