@@ -17,7 +17,7 @@ for arg in "$@"; do
 done
 
 PACKAGES=(
-  build-essential cmake ninja-build pkg-config git
+  build-essential cmake ninja-build lld pkg-config git
   libeigen3-dev libceres-dev libgoogle-glog-dev
   libpcl-dev libnanoflann-dev libprotobuf-dev protobuf-compiler
   liblz4-dev lz4 libbz2-dev libfmt-dev libsqlite3-dev libzstd-dev zlib1g-dev libpng-dev
