@@ -12,6 +12,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -24,7 +25,11 @@
 namespace tiltcal::calibrate {
 namespace {
 
-using ImuFaultsTest = ShortSequenceTest;
+// Each test simulates its own sequence into the test's folder.
+class ImuFaultsTest : public ::testing::Test {
+ protected:
+  const std::unique_ptr<testing::TempDir> dir_ = std::make_unique<testing::TempDir>();
+};
 
 proto::SimulateParams ShortSequenceWith(const std::string& faults) {
   proto::SimulateParams scenario;
