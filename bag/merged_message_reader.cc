@@ -257,21 +257,62 @@ bool MergedMessageReader::TimeRange(int64_t* start_ns, int64_t* end_ns) const {
   return any;
 }
 
-Status MergedMessageReader::ReadMessages(const MessageSelection& selection,
-                                         const std::function<Status(const Message&)>& fn) {
-  duplicates_dropped_ = 0;
-  std::unordered_map<std::string, const std::string*> topic_names;
-  for (const TopicInfo& t : topics_) topic_names[t.name] = &t.name;
+// A file that holds a selected topic, with its lower bound: its first
+// record time until its first message is taken, then that message.
+struct MergedMessageReader::Head {
+  std::unique_ptr<Source> source;
+  MessageSelection selection;
+  int64_t key_ns;
+  bool has_message = false;
+  OwnedMessage message;
 
-  // The files that hold a selected topic, each with its lower bound: its
-  // first record time until its first message is taken, then that message.
-  struct Head {
-    std::unique_ptr<Source> source;
-    MessageSelection selection;
-    int64_t key_ns;
-    bool has_message = false;
-    OwnedMessage message;
-  };
+  bool finished() const { return source->started() && !has_message; }
+  // Takes the next message of the file into `message`.
+  Status Advance() {
+    Status status;
+    has_message = source->Take(&message, &status);
+    if (!status.ok()) return status;
+    if (has_message) key_ns = message.time_ns;
+    return Status::Ok();
+  }
+};
+
+namespace {
+
+// The messages given at the latest record time, to recognise the same
+// message in a later file.
+class GivenAtTime {
+ public:
+  bool IsDuplicate(const OwnedMessage& m) {
+    if (!given_.empty() && given_.front().time_ns != m.time_ns) given_.clear();
+    for (const OwnedMessage& g : given_) {
+      if (g.topic == m.topic && g.file != m.file && g.data == m.data) return true;
+    }
+    return false;
+  }
+  void Add(OwnedMessage&& m) { given_.push_back(std::move(m)); }
+
+ private:
+  std::vector<OwnedMessage> given_;
+};
+
+// `m` as the message handed out (`sequence` is the caller's).
+void ViewOf(const OwnedMessage& m, Message* out) {
+  out->topic = m.topic;
+  out->encoding = m.encoding;
+  out->time_ns = m.time_ns;
+  out->file = m.file;
+  out->position_name = m.position_name;
+  out->position = m.position;
+  out->data = m.data.data();
+  out->size = m.data.size();
+}
+
+}  // namespace
+
+std::vector<MergedMessageReader::Head> MergedMessageReader::OpenHeads(
+    const MessageSelection& selection,
+    const std::unordered_map<std::string, const std::string*>* topic_names) const {
   std::vector<Head> heads;
   for (size_t i = 0; i < files_.size(); ++i) {
     MessageReader* f = files_[i].get();
@@ -289,62 +330,46 @@ Status MergedMessageReader::ReadMessages(const MessageSelection& selection,
       continue;
     }
     Head h;
-    h.source = std::make_unique<Source>(f, i, f->path(), &topic_names);
+    h.source = std::make_unique<Source>(f, i, f->path(), topic_names);
     h.selection = std::move(own);
     h.key_ns = std::max(start_ns, selection.start_ns);
     heads.push_back(std::move(h));
   }
+  return heads;
+}
 
-  // The messages given at the latest record time, to recognise the same
-  // message in a later file.
-  std::vector<OwnedMessage> given_at_time;
-  auto is_duplicate = [&](const OwnedMessage& m) {
-    if (!given_at_time.empty() && given_at_time.front().time_ns != m.time_ns) {
-      given_at_time.clear();
-    }
-    for (const OwnedMessage& g : given_at_time) {
-      if (g.topic == m.topic && g.file != m.file && g.data == m.data) return true;
-    }
-    return false;
-  };
-
+Status MergedMessageReader::ReadMessages(const MessageSelection& selection,
+                                         const std::function<Status(const Message&)>& fn) {
+  duplicates_dropped_ = 0;
+  std::unordered_map<std::string, const std::string*> topic_names;
+  for (const TopicInfo& t : topics_) topic_names[t.name] = &t.name;
+  std::vector<Head> heads = OpenHeads(selection, &topic_names);
+  GivenAtTime given;
   Message out;
-  Status status;
   while (true) {
     // The head with the smallest (key, file index); sources not started
     // yet have their first record time as key, never after their message.
     Head* next = nullptr;
     for (Head& h : heads) {
-      if (h.source->started() && !h.has_message) continue;  // finished
+      if (h.finished()) continue;
       if (next == nullptr || h.key_ns < next->key_ns) next = &h;
     }
     if (next == nullptr) break;
     if (!next->has_message) {
       if (!next->source->started()) next->source->Start(next->selection);
-      next->has_message = next->source->Take(&next->message, &status);
-      if (!status.ok()) return status;
-      if (next->has_message) next->key_ns = next->message.time_ns;
+      TILTCAL_RETURN_IF_ERROR(next->Advance());
       continue;
     }
     OwnedMessage& m = next->message;
-    if (is_duplicate(m)) {
+    if (given.IsDuplicate(m)) {
       ++duplicates_dropped_;
     } else {
-      out.topic = m.topic;
-      out.encoding = m.encoding;
-      out.time_ns = m.time_ns;
-      out.file = m.file;
-      out.position_name = m.position_name;
-      out.position = m.position;
-      out.data = m.data.data();
-      out.size = m.data.size();
+      ViewOf(m, &out);
       TILTCAL_RETURN_IF_ERROR(fn(out));
       ++out.sequence;
-      given_at_time.push_back(std::move(m));
+      given.Add(std::move(m));
     }
-    next->has_message = next->source->Take(&next->message, &status);
-    if (!status.ok()) return status;
-    if (next->has_message) next->key_ns = next->message.time_ns;
+    TILTCAL_RETURN_IF_ERROR(next->Advance());
   }
   return Status::Ok();
 }

@@ -28,6 +28,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "bag/message_reader.h"
@@ -68,6 +69,11 @@ class MergedMessageReader : public MessageReader {
 
  private:
   class Source;
+  struct Head;
+  // The files that hold a selected topic inside the time window.
+  std::vector<Head> OpenHeads(
+      const MessageSelection& selection,
+      const std::unordered_map<std::string, const std::string*>* topic_names) const;
 
   std::string path_;
   std::vector<std::unique_ptr<MessageReader>> files_;

@@ -32,6 +32,25 @@ T LoadLe(const uint8_t* p) {
 
 }  // namespace
 
+std::string OpcodeName(uint8_t opcode) {
+  switch (opcode) {
+    case kHeader: return "Header";
+    case kFooter: return "Footer";
+    case kSchema: return "Schema";
+    case kChannel: return "Channel";
+    case kMessage: return "Message";
+    case kChunk: return "Chunk";
+    case kMessageIndex: return "MessageIndex";
+    case kChunkIndex: return "ChunkIndex";
+    case kDataEnd: return "DataEnd";
+    default: return "opcode " + std::to_string(opcode);
+  }
+}
+
+bool CanStartRecord(uint8_t opcode) {
+  return (opcode >= kSchema && opcode <= kDataEnd) || opcode >= 0x80;
+}
+
 uint32_t Crc32(const uint8_t* data, size_t size, uint32_t crc) {
   static const CrcTables t = MakeCrcTables();
   crc = ~crc;

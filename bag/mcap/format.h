@@ -32,6 +32,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <functional>
 #include <string>
 #include <utility>
@@ -56,6 +57,23 @@ enum Opcode : uint8_t {
   kChunkIndex = 0x08,
   kDataEnd = 0x0F,
 };
+
+// "Header", "Chunk", ...; "opcode N" for any other.
+std::string OpcodeName(uint8_t opcode);
+// Opcodes a record of the data section may have when looking for where the
+// records resume after a damaged one: the known records and the private
+// ones (0x80 and up).
+bool CanStartRecord(uint8_t opcode);
+// No record of a sane recording is this large; readers refuse it before
+// allocating.
+inline constexpr uint64_t kMaxRecordBytes = uint64_t{4} << 30;
+
+// The little-endian u64 at `p` (any alignment).
+inline uint64_t LoadU64(const uint8_t* p) {
+  uint64_t v;
+  std::memcpy(&v, p, 8);
+  return v;
+}
 
 // CRC-32 (ISO-HDLC, as zlib's crc32) of `size` bytes, continuing from `crc`.
 uint32_t Crc32(const uint8_t* data, size_t size, uint32_t crc = 0);

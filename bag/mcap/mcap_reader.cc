@@ -17,39 +17,6 @@ namespace {
 
 constexpr char kChunkPosition[] = "chunk at byte";
 constexpr char kRecordPosition[] = "record at byte";
-// No record of a sane recording is this large; refuse before allocating.
-constexpr uint64_t kMaxRecordBytes = uint64_t{4} << 30;
-
-uint64_t LoadU64(const uint8_t* p) {
-  uint64_t v;
-  std::memcpy(&v, p, 8);
-  return v;
-}
-
-std::string OpcodeName(uint8_t opcode) {
-  switch (opcode) {
-    case kHeader: return "Header";
-    case kFooter: return "Footer";
-    case kSchema: return "Schema";
-    case kChannel: return "Channel";
-    case kMessage: return "Message";
-    case kChunk: return "Chunk";
-    case kMessageIndex: return "MessageIndex";
-    case kChunkIndex: return "ChunkIndex";
-    case kDataEnd: return "DataEnd";
-    default: return "opcode " + std::to_string(opcode);
-  }
-}
-
-// Opcodes a record of the data section may have when looking for where the
-// records resume after a damaged one: the known records and the private
-// ones (0x80 and up).
-bool CanStartRecord(uint8_t opcode) {
-  return (opcode >= kSchema && opcode <= kDataEnd) || opcode >= 0x80;
-}
-
-// More damaged records than this: not a recording worth salvaging.
-constexpr int kMaxDamagedRecords = 100;
 
 }  // namespace
 
@@ -225,311 +192,6 @@ Status McapReader::IndexChunkFromSummary(const ChunkIndexRecord& index) {
   return Status::Ok();
 }
 
-Status McapReader::WalkDataSection() {
-  // The chunks the summary listed (sorted by offset): not read again.
-  const size_t listed = chunks_.size();
-  const bool summary = indexed_;
-  size_t unlisted_chunks = 0;
-  size_t unlisted_entries = 0;
-  uint64_t first_unlisted = 0;
-  int damaged = 0;
-  uint64_t skipped_bytes = 0;
-  // The last record read whole: where it starts, its opcode, and how many
-  // entries and chunks there were before it.
-  struct Last {
-    bool valid = false;
-    uint64_t offset = 0;
-    uint8_t opcode = 0;
-    size_t entries = 0;
-    size_t chunks = 0;
-  } last;
-  std::vector<uint8_t> content;
-  uint64_t offset = header_end_;
-  while (true) {
-    if (complete_ && offset == data_end_) break;  // no DataEnd record: tolerated
-    std::string damage;  // why the record at `offset` is damaged
-    uint8_t opcode = 0;
-    uint64_t length = 0;
-    if (offset + kRecordPrefixBytes > data_end_) {
-      if (!complete_) {
-        salvage_note_ = "the recording ends at byte " + std::to_string(file_size_) +
-                        " without its DataEnd record";
-        break;
-      }
-      damage = "the data section ends at byte " + std::to_string(data_end_) +
-               " inside its 9-byte prefix";
-    } else {
-      uint8_t prefix[kRecordPrefixBytes];
-      TILTCAL_RETURN_IF_ERROR(ReadAt(offset, kRecordPrefixBytes, prefix));
-      opcode = prefix[0];
-      length = LoadU64(prefix + 1);
-      const uint64_t room = data_end_ - offset - kRecordPrefixBytes;
-      if (!complete_ && (opcode == kDataEnd || opcode == kFooter)) break;
-      if (opcode == kDataEnd && length == room) break;
-      if (length > room) {
-        if (!complete_) {
-          salvage_note_ = "the recording ends inside the " + OpcodeName(opcode) +
-                          " record at byte " + std::to_string(offset) + " (" +
-                          std::to_string(file_size_) + " bytes): what follows it is lost";
-          break;
-        }
-        damage = "length " + std::to_string(length) + " runs past the end of the data section at byte " +
-                 std::to_string(data_end_);
-      } else if (opcode == kDataEnd) {
-        damage = "it ends at byte " + std::to_string(offset + kRecordPrefixBytes + length) +
-                 ", not at the end of the data section (byte " + std::to_string(data_end_) + ")";
-      } else if (opcode == 0 || opcode == kHeader || opcode == kFooter) {
-        damage = "no " + OpcodeName(opcode) + " record belongs in the data section";
-      }
-    }
-    if (!damage.empty() && opcode == kChunk && offset + kRecordPrefixBytes <= data_end_) {
-      // Only the length is damaged when the chunk's own fields give one from
-      // which the records after it chain onto the end of the data section.
-      uint64_t by_fields = 0;
-      TILTCAL_RETURN_IF_ERROR(ChunkLengthByItsFields(offset, &by_fields));
-      if (by_fields != 0 && by_fields != length) {
-        warnings_.push_back(DamagedChunkLength(offset, length, by_fields));
-        length = by_fields;
-        damage.clear();
-      }
-    }
-    const size_t entries_before = entries_.size();
-    const size_t chunks_before = chunks_.size();
-    if (damage.empty() && opcode == kChunk) {
-      const bool in_summary =
-          std::binary_search(chunks_.begin(), chunks_.begin() + static_cast<long>(listed),
-                             Chunk{offset, 0, 0},
-                             [](const Chunk& a, const Chunk& b) { return a.offset < b.offset; });
-      if (!in_summary) {
-        if (length > kMaxRecordBytes) {
-          return Error(offset, "Chunk record of " + std::to_string(length) + " bytes");
-        }
-        content.resize(length);
-        TILTCAL_RETURN_IF_ERROR(ReadAt(offset + kRecordPrefixBytes, length, content.data()));
-        ChunkRecord chunk;
-        Status status = ParseChunk(content.data(), content.size(), &chunk);
-        if (!status.ok() && !complete_) return Error(offset, "Chunk: " + status.message());
-        if (!status.ok()) {
-          damage = status.message();
-        } else {
-          const auto index = static_cast<uint32_t>(chunks_.size());
-          chunks_.push_back({offset, kRecordPrefixBytes + length, chunk.uncompressed_size});
-          // Decompressed into the cache: the first ReadMessages() finds it there.
-          std::vector<uint8_t>* records = CacheSlot(index, chunk.uncompressed_size);
-          status = decompressor_.Decompress(chunk, records);
-          if (!status.ok()) return Error(offset, "Chunk: " + status.message());
-          if (!chunk.compression.empty()) ++chunks_decompressed_;
-          cached_bytes_ += records->size();
-          TILTCAL_RETURN_IF_ERROR(IndexRecords(records->data(), records->size(), index, offset));
-          if (summary) {
-            if (unlisted_chunks++ == 0) first_unlisted = offset;
-            unlisted_entries += entries_.size() - entries_before;
-          }
-        }
-      }
-    } else if (damage.empty() &&
-               (opcode == kSchema || opcode == kChannel || opcode == kMessage)) {
-      content.resize(kRecordPrefixBytes + length);
-      TILTCAL_RETURN_IF_ERROR(ReadAt(offset, content.size(), content.data()));
-      Status status = IndexRecords(content.data(), content.size(), kNoChunk, offset);
-      if (!status.ok() && !complete_) return status;
-      if (!status.ok()) damage = OpcodeName(opcode) + " does not parse";
-    }
-    if (damage.empty()) {
-      last = {true, offset, opcode, entries_before, chunks_before};
-      offset += kRecordPrefixBytes + length;
-      continue;
-    }
-    // A damaged record. When it is no record at all (an opcode no record
-    // starts with), the length of the record before it is the damaged
-    // one: that record and what it gave are dropped.
-    if (!CanStartRecord(opcode) && last.valid && last.opcode == kChunk) {
-      // The chunk before it was read whole by its own fields; only its
-      // length overshoots.
-      uint64_t by_fields = 0;
-      TILTCAL_RETURN_IF_ERROR(ChunkLengthByItsFields(last.offset, &by_fields));
-      const uint64_t resume = last.offset + kRecordPrefixBytes + by_fields;
-      if (by_fields != 0 && resume != offset) {
-        warnings_.push_back(DamagedChunkLength(
-            last.offset, offset - last.offset - kRecordPrefixBytes, by_fields));
-        for (size_t c = last.chunks; c < chunks_.size(); ++c) {
-          chunks_[c].length = kRecordPrefixBytes + by_fields;
-        }
-        last.valid = false;
-        offset = resume;
-        continue;
-      }
-    }
-    if (++damaged > kMaxDamagedRecords) {
-      return Error(offset, "more than " + std::to_string(kMaxDamagedRecords) +
-                               " damaged records; the last: " + damage);
-    }
-    std::string what = "the " + OpcodeName(opcode) + " record at byte " + std::to_string(offset) +
-                       " (" + damage + ")";
-    uint64_t skip_from = offset;
-    size_t dropped = 0;
-    if (!CanStartRecord(opcode) && last.valid) {
-      what = "the " + OpcodeName(last.opcode) + " record at byte " + std::to_string(last.offset) +
-             " (its length leads to byte " + std::to_string(offset) +
-             ", where no record starts)";
-      skip_from = last.offset;
-      dropped = entries_.size() - last.entries;
-      entries_.resize(last.entries);
-      for (size_t c = last.chunks; c < chunks_.size(); ++c) {
-        cache_.remove_if([&](const CachedChunk& cached) { return cached.chunk == c; });
-      }
-      if (chunks_.size() > last.chunks) chunks_.resize(last.chunks);
-    } else {
-      entries_.resize(entries_before);
-      chunks_.resize(chunks_before);
-    }
-    cached_bytes_ = 0;
-    for (const CachedChunk& cached : cache_) cached_bytes_ += cached.records.size();
-    uint64_t resume = data_end_;
-    TILTCAL_RETURN_IF_ERROR(FindResumeOffset(skip_from + 1, listed, &resume));
-    skipped_bytes += resume - skip_from;
-    std::string resumed = "nothing after it chains onto the end of the data section";
-    if (resume < data_end_) {
-      uint8_t resume_opcode = 0;
-      TILTCAL_RETURN_IF_ERROR(ReadAt(resume, 1, &resume_opcode));
-      resumed = "reading resumed at the " + OpcodeName(resume_opcode) + " record at byte " +
-                std::to_string(resume);
-    }
-    warnings_.push_back(path_ + ": damaged " + what + ": bytes " + std::to_string(skip_from) +
-                        " to " + std::to_string(resume) + " skipped (" +
-                        std::to_string(resume - skip_from) + " bytes" +
-                        (dropped > 0 ? ", with the " + std::to_string(dropped) +
-                                           " messages read from that record"
-                                     : "") +
-                        "); " + resumed);
-    last.valid = false;
-    offset = resume;
-  }
-  // Messages of channels no Channel record defines (their Channel record
-  // was in a damaged record) cannot be given a topic.
-  const auto defined = [this](const Entry& e) {
-    return e.channel < channels_.size() && channels_[e.channel] != nullptr;
-  };
-  const auto without_channel = static_cast<size_t>(
-      std::count_if(entries_.begin(), entries_.end(), [&](const Entry& e) { return !defined(e); }));
-  if (without_channel > 0) {
-    entries_.erase(std::remove_if(entries_.begin(), entries_.end(),
-                                  [&](const Entry& e) { return !defined(e); }),
-                   entries_.end());
-    warnings_.push_back(path_ + ": " + std::to_string(without_channel) +
-                        " messages on channels that no Channel record defines left out (their "
-                        "topic is unknown)");
-  }
-  if (damaged > 0) {
-    warnings_.push_back(path_ + ": " + std::to_string(damaged) + " damaged record(s), " +
-                        std::to_string(skipped_bytes) + " bytes skipped; " +
-                        std::to_string(entries_.size()) +
-                        " messages read from the rest of the file");
-  }
-  if (unlisted_chunks > 0) {
-    warnings_.push_back(path_ + ": the summary disagrees with the data section: it lists " +
-                        std::to_string(listed) + " chunks, the data section holds " +
-                        std::to_string(listed + unlisted_chunks) + "; the " +
-                        std::to_string(unlisted_chunks) + " chunk(s) it omits (the first at byte " +
-                        std::to_string(first_unlisted) + ", " +
-                        std::to_string(unlisted_entries) +
-                        " messages) were read from the data section");
-  }
-  return Status::Ok();
-}
-
-Status McapReader::FindResumeOffset(uint64_t from, size_t listed, uint64_t* resume) {
-  *resume = data_end_;
-  // Inside a chunk the summary lists: its records are read from the chunk.
-  auto inside_listed_chunk = [&](uint64_t offset) {
-    const auto end = chunks_.begin() + static_cast<long>(listed);
-    auto it = std::upper_bound(chunks_.begin(), end, offset,
-                               [](uint64_t o, const Chunk& c) { return o < c.offset; });
-    return it != chunks_.begin() && offset < std::prev(it)->offset + std::prev(it)->length &&
-           offset != std::prev(it)->offset;
-  };
-  std::vector<uint8_t> window;
-  constexpr uint64_t kWindowBytes = uint64_t{1} << 20;
-  for (uint64_t p = from; p + kRecordPrefixBytes <= data_end_;) {
-    const uint64_t n = std::min(kWindowBytes, data_end_ - p);
-    window.resize(n);
-    TILTCAL_RETURN_IF_ERROR(ReadAt(p, n, window.data()));
-    for (uint64_t i = 0; i + kRecordPrefixBytes <= n; ++i) {
-      const uint64_t q = p + i;
-      if (!CanStartRecord(window[i]) ||
-          LoadU64(&window[i + 1]) > data_end_ - q - kRecordPrefixBytes || inside_listed_chunk(q)) {
-        continue;
-      }
-      bool chains = false;
-      TILTCAL_RETURN_IF_ERROR(ChainsToDataEnd(q, &chains));
-      if (chains) {
-        *resume = q;
-        return Status::Ok();
-      }
-    }
-    p += n - (kRecordPrefixBytes - 1);  // the windows overlap by a prefix less one byte
-  }
-  return Status::Ok();
-}
-
-std::string McapReader::DamagedChunkLength(uint64_t offset, uint64_t declared,
-                                           uint64_t by_fields) const {
-  return path_ + ": damaged length of the Chunk record at byte " + std::to_string(offset) +
-         ": it declares " + std::to_string(declared) + " bytes, its fields give " +
-         std::to_string(by_fields) +
-         ", after which the records follow; read with that length, nothing skipped";
-}
-
-Status McapReader::ChunkLengthByItsFields(uint64_t offset, uint64_t* length) {
-  *length = 0;
-  // start, end, uncompressed_size (u64), crc, compression length (u32).
-  constexpr uint64_t kFixed = 8 + 8 + 8 + 4 + 4;
-  constexpr uint32_t kMaxCompressionName = 64;
-  const uint64_t room = data_end_ - offset - kRecordPrefixBytes;
-  if (room < kFixed) return Status::Ok();
-  uint8_t fixed[kFixed];
-  TILTCAL_RETURN_IF_ERROR(ReadAt(offset + kRecordPrefixBytes, kFixed, fixed));
-  uint32_t name_length = 0;
-  std::memcpy(&name_length, fixed + 28, 4);
-  if (name_length > kMaxCompressionName || kFixed + name_length + 8 > room) return Status::Ok();
-  uint8_t records_size_bytes[8];
-  TILTCAL_RETURN_IF_ERROR(
-      ReadAt(offset + kRecordPrefixBytes + kFixed + name_length, 8, records_size_bytes));
-  const uint64_t records_size = LoadU64(records_size_bytes);
-  if (records_size > room - kFixed - name_length - 8) return Status::Ok();
-  const uint64_t by_fields = kFixed + name_length + 8 + records_size;
-  bool chains = false;
-  TILTCAL_RETURN_IF_ERROR(ChainsToDataEnd(offset + kRecordPrefixBytes + by_fields, &chains));
-  if (chains) *length = by_fields;
-  return Status::Ok();
-}
-
-Status McapReader::ChainsToDataEnd(uint64_t offset, bool* chains) {
-  *chains = false;
-  std::vector<uint64_t> visited;
-  for (uint64_t p = offset;;) {
-    if (p == data_end_) {
-      *chains = true;
-      break;
-    }
-    if (p + kRecordPrefixBytes > data_end_ || dead_offsets_.count(p) > 0) break;
-    uint8_t prefix[kRecordPrefixBytes];
-    TILTCAL_RETURN_IF_ERROR(ReadAt(p, kRecordPrefixBytes, prefix));
-    const uint64_t length = LoadU64(prefix + 1);
-    const uint64_t room = data_end_ - p - kRecordPrefixBytes;
-    if (!CanStartRecord(prefix[0]) || length > room) break;
-    visited.push_back(p);
-    if (prefix[0] == kDataEnd) {
-      *chains = length == room;
-      break;
-    }
-    p += kRecordPrefixBytes + length;
-  }
-  // Every offset of a failed chain fails the same way: never followed again.
-  if (!*chains) dead_offsets_.insert(visited.begin(), visited.end());
-  return Status::Ok();
-}
-
 Status McapReader::IndexRecords(const uint8_t* data, size_t size, uint32_t chunk,
                                 uint64_t base) {
   for (size_t pos = 0; pos < size;) {
@@ -679,15 +341,19 @@ Status McapReader::ChunkCompressions(std::map<std::string, int64_t>* compression
   return Status::Ok();
 }
 
+bool McapReader::ChannelSelected(const Channel* channel,
+                                 const bag::MessageSelection& selection) {
+  return channel != nullptr &&
+         (selection.topics.empty() ||
+          std::find(selection.topics.begin(), selection.topics.end(), channel->topic) !=
+              selection.topics.end());
+}
+
 Status McapReader::ReadMessages(const bag::MessageSelection& selection,
                                 const std::function<Status(const bag::Message&)>& fn) {
   for (size_t id = 0; id < channels_.size(); ++id) {
     const Channel* c = channels_[id].get();
-    if (c == nullptr || (!selection.topics.empty() &&
-                         std::find(selection.topics.begin(), selection.topics.end(), c->topic) ==
-                             selection.topics.end())) {
-      continue;
-    }
+    if (!ChannelSelected(c, selection)) continue;
     if (c->message_encoding != "ros1" && c->message_encoding != "cdr") {
       return Status::Error(path_ + ": channel " + std::to_string(id) + " (topic '" + c->topic +
                            "') has message encoding '" + c->message_encoding +
@@ -698,20 +364,11 @@ Status McapReader::ReadMessages(const bag::MessageSelection& selection,
                             [&fn](const bag::Message& m, const MessageRecord&) { return fn(m); });
 }
 
-Status McapReader::ReadMessageRecords(
-    const bag::MessageSelection& selection, Order order,
-    const std::function<Status(const bag::Message&, const MessageRecord&)>& fn) {
+std::vector<const McapReader::Entry*> McapReader::SelectedEntries(
+    const bag::MessageSelection& selection, Order order) const {
   std::vector<bool> selected(channels_.size(), false);
-  std::vector<bag::Encoding> encodings(channels_.size(), bag::Encoding::kCdr);
   for (size_t id = 0; id < channels_.size(); ++id) {
-    const Channel* c = channels_[id].get();
-    if (c == nullptr || (!selection.topics.empty() &&
-                         std::find(selection.topics.begin(), selection.topics.end(), c->topic) ==
-                             selection.topics.end())) {
-      continue;
-    }
-    if (c->message_encoding == "ros1") encodings[id] = bag::Encoding::kRos1;
-    selected[id] = true;
+    selected[id] = ChannelSelected(channels_[id].get(), selection);
   }
   std::vector<const Entry*> items;
   for (const Entry& e : entries_) {
@@ -737,43 +394,61 @@ Status McapReader::ReadMessageRecords(
       return file_order(a, b);
     });
   }
+  return items;
+}
+
+Status McapReader::ReadMessageRecord(const Entry& e, std::vector<uint8_t>* record,
+                                     MessageRecord* message, uint64_t* where) {
+  const uint8_t* data = nullptr;
+  size_t size = 0;
+  *where = e.offset;
+  if (e.chunk != kNoChunk) {
+    const std::vector<uint8_t>* records = nullptr;
+    TILTCAL_RETURN_IF_ERROR(LoadChunk(e.chunk, &records));
+    *where = chunks_[e.chunk].offset;
+    if (e.offset > records->size()) return Error(*where, "message offset past its chunk");
+    data = records->data() + e.offset;
+    size = records->size() - e.offset;
+  } else {
+    record->resize(kRecordPrefixBytes + kMessageFixedBytes);
+    TILTCAL_RETURN_IF_ERROR(ReadAt(e.offset, kRecordPrefixBytes, record->data()));
+    const uint64_t length = LoadU64(record->data() + 1);
+    if (length > kMaxRecordBytes || length > file_size_ - e.offset - kRecordPrefixBytes) {
+      return Error(*where, "Message record of " + std::to_string(length) +
+                               " bytes runs past the end of the file");
+    }
+    record->resize(kRecordPrefixBytes + length);
+    TILTCAL_RETURN_IF_ERROR(ReadAt(e.offset, record->size(), record->data()));
+    data = record->data();
+    size = record->size();
+  }
+  Status status = size < kRecordPrefixBytes || data[0] != kMessage ||
+                          LoadU64(data + 1) > size - kRecordPrefixBytes
+                      ? Status::Error("no Message record at offset " + std::to_string(e.offset))
+                      : ParseMessage(data + kRecordPrefixBytes, LoadU64(data + 1), message);
+  if (!status.ok()) return Error(*where, status.message());
+  if (message->channel_id != e.channel || static_cast<int64_t>(message->log_time) != e.time_ns) {
+    return Error(*where, "the message index does not match the Message record at offset " +
+                             std::to_string(e.offset));
+  }
+  return Status::Ok();
+}
+
+Status McapReader::ReadMessageRecords(
+    const bag::MessageSelection& selection, Order order,
+    const std::function<Status(const bag::Message&, const MessageRecord&)>& fn) {
+  std::vector<bag::Encoding> encodings(channels_.size(), bag::Encoding::kCdr);
+  for (size_t id = 0; id < channels_.size(); ++id) {
+    const Channel* c = channels_[id].get();
+    if (c != nullptr && c->message_encoding == "ros1") encodings[id] = bag::Encoding::kRos1;
+  }
   bag::Message m;
   m.file = nullptr;  // one file: the caller names it
   std::vector<uint8_t> record;
-  for (const Entry* e : items) {
-    const uint8_t* data = nullptr;
-    size_t size = 0;
-    uint64_t where = e->offset;
-    if (e->chunk != kNoChunk) {
-      const std::vector<uint8_t>* records = nullptr;
-      TILTCAL_RETURN_IF_ERROR(LoadChunk(e->chunk, &records));
-      where = chunks_[e->chunk].offset;
-      if (e->offset > records->size()) return Error(where, "message offset past its chunk");
-      data = records->data() + e->offset;
-      size = records->size() - e->offset;
-    } else {
-      record.resize(kRecordPrefixBytes + kMessageFixedBytes);
-      TILTCAL_RETURN_IF_ERROR(ReadAt(e->offset, kRecordPrefixBytes, record.data()));
-      const uint64_t length = LoadU64(record.data() + 1);
-      if (length > kMaxRecordBytes || length > file_size_ - e->offset - kRecordPrefixBytes) {
-        return Error(where, "Message record of " + std::to_string(length) +
-                                " bytes runs past the end of the file");
-      }
-      record.resize(kRecordPrefixBytes + length);
-      TILTCAL_RETURN_IF_ERROR(ReadAt(e->offset, record.size(), record.data()));
-      data = record.data();
-      size = record.size();
-    }
+  for (const Entry* e : SelectedEntries(selection, order)) {
     MessageRecord message;
-    Status status = size < kRecordPrefixBytes || data[0] != kMessage ||
-                            LoadU64(data + 1) > size - kRecordPrefixBytes
-                        ? Status::Error("no Message record at offset " + std::to_string(e->offset))
-                        : ParseMessage(data + kRecordPrefixBytes, LoadU64(data + 1), &message);
-    if (!status.ok()) return Error(where, status.message());
-    if (message.channel_id != e->channel || static_cast<int64_t>(message.log_time) != e->time_ns) {
-      return Error(where, "the message index does not match the Message record at offset " +
-                              std::to_string(e->offset));
-    }
+    uint64_t where = 0;
+    TILTCAL_RETURN_IF_ERROR(ReadMessageRecord(*e, &record, &message, &where));
     m.topic = &channels_[e->channel]->topic;
     m.encoding = encodings[e->channel];
     m.time_ns = e->time_ns;

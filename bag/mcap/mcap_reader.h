@@ -148,7 +148,33 @@ class McapReader : public bag::MessageReader {
   Status IndexChunkFromSummary(const ChunkIndexRecord& index);
   // Walks the data section (see the top of this file); chunks at the
   // offsets in chunks_ on entry (from the summary) are not read again.
+  // Its steps are in data_section_walk.cc.
   Status WalkDataSection();
+  struct WalkedRecord;
+  struct Walk;
+  // The prefix of the record at `offset`, and whether and why it is
+  // damaged; *end when the data section (or a recording cut short) ends
+  // there.
+  Status ReadWalkedPrefix(uint64_t offset, WalkedRecord* record, bool* end);
+  // A damaged Chunk whose own fields give a length from which the records
+  // after it chain onto the end: that length, and not damaged.
+  Status MendChunkLength(WalkedRecord* record);
+  // Reads and indexes a Chunk the summary does not list, or a Schema,
+  // Channel or Message record; sets record->damage when it does not parse.
+  Status IndexWalkedRecord(WalkedRecord* record, Walk* walk);
+  // When the damaged `record` is no record at all and follows a Chunk whose
+  // own fields give a shorter length: that chunk's length is mended, and
+  // *offset set after it (*mended).
+  Status MendLastChunkLength(const WalkedRecord& record, Walk* walk, bool* mended,
+                             uint64_t* offset);
+  // Drops the damaged record (or the one before it whose length led to no
+  // record) and what it gave, warns, and sets *offset where the records
+  // chain onto the end again.
+  Status SkipDamagedRecord(const WalkedRecord& record, Walk* walk, uint64_t* offset);
+  // Leaves out the messages of channels no Channel record defines.
+  void DropMessagesWithoutChannel();
+  // The warnings of damaged records and of chunks the summary omits.
+  void WarnAboutWalk(const Walk& walk);
   // The first offset in [from, data_end_) from which the records chain
   // exactly onto data_end_, outside the chunks listed by the summary;
   // data_end_ when there is none.
@@ -171,6 +197,16 @@ class McapReader : public bag::MessageReader {
   // buffer for it at the front; the cache's budget is max_chunk_bytes_.
   std::vector<uint8_t>* CacheSlot(uint32_t chunk, uint64_t bytes);
   Status DecompressChunkAt(uint64_t offset, uint64_t length, std::vector<uint8_t>* records);
+  // Whether `channel` (null: not defined) is one of the selected topics.
+  static bool ChannelSelected(const Channel* channel, const bag::MessageSelection& selection);
+  // The entries of the selected channels inside the time window, in `order`.
+  std::vector<const Entry*> SelectedEntries(const bag::MessageSelection& selection,
+                                            Order order) const;
+  // The Message record of entry `e` (read into *record when it lies outside
+  // a chunk), checked against the entry; *where is the byte offset of its
+  // chunk or record.
+  Status ReadMessageRecord(const Entry& e, std::vector<uint8_t>* record,
+                           MessageRecord* message, uint64_t* where);
 
   std::string path_;
   int fd_ = -1;

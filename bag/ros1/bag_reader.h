@@ -16,6 +16,10 @@
 // chunks (in the order of their first use) while the messages of the current
 // one are handed out, at most that many ahead.
 // The file is read with pread(); nothing is memory-mapped.
+//
+// The parts: record_file.h (records at byte offsets), bag_index.h (what the
+// index says), bag_salvage.h (the scan of an unindexed bag), chunk_cache.h
+// (the LRU cache of decompressed chunks and the read-ahead).
 
 #include <cstdint>
 #include <functional>
@@ -24,21 +28,15 @@
 #include <string>
 #include <vector>
 
+#include "bag/ros1/bag_index.h"
 #include "bag/ros1/chunk_codec.h"
 #include "bag/ros1/format.h"
+#include "bag/ros1/record_file.h"
 #include "common/status.h"
 
 namespace tiltcal::ros1 {
 
-// A connection (one publisher of one topic). Several may share a topic.
-struct Connection {
-  uint32_t id = 0;
-  std::string topic;  // from the outer record header, always present
-  std::string type;   // e.g. "sensor_msgs/Imu"
-  std::string md5sum;
-  std::string message_definition;
-  std::string callerid;  // empty when not recorded
-};
+class ChunkReadAhead;
 
 // One message as yielded by ReadMessages(). `data` points into the reader's
 // chunk cache and stays valid only during the callback.
@@ -83,8 +81,8 @@ class BagReader {
   // file and, where it applies, the byte offset of the record at fault.
   Status Open(const std::string& path);
 
-  const std::string& path() const { return path_; }
-  uint64_t file_size() const { return file_size_; }
+  const std::string& path() const { return file_.path(); }
+  uint64_t file_size() const { return file_.size(); }
   // False for a bag without index (index_pos 0), read by a linear scan.
   bool indexed() const { return indexed_; }
   // Messages recovered by the linear scan of an unindexed bag, and what
@@ -92,7 +90,7 @@ class BagReader {
   int64_t num_salvaged_messages() const { return num_salvaged_; }
   const std::string& salvage_note() const { return salvage_note_; }
 
-  const std::vector<Connection>& connections() const { return connections_; }
+  const std::vector<Connection>& connections() const { return index_.connections; }
   // Topic names (sorted, unique) of connections whose type is `type`.
   std::vector<std::string> TopicsOfType(const std::string& type) const;
   // Sorted, unique topic names.
@@ -116,9 +114,6 @@ class BagReader {
   std::map<std::string, int64_t> ChunkCompressions() const;
 
  private:
-  struct Chunk;
-  struct Entry;
-  class ChunkCache;
   // One message to yield: its index entry and connection slot.
   struct Item {
     int64_t time_ns;
@@ -127,12 +122,9 @@ class BagReader {
     uint32_t slot;
   };
 
-  Status Error(uint64_t pos, const std::string& what) const;
-  Status ReadAt(uint64_t pos, size_t size, void* dst) const;
-  // Reads the record header at `pos`: header fields into *header (views into
-  // *buffer), the data position and length. The record must fit in the file.
-  Status ReadRecordHeaderAt(uint64_t pos, std::string* buffer, RecordHeader* header,
-                            uint64_t* data_pos, uint32_t* data_len) const;
+  // The version line: an error naming what the file is when it is not a
+  // ROS1 bag of format 2.0.
+  Status CheckVersionLine() const;
   Status ReadIndexed(uint64_t index_pos, uint32_t conn_count, uint32_t chunk_count);
   // The index section of an indexed bag: connection records from *pos (left
   // just past them), then the chunk info records, then each chunk's header.
@@ -142,56 +134,27 @@ class BagReader {
   Status ReadChunkIndex(size_t chunk_index, const std::vector<size_t>& connection_slots);
   // Reads the index entries of the connection slots not read yet.
   Status LoadEntries(const std::vector<size_t>& slots);
+  // The connection slots of the topics of `options`; an error for a topic
+  // that is not in the bag.
+  Status SelectSlots(const ReadOptions& options, std::vector<size_t>* slots) const;
+  // The read-ahead of the chunks of `items` (nullptr for depth 0 or fewer
+  // than two chunks).
+  std::unique_ptr<ChunkReadAhead> StartReadAhead(const std::vector<Item>& items,
+                                                 size_t depth) const;
+  // The message record at *offset of `buffer` (the decompressed `chunk`),
+  // past any connection records before it (*offset is moved to it).
+  Status FindMessageRecord(const Chunk& chunk, const uint8_t* buffer, size_t* offset,
+                           BufferRecord* record) const;
   // The entries of `slots` inside the time window of `options`, ordered by
   // (time, chunk_pos, offset).
   std::vector<Item> MergedItems(const std::vector<size_t>& slots,
                                 const ReadOptions& options) const;
-  Status ScanUnindexed(uint64_t first_record_pos);
-  // The compression and size fields of a chunk record header; the size must
-  // be one its chunk->data_len bytes can hold (checked before allocating).
-  static Status ParseChunkHeader(const RecordHeader& header, Chunk* chunk);
-  // Scan of an unindexed bag: reads the chunk record at `pos` and indexes its
-  // records; sets *stop (with salvage_note_ saying why) when nothing after
-  // it can be trusted. Errors only for I/O failures.
-  Status SalvageChunk(uint64_t pos, const RecordHeader& header, uint64_t data_pos,
-                      uint32_t data_len, bool* stop);
-  // A chunk still open when the recording stopped (size and data length 0):
-  // its records run to the end of the file, up to the first incomplete one.
-  Status SalvageOpenChunk(uint32_t chunk_index);
-  // The one dispatch of the records inside a chunk (`size` uncompressed bytes
-  // of chunk `chunk_index`): connection records add their connection, message
-  // data records an index entry. Another op is skipped, or ends the records
-  // of an `open` chunk (one whose size was never written). *end is the offset
-  // just past the last record taken.
-  Status IndexChunkRecords(const uint8_t* records, size_t size, uint32_t chunk_index, bool open,
-                           size_t* end);
-  void AddSalvagedEntry(uint32_t conn, RosTime time, uint32_t chunk, uint32_t offset);
-  Status AddConnection(const RecordHeader& header, const uint8_t* data, size_t size,
-                       uint64_t pos);
-  class ChunkReadAhead;
-  // Loads chunk `chunk_index` decompressed into `dst` (sized to the chunk size).
-  Status LoadChunk(size_t chunk_index, std::vector<uint8_t>* compressed, uint8_t* dst);
-  // LoadChunk with a decompressor of the caller, without counting it in the
-  // stats (safe on another thread: reads the file with pread only).
-  Status LoadChunkWith(size_t chunk_index, ChunkDecompressor* decompressor,
-                       std::vector<uint8_t>* compressed, uint8_t* dst) const;
-  void CountChunkLoad(size_t chunk_index);
-  int ConnectionSlot(uint32_t id) const;
 
-  std::string path_;
-  int fd_ = -1;
-  uint64_t file_size_ = 0;
+  RecordFile file_;
   bool indexed_ = true;
   int64_t num_salvaged_ = 0;
   std::string salvage_note_;
-  std::vector<Connection> connections_;
-  std::vector<Chunk> chunks_;
-  // Per connection slot: message count, and (once read) its index entries.
-  std::vector<int64_t> message_counts_;
-  std::vector<std::vector<Entry>> entries_;
-  std::vector<bool> entries_loaded_;
-  int64_t start_ns_ = INT64_MAX;
-  int64_t end_ns_ = INT64_MIN;
+  BagIndex index_;
   ChunkDecompressor decompressor_;
   ReaderStats stats_;
 };

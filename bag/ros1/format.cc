@@ -116,6 +116,35 @@ Status RecordHeader::GetString(std::string_view name, std::string* out) const {
   return Status::Ok();
 }
 
+Status ParseBufferRecord(const uint8_t* buffer, size_t size, size_t offset, BufferRecord* r) {
+  if (offset > size || size - offset < 4) {
+    return Status::Error("record header length at chunk offset " + std::to_string(offset) +
+                         " runs past the chunk end " + std::to_string(size));
+  }
+  const uint32_t header_len = LoadU32Le(buffer + offset);
+  if (header_len > size - offset - 4 || size - offset - 4 - header_len < 4) {
+    return Status::Error("record header at chunk offset " + std::to_string(offset) +
+                         " (length " + std::to_string(header_len) +
+                         ") runs past the chunk end " + std::to_string(size));
+  }
+  const size_t data_pos = offset + 4 + header_len + 4;
+  r->data_len = LoadU32Le(buffer + data_pos - 4);
+  if (r->data_len > size - data_pos) {
+    return Status::Error("record data at chunk offset " + std::to_string(offset) + " (length " +
+                         std::to_string(r->data_len) + ") runs past the chunk end " +
+                         std::to_string(size));
+  }
+  r->data = buffer + data_pos;
+  r->end = data_pos + r->data_len;
+  Status status = r->header.Parse(buffer + offset + 4, header_len);
+  if (status.ok()) status = r->header.GetOp(&r->op);
+  if (!status.ok()) {
+    return Status::Error("record at chunk offset " + std::to_string(offset) + ": " +
+                         status.message());
+  }
+  return Status::Ok();
+}
+
 std::string OpValue(Op op) { return std::string(1, static_cast<char>(op)); }
 
 std::string U32Value(uint32_t value) {

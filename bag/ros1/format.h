@@ -118,6 +118,20 @@ class RecordHeader {
   std::vector<std::pair<std::string_view, std::string_view>> fields_;
 };
 
+// ---- Records inside a decompressed chunk. ----
+// One record of a chunk buffer: header fields and data are views into it.
+struct BufferRecord {
+  RecordHeader header;
+  uint8_t op = 0;
+  const uint8_t* data = nullptr;
+  uint32_t data_len = 0;
+  size_t end = 0;  // offset just past the record
+};
+
+// Parses the record at `offset` of `buffer` (size `size`); every length must
+// stay inside the buffer.
+Status ParseBufferRecord(const uint8_t* buffer, size_t size, size_t offset, BufferRecord* r);
+
 // ---- Record header building (writer side). ----
 // Field name -> binary value. std::map keeps names sorted, the order ros_comm
 // writes them in.

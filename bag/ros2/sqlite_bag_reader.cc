@@ -218,6 +218,16 @@ Status SqliteBagReader::OpenDatabase(const std::string& file,
 }
 
 Status SqliteBagReader::ReadTopics(Database* d, std::map<std::string, bag::TopicInfo>* topics) {
+  TILTCAL_RETURN_IF_ERROR(ReadTopicsTable(d, topics));
+  std::map<std::string, int64_t> unusable_by_topic;
+  TILTCAL_RETURN_IF_ERROR(CountMessages(d, topics, &unusable_by_topic));
+  if (start_ns_ < 0) return NegativeTimestampError(*d);
+  if (!unusable_by_topic.empty()) WarnUnusableTimestamps(*d, unusable_by_topic);
+  return Status::Ok();
+}
+
+Status SqliteBagReader::ReadTopicsTable(Database* d,
+                                        std::map<std::string, bag::TopicInfo>* topics) {
   sqlite3_stmt* s = nullptr;
   if (sqlite3_prepare_v2(d->db, "SELECT id, name, type, serialization_format FROM topics", -1,
                          &s, nullptr) != SQLITE_OK) {
@@ -244,6 +254,12 @@ Status SqliteBagReader::ReadTopics(Database* d, std::map<std::string, bag::Topic
     d->topic_names[id] = name;
   }
   if (rc != SQLITE_DONE) return d->Error("reading the topics table");
+  return Status::Ok();
+}
+
+Status SqliteBagReader::CountMessages(const Database* d,
+                                      std::map<std::string, bag::TopicInfo>* topics,
+                                      std::map<std::string, int64_t>* unusable_by_topic) {
   // Counts and time range of the rows with an integer timestamp; the
   // others (NULL, text, real) are counted apart and left out.
   sqlite3_stmt* c = nullptr;
@@ -254,8 +270,7 @@ Status SqliteBagReader::ReadTopics(Database* d, std::map<std::string, bag::Topic
     return d->Error("not a rosbag2 sqlite3 file (no messages table)");
   }
   std::unique_ptr<sqlite3_stmt, int (*)(sqlite3_stmt*)> count_guard(c, sqlite3_finalize);
-  int64_t unusable = 0;
-  std::map<std::string, int64_t> unusable_by_topic;
+  int rc;
   while ((rc = sqlite3_step(c)) == SQLITE_ROW) {
     const int64_t id = sqlite3_column_int64(c, 0);
     const auto name = d->topic_names.find(id);
@@ -265,8 +280,7 @@ Status SqliteBagReader::ReadTopics(Database* d, std::map<std::string, bag::Topic
     }
     const int64_t count = sqlite3_column_int64(c, 2);
     if (sqlite3_column_int(c, 1) == 0) {
-      unusable += count;
-      unusable_by_topic[name->second] += count;
+      (*unusable_by_topic)[name->second] += count;
       continue;
     }
     (*topics)[name->second].message_count += count;
@@ -274,45 +288,50 @@ Status SqliteBagReader::ReadTopics(Database* d, std::map<std::string, bag::Topic
     end_ns_ = std::max<int64_t>(end_ns_, sqlite3_column_int64(c, 4));
   }
   if (rc != SQLITE_DONE) return d->Error("counting the messages");
-  if (start_ns_ < 0) {
-    sqlite3_stmt* n = nullptr;
-    int64_t row = 0;
-    if (sqlite3_prepare_v2(d->db,
-                           "SELECT id FROM messages WHERE typeof(timestamp) = 'integer' AND "
-                           "timestamp < 0 ORDER BY id LIMIT 1",
-                           -1, &n, nullptr) == SQLITE_OK &&
-        sqlite3_step(n) == SQLITE_ROW) {
-      row = sqlite3_column_int64(n, 0);
-    }
-    sqlite3_finalize(n);
-    return Status::Error(d->file + ": row " + std::to_string(row) +
-                         " has a negative timestamp (before 1970): rosbag2 record times are "
-                         "nanoseconds since the epoch, and messages are read in their order");
-  }
-  if (unusable > 0) {
-    // The first rows named, with what their timestamp is.
-    sqlite3_stmt* u = nullptr;
-    std::string rows;
-    if (sqlite3_prepare_v2(d->db,
-                           "SELECT id, typeof(timestamp) FROM messages WHERE typeof(timestamp) "
-                           "!= 'integer' ORDER BY id LIMIT 5",
-                           -1, &u, nullptr) == SQLITE_OK) {
-      while (sqlite3_step(u) == SQLITE_ROW) {
-        const unsigned char* type = sqlite3_column_text(u, 1);
-        rows += (rows.empty() ? "" : ", ") + std::to_string(sqlite3_column_int64(u, 0)) + " (" +
-                (type == nullptr ? "?" : reinterpret_cast<const char*>(type)) + ")";
-      }
-    }
-    sqlite3_finalize(u);
-    std::string by_topic;
-    for (const auto& [topic, count] : unusable_by_topic) {
-      by_topic += (by_topic.empty() ? "" : ", ") + topic + " " + std::to_string(count);
-    }
-    warnings_.push_back(d->file + ": " + std::to_string(unusable) +
-                        " message(s) without an integer timestamp left out (" + by_topic +
-                        "; rows " + rows + (unusable > 5 ? ", ..." : "") + ")");
-  }
   return Status::Ok();
+}
+
+Status SqliteBagReader::NegativeTimestampError(const Database& d) {
+  sqlite3_stmt* n = nullptr;
+  int64_t row = 0;
+  if (sqlite3_prepare_v2(d.db,
+                         "SELECT id FROM messages WHERE typeof(timestamp) = 'integer' AND "
+                         "timestamp < 0 ORDER BY id LIMIT 1",
+                         -1, &n, nullptr) == SQLITE_OK &&
+      sqlite3_step(n) == SQLITE_ROW) {
+    row = sqlite3_column_int64(n, 0);
+  }
+  sqlite3_finalize(n);
+  return Status::Error(d.file + ": row " + std::to_string(row) +
+                       " has a negative timestamp (before 1970): rosbag2 record times are "
+                       "nanoseconds since the epoch, and messages are read in their order");
+}
+
+void SqliteBagReader::WarnUnusableTimestamps(
+    const Database& d, const std::map<std::string, int64_t>& unusable_by_topic) {
+  int64_t unusable = 0;
+  for (const auto& [topic, count] : unusable_by_topic) unusable += count;
+  // The first rows named, with what their timestamp is.
+  sqlite3_stmt* u = nullptr;
+  std::string rows;
+  if (sqlite3_prepare_v2(d.db,
+                         "SELECT id, typeof(timestamp) FROM messages WHERE typeof(timestamp) "
+                         "!= 'integer' ORDER BY id LIMIT 5",
+                         -1, &u, nullptr) == SQLITE_OK) {
+    while (sqlite3_step(u) == SQLITE_ROW) {
+      const unsigned char* type = sqlite3_column_text(u, 1);
+      rows += (rows.empty() ? "" : ", ") + std::to_string(sqlite3_column_int64(u, 0)) + " (" +
+              (type == nullptr ? "?" : reinterpret_cast<const char*>(type)) + ")";
+    }
+  }
+  sqlite3_finalize(u);
+  std::string by_topic;
+  for (const auto& [topic, count] : unusable_by_topic) {
+    by_topic += (by_topic.empty() ? "" : ", ") + topic + " " + std::to_string(count);
+  }
+  warnings_.push_back(d.file + ": " + std::to_string(unusable) +
+                      " message(s) without an integer timestamp left out (" + by_topic +
+                      "; rows " + rows + (unusable > 5 ? ", ..." : "") + ")");
 }
 
 bool SqliteBagReader::TimeRange(int64_t* start_ns, int64_t* end_ns) const {

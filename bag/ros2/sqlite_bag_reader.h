@@ -66,6 +66,17 @@ class SqliteBagReader : public bag::MessageReader {
   // Opens one .db3 and adds its topics and counts to *topics (by name).
   Status OpenDatabase(const std::string& file, std::map<std::string, bag::TopicInfo>* topics);
   Status ReadTopics(Database* d, std::map<std::string, bag::TopicInfo>* topics);
+  // The topics table: names, types, and the ids of the database.
+  Status ReadTopicsTable(Database* d, std::map<std::string, bag::TopicInfo>* topics);
+  // Message counts and the time range of the rows with an integer timestamp;
+  // the others counted by topic in *unusable_by_topic.
+  Status CountMessages(const Database* d, std::map<std::string, bag::TopicInfo>* topics,
+                       std::map<std::string, int64_t>* unusable_by_topic);
+  // The error naming the first row with a negative timestamp.
+  static Status NegativeTimestampError(const Database& d);
+  // The warning of the rows left out for want of an integer timestamp.
+  void WarnUnusableTimestamps(const Database& d,
+                              const std::map<std::string, int64_t>& unusable_by_topic);
 
   std::string path_;
   std::vector<std::string> files_;

@@ -50,109 +50,153 @@ std::string Position(int line, int column) {
 // non-repeated field seen twice within one message: "line L, column C: field
 // a.b is given twice (first at line L0, column C0)". Text it does not follow
 // (a syntax error) ends the walk without a finding; the parser reports it.
-std::string FindDuplicateField(const std::string& text,
-                               const google::protobuf::Descriptor* root) {
-  using google::protobuf::Descriptor;
-  using google::protobuf::FieldDescriptor;
-  using google::protobuf::io::Tokenizer;
-  google::protobuf::io::ArrayInputStream input(text.data(), static_cast<int>(text.size()));
-  SilentErrorCollector ignored;
-  Tokenizer tokens(&input, &ignored);
-  tokens.set_allow_f_after_float(true);
-  tokens.set_comment_style(Tokenizer::SH_COMMENT_STYLE);
-  tokens.set_require_space_after_number(false);
-  tokens.set_allow_multiline_strings(true);
+class DuplicateFieldFinder {
+ public:
+  using Descriptor = google::protobuf::Descriptor;
+  using FieldDescriptor = google::protobuf::FieldDescriptor;
+  using Tokenizer = google::protobuf::io::Tokenizer;
+
+  DuplicateFieldFinder(const std::string& text, const Descriptor* root)
+      : input_(text.data(), static_cast<int>(text.size())),
+        tokens_(&input_, &ignored_),
+        root_(root) {
+    tokens_.set_allow_f_after_float(true);
+    tokens_.set_comment_style(Tokenizer::SH_COMMENT_STYLE);
+    tokens_.set_require_space_after_number(false);
+    tokens_.set_allow_multiline_strings(true);
+  }
+
+  // The finding, "" without one.
+  std::string Find() {
+    std::vector<Message> stack = {{root_, "", {}}};
+    tokens_.Next();
+    while (tokens_.current().type != Tokenizer::TYPE_END) {
+      if (Is("}") || Is(">")) {
+        if (stack.size() == 1) return "";
+        stack.pop_back();
+        tokens_.Next();
+        SkipSeparator();
+        continue;
+      }
+      Message& message = stack.back();
+      const int line = tokens_.current().line, column = tokens_.current().column;
+      FieldName field;
+      if (!ReadFieldName(message, &field)) return "";
+      if (field.field != nullptr && !field.field->is_repeated()) {
+        const auto [first, inserted] =
+            message.seen.emplace(field.field, std::make_pair(line, column));
+        if (!inserted) {
+          return Position(line, column) + ": field " + message.path + field.name +
+                 " is given twice (first at " +
+                 Position(first->second.first, first->second.second) + ")";
+        }
+      }
+      if (field.field != nullptr && field.field->cpp_type() == FieldDescriptor::CPPTYPE_MESSAGE) {
+        field.nested = field.field->message_type();
+      }
+      if (Is(":")) tokens_.Next();
+      if (Is("{") || Is("<")) {
+        stack.push_back({field.nested, message.path + field.name + ".", {}});
+        tokens_.Next();
+        continue;
+      }
+      if (!SkipValue()) return "";
+      SkipSeparator();
+    }
+    return "";
+  }
+
+ private:
   struct Message {
     const Descriptor* type;  // nullptr: not known (its fields are not checked)
     std::string path;        // "a.b." of its fields
     std::map<const FieldDescriptor*, std::pair<int, int>> seen;  // line, column
   };
-  std::vector<Message> stack = {{root, "", {}}};
-  const auto is = [&tokens](const char* symbol) {
-    return tokens.current().type == Tokenizer::TYPE_SYMBOL && tokens.current().text == symbol;
-  };
-  const auto skip_separator = [&] {
-    if (is(";") || is(",")) tokens.Next();
-  };
-  tokens.Next();
-  while (tokens.current().type != Tokenizer::TYPE_END) {
-    if (is("}") || is(">")) {
-      if (stack.size() == 1) return "";
-      stack.pop_back();
-      tokens.Next();
-      skip_separator();
-      continue;
-    }
-    Message& message = stack.back();
-    const int line = tokens.current().line, column = tokens.current().column;
+  // The name of a field as written, and what it names.
+  struct FieldName {
     std::string name;
     const FieldDescriptor* field = nullptr;
-    const Descriptor* nested = nullptr;
-    if (is("[")) {  // an extension [pkg.ext] or an Any [type.googleapis.com/pkg.Type]
-      for (tokens.Next(); !is("]"); tokens.Next()) {
-        if (tokens.current().type == Tokenizer::TYPE_END) return "";
-        name += tokens.current().text;
+    const Descriptor* nested = nullptr;  // the type of an Any's value
+  };
+
+  bool Is(const char* symbol) {
+    return tokens_.current().type == Tokenizer::TYPE_SYMBOL && tokens_.current().text == symbol;
+  }
+  void SkipSeparator() {
+    if (Is(";") || Is(",")) tokens_.Next();
+  }
+
+  // Reads the field name at the current token: an identifier, an extension
+  // [pkg.ext] or an Any [type.googleapis.com/pkg.Type]. False for text the
+  // walk does not follow.
+  bool ReadFieldName(const Message& message, FieldName* out) {
+    if (Is("[")) {
+      std::string name;
+      for (tokens_.Next(); !Is("]"); tokens_.Next()) {
+        if (tokens_.current().type == Tokenizer::TYPE_END) return false;
+        name += tokens_.current().text;
       }
-      tokens.Next();
-      const auto* pool = root->file()->pool();
+      tokens_.Next();
+      const auto* pool = root_->file()->pool();
       const size_t slash = name.rfind('/');
       if (slash != std::string::npos) {
-        nested = pool->FindMessageTypeByName(name.substr(slash + 1));
+        out->nested = pool->FindMessageTypeByName(name.substr(slash + 1));
       } else {
-        field = pool->FindExtensionByName(name);
+        out->field = pool->FindExtensionByName(name);
       }
-      name = "[" + name + "]";
-    } else if (tokens.current().type == Tokenizer::TYPE_IDENTIFIER) {
-      name = tokens.current().text;
-      if (message.type != nullptr) {
-        field = message.type->FindFieldByName(name);
-        if (field == nullptr) {  // a group is named by its type
-          std::string lower = name;
-          for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-          field = message.type->FindFieldByLowercaseName(lower);
-          if (field != nullptr && field->type() != FieldDescriptor::TYPE_GROUP) field = nullptr;
-        }
-      }
-      tokens.Next();
-    } else {
-      return "";
+      out->name = "[" + name + "]";
+      return true;
     }
-    if (field != nullptr && !field->is_repeated()) {
-      const auto [first, inserted] = message.seen.emplace(field, std::make_pair(line, column));
-      if (!inserted) {
-        return Position(line, column) + ": field " + message.path + name +
-               " is given twice (first at " + Position(first->second.first, first->second.second) +
-               ")";
-      }
-    }
-    if (field != nullptr && field->cpp_type() == FieldDescriptor::CPPTYPE_MESSAGE) {
-      nested = field->message_type();
-    }
-    if (is(":")) tokens.Next();
-    if (is("{") || is("<")) {
-      stack.push_back({nested, message.path + name + ".", {}});
-      tokens.Next();
-      continue;
-    }
-    if (is("[")) {  // a list: skipped with its nested messages
+    if (tokens_.current().type != Tokenizer::TYPE_IDENTIFIER) return false;
+    out->name = tokens_.current().text;
+    if (message.type != nullptr) out->field = FindField(*message.type, out->name);
+    tokens_.Next();
+    return true;
+  }
+
+  // The field `name` of `type`; a group is named by its type.
+  static const FieldDescriptor* FindField(const Descriptor& type, const std::string& name) {
+    const FieldDescriptor* field = type.FindFieldByName(name);
+    if (field != nullptr) return field;
+    std::string lower = name;
+    for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    field = type.FindFieldByLowercaseName(lower);
+    if (field != nullptr && field->type() != FieldDescriptor::TYPE_GROUP) return nullptr;
+    return field;
+  }
+
+  // Skips a value that is not a message: a list (with its nested messages),
+  // a negative number, adjacent strings or one token. False when the text
+  // ends inside a list.
+  bool SkipValue() {
+    if (Is("[")) {
       int depth = 0;
       do {
-        if (is("[") || is("{") || is("<")) ++depth;
-        if (is("]") || is("}") || is(">")) --depth;
-        if (tokens.current().type == Tokenizer::TYPE_END) return "";
-        tokens.Next();
+        if (Is("[") || Is("{") || Is("<")) ++depth;
+        if (Is("]") || Is("}") || Is(">")) --depth;
+        if (tokens_.current().type == Tokenizer::TYPE_END) return false;
+        tokens_.Next();
       } while (depth > 0);
-    } else if (is("-")) {
-      tokens.Next();
-      tokens.Next();
-    } else if (tokens.current().type == Tokenizer::TYPE_STRING) {
-      while (tokens.current().type == Tokenizer::TYPE_STRING) tokens.Next();
+    } else if (Is("-")) {
+      tokens_.Next();
+      tokens_.Next();
+    } else if (tokens_.current().type == Tokenizer::TYPE_STRING) {
+      while (tokens_.current().type == Tokenizer::TYPE_STRING) tokens_.Next();
     } else {
-      tokens.Next();
+      tokens_.Next();
     }
-    skip_separator();
+    return true;
   }
-  return "";
+
+  google::protobuf::io::ArrayInputStream input_;
+  SilentErrorCollector ignored_;
+  Tokenizer tokens_;
+  const Descriptor* root_;
+};
+
+std::string FindDuplicateField(const std::string& text,
+                               const google::protobuf::Descriptor* root) {
+  return DuplicateFieldFinder(text, root).Find();
 }
 
 }  // namespace

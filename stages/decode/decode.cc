@@ -334,6 +334,48 @@ Status CheckStampsAndUnits(const DecodePaths& paths, const proto::DecodeParams& 
   return Status::Ok();
 }
 
+// One run at a time writes into the outputs' folders (two decodes of the
+// same outputs would race on the commit manifests); folders locked in name
+// order, so that two runs never wait for each other.
+Status LockOutputDirectories(const DecodePaths& paths, std::ostream* log,
+                             DirectoryLock locks[2]) {
+  std::set<std::string> out_dirs = {OutputDirectory(paths.out_imu),
+                                    OutputDirectory(paths.out_scans)};
+  int locked = 0;
+  for (const std::string& dir : out_dirs) {
+    TILTCAL_RETURN_IF_ERROR(locks[locked++].Acquire(dir, "tiltcal_decode", log));
+  }
+  return Status::Ok();
+}
+
+// The provenance of both outputs: the bag as named, and every file read when
+// they differ from it; the rig; /tf_static; what the reader left out.
+proto::Provenance OutputProvenance(const DecodePaths& paths, const proto::DecodeParams& params,
+                                   const DecodeSummary& s) {
+  std::vector<InputPath> input_paths = {{"bag", paths.bag}};
+  if (s.bag_files != std::vector<std::string>{paths.bag}) {
+    for (const std::string& file : s.bag_files) input_paths.push_back({"bag file", file});
+  }
+  if (!paths.rig.empty()) input_paths.push_back({"rig", paths.rig});
+  proto::Provenance provenance =
+      MakeProvenance("tiltcal_decode", params, input_paths, paths.command_line);
+  *provenance.mutable_tf_static() = bag::ToProto(s.tf_static);
+  if (!s.salvage_note.empty()) provenance.add_notes("bag salvaged: " + s.salvage_note);
+  for (const std::string& warning : s.bag_warnings) provenance.add_notes("bag: " + warning);
+  return provenance;
+}
+
+Status OpenScansWriter(const DecodePaths& paths, const proto::DecodeParams& params,
+                       const proto::Provenance& provenance, AsyncRecordWriter* writer) {
+  Lz4FrameOptions scans_frame;
+  scans_frame.compress_blocks = !params.scans_output().store_blocks();
+  scans_frame.content_checksum = !params.scans_output().omit_content_checksum();
+  AtomicFileOptions scans_file;
+  scans_file.bypass_page_cache = params.scans_output().bypass_page_cache();
+  return writer->Open(paths.out_scans, proto::Scan::descriptor()->full_name(), provenance,
+                      scans_frame, scans_file);
+}
+
 }  // namespace
 
 Status Decode(const DecodePaths& paths, const proto::DecodeParams& params, std::ostream* log,
@@ -341,16 +383,8 @@ Status Decode(const DecodePaths& paths, const proto::DecodeParams& params, std::
   const Clock::time_point t0 = Clock::now();
   DecodeSummary s;
   TILTCAL_RETURN_IF_ERROR(CheckPaths(paths));
-  // One run at a time writes into the outputs' folders (two decodes of the
-  // same outputs would race on the commit manifests); folders locked in
-  // name order, so that two runs never wait for each other.
-  std::set<std::string> out_dirs = {OutputDirectory(paths.out_imu),
-                                    OutputDirectory(paths.out_scans)};
   DirectoryLock locks[2];
-  int locked = 0;
-  for (const std::string& dir : out_dirs) {
-    TILTCAL_RETURN_IF_ERROR(locks[locked++].Acquire(dir, "tiltcal_decode", log));
-  }
+  TILTCAL_RETURN_IF_ERROR(LockOutputDirectories(paths, log, locks));
   // A run killed while committing its pair: finish that commit first.
   TILTCAL_RETURN_IF_ERROR(CompleteInterruptedCommit(paths.out_imu));
   TILTCAL_RETURN_IF_ERROR(CompleteInterruptedCommit(paths.out_scans));
@@ -368,30 +402,11 @@ Status Decode(const DecodePaths& paths, const proto::DecodeParams& params, std::
   TILTCAL_RETURN_IF_ERROR(
       bag::ReadStaticTransforms(reader, s.imu_topic, s.lidar_topic, &s.tf_static));
 
-  // The bag as named, and every file read when they differ from it.
-  std::vector<InputPath> input_paths = {{"bag", paths.bag}};
-  if (s.bag_files != std::vector<std::string>{paths.bag}) {
-    for (const std::string& file : s.bag_files) input_paths.push_back({"bag file", file});
-  }
-  if (!paths.rig.empty()) input_paths.push_back({"rig", paths.rig});
-  proto::Provenance provenance =
-      MakeProvenance("tiltcal_decode", params, input_paths, paths.command_line);
-  *provenance.mutable_tf_static() = bag::ToProto(s.tf_static);
-  // What the reader left out of the bag, in both outputs.
-  if (!s.salvage_note.empty()) provenance.add_notes("bag salvaged: " + s.salvage_note);
-  for (const std::string& warning : s.bag_warnings) provenance.add_notes("bag: " + warning);
-
+  const proto::Provenance provenance = OutputProvenance(paths, params, s);
   // Scans are serialized, framed and written on a second thread, 4 scans in
   // flight.
   AsyncRecordWriter scans_writer(proto::Scan::default_instance(), 4);
-  Lz4FrameOptions scans_frame;
-  scans_frame.compress_blocks = !params.scans_output().store_blocks();
-  scans_frame.content_checksum = !params.scans_output().omit_content_checksum();
-  AtomicFileOptions scans_file;
-  scans_file.bypass_page_cache = params.scans_output().bypass_page_cache();
-  TILTCAL_RETURN_IF_ERROR(scans_writer.Open(paths.out_scans,
-                                            proto::Scan::descriptor()->full_name(),
-                                            provenance, scans_frame, scans_file));
+  TILTCAL_RETURN_IF_ERROR(OpenScansWriter(paths, params, provenance, &scans_writer));
   ImuSink imu(paths.bag, reader.MessageCount(s.imu_topic));
   ScanSink scans(paths.bag, params, s.lidar_type, &scans_writer);
   {

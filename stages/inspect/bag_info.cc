@@ -154,6 +154,49 @@ void CompareWithMetadata(BagInfo* info) {
   }
 }
 
+// Counts message `m` in the figures of its topic, and deserialises it when
+// its type is a sensor's.
+void CountMessage(const bag::Message& m, TopicFigures* f) {
+  if (f->count == 0) f->first_ns = m.time_ns;
+  f->last_ns = m.time_ns;
+  ++f->count;
+  f->encoding = m.encoding == bag::Encoding::kRos1 ? "ros1" : "cdr";
+  if (!f->sensor_type) return;
+  const Status decoded = DecodeSensorMessage(f->type, m);
+  if (decoded.ok()) {
+    ++f->decoded;
+  } else if (f->decode_failures++ == 0) {
+    f->decode_error = fmt::format("message {} ({}): {}", f->count - 1, bag::DescribePosition(m),
+                                  decoded.message());
+  }
+}
+
+// The warnings of the reading: salvage, what the reader left out (damaged
+// records, unlisted files, bad rows: `reader_warnings`), duplicates, counts
+// that differ from the index, messages that do not deserialise.
+void AddReadWarnings(const std::vector<std::string>& reader_warnings, BagInfo* info) {
+  if (!info->salvage_note.empty()) info->warnings.push_back("salvaged: " + info->salvage_note);
+  for (const std::string& w : reader_warnings) info->warnings.push_back("reader: " + w);
+  if (info->duplicates_dropped > 0) {
+    info->warnings.push_back(fmt::format(
+        "{} messages held by two files of the folder (same topic, time and bytes) counted once",
+        info->duplicates_dropped));
+  }
+  for (const TopicFigures& f : info->topics) {
+    // (The duplicates a folder's merge drops are in its files' counts.)
+    if (info->duplicates_dropped == 0 && f.count != f.indexed_count) {
+      info->warnings.push_back(fmt::format("topic '{}': the index counts {} messages, {} were read",
+                                           f.name, f.indexed_count, f.count));
+    }
+    if (f.decode_failures > 0) {
+      info->warnings.push_back(fmt::format("topic '{}': {} of {} messages do not deserialise as {}; "
+                                           "the first: {}",
+                                           f.name, f.decode_failures, f.count, f.type,
+                                           f.decode_error));
+    }
+  }
+}
+
 }  // namespace
 
 Status ReadBagInfo(const std::string& path, BagInfo* info) {
@@ -184,21 +227,8 @@ Status ReadBagInfo(const std::string& path, BagInfo* info) {
       return Status::Error(fmt::format("{}: a message of topic '{}', which the reader did not list",
                                        path, *m.topic));
     }
-    TopicFigures& f = info->topics[it->second];
-    if (f.count == 0) f.first_ns = m.time_ns;
-    f.last_ns = m.time_ns;
-    ++f.count;
     times[it->second].push_back(m.time_ns);
-    f.encoding = m.encoding == bag::Encoding::kRos1 ? "ros1" : "cdr";
-    if (f.sensor_type) {
-      const Status decoded = DecodeSensorMessage(f.type, m);
-      if (decoded.ok()) {
-        ++f.decoded;
-      } else if (f.decode_failures++ == 0) {
-        f.decode_error = fmt::format("message {} ({}): {}", f.count - 1, bag::DescribePosition(m),
-                                     decoded.message());
-      }
-    }
+    CountMessage(m, &info->topics[it->second]);
     return Status::Ok();
   }));
   info->salvage_note = reader->salvage_note();
@@ -212,27 +242,7 @@ Status ReadBagInfo(const std::string& path, BagInfo* info) {
     info->last_ns = info->message_count == 0 ? f.last_ns : std::max(info->last_ns, f.last_ns);
     info->message_count += f.count;
   }
-  if (!info->salvage_note.empty()) info->warnings.push_back("salvaged: " + info->salvage_note);
-  // What the reader left out (damaged records, unlisted files, bad rows).
-  for (const std::string& w : reader->warnings()) info->warnings.push_back("reader: " + w);
-  if (info->duplicates_dropped > 0) {
-    info->warnings.push_back(fmt::format(
-        "{} messages held by two files of the folder (same topic, time and bytes) counted once",
-        info->duplicates_dropped));
-  }
-  for (const TopicFigures& f : info->topics) {
-    // (The duplicates a folder's merge drops are in its files' counts.)
-    if (info->duplicates_dropped == 0 && f.count != f.indexed_count) {
-      info->warnings.push_back(fmt::format("topic '{}': the index counts {} messages, {} were read",
-                                           f.name, f.indexed_count, f.count));
-    }
-    if (f.decode_failures > 0) {
-      info->warnings.push_back(fmt::format("topic '{}': {} of {} messages do not deserialise as {}; "
-                                           "the first: {}",
-                                           f.name, f.decode_failures, f.count, f.type,
-                                           f.decode_error));
-    }
-  }
+  AddReadWarnings(reader->warnings(), info);
 
   std::error_code ec;
   const fs::path metadata = fs::path(path) / "metadata.yaml";

@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include "common/io/png_encoder.h"
+#include "stages/report/png_encoder.h"
 #include "stages/report/base64.h"
 #include "stages/report/map_pcd.h"
 

@@ -60,27 +60,35 @@ std::optional<Eigen::Vector3i> CellOf(const Eigen::Vector3d& p, double cell_m) {
   return index.cast<int>().matrix();
 }
 
-}  // namespace
-
-std::optional<WallSlab> FindWall(const std::vector<Eigen::Vector3f>& points,
-                                 const Eigen::Vector3d& up,
-                                 const proto::WallSnapshotParams& params) {
+// The points binned into cells of cell_m, and each cell's index in `cells`
+// by Key.
+struct CellGrid {
   std::unordered_map<int64_t, size_t> index_of;
   std::vector<Cell> cells;
+};
+
+CellGrid BinIntoCells(const std::vector<Eigen::Vector3f>& points, double cell_m) {
+  CellGrid grid;
   for (const Eigen::Vector3f& q : points) {
     const Eigen::Vector3d p = q.cast<double>();
-    const std::optional<Eigen::Vector3i> cell_index = CellOf(p, params.cell_m());
+    const std::optional<Eigen::Vector3i> cell_index = CellOf(p, cell_m);
     if (!cell_index) continue;  // not finite, or beyond the cell grid
     const Eigen::Vector3i& i = *cell_index;
-    const auto [it, inserted] = index_of.emplace(Key(i), cells.size());
+    const auto [it, inserted] = grid.index_of.emplace(Key(i), grid.cells.size());
     if (inserted) {
       Cell cell;
       cell.index = i;
-      cells.push_back(cell);
+      grid.cells.push_back(cell);
     }
-    cells[it->second].moments.Add(p);
+    grid.cells[it->second].moments.Add(p);
   }
-  for (Cell& cell : cells) {
+  return grid;
+}
+
+// A cell of enough points is a wall cell when planar and vertical.
+void MarkWallCells(const Eigen::Vector3d& up, const proto::WallSnapshotParams& params,
+                   std::vector<Cell>* cells) {
+  for (Cell& cell : *cells) {
     if (cell.moments.n < static_cast<int64_t>(params.min_cell_points())) continue;
     const auto scatter = cell.moments.Scatter();
     const Eigen::Vector3d l = scatter.eigenvalues();
@@ -89,27 +97,32 @@ std::optional<WallSlab> FindWall(const std::vector<Eigen::Vector3f>& points,
     cell.wall = l.y() > 0 && l.x() / l.y() < params.max_cell_planarity() &&
                 std::abs(cell.normal.dot(up)) < params.max_normal_up();
   }
-  // Region growing over the wall cells.
+}
+
+// Region growing over the wall cells: neighbours (26-connected) with
+// parallel normals, each within max_plane_distance_m of the other's plane.
+// Sets each cell's cluster; the clusters' moments and cell counts.
+void GrowWallClusters(const proto::WallSnapshotParams& params, CellGrid* grid,
+                      std::vector<Moments>* clusters, std::vector<int>* cluster_cells) {
+  std::vector<Cell>& cells = grid->cells;
   const double min_cos = std::cos(geometry::DegToRad(params.max_normal_angle_deg()));
-  std::vector<Moments> clusters;
-  std::vector<int> cluster_cells;
   for (size_t seed = 0; seed < cells.size(); ++seed) {
     if (!cells[seed].wall || cells[seed].cluster >= 0) continue;
-    const int id = static_cast<int>(clusters.size());
-    clusters.emplace_back();
-    cluster_cells.push_back(0);
+    const int id = static_cast<int>(clusters->size());
+    clusters->emplace_back();
+    cluster_cells->push_back(0);
     std::vector<size_t> stack = {seed};
     cells[seed].cluster = id;
     while (!stack.empty()) {
       const Cell& cell = cells[stack.back()];
       stack.pop_back();
-      clusters[id].Add(cell.moments);
-      ++cluster_cells[id];
+      (*clusters)[id].Add(cell.moments);
+      ++(*cluster_cells)[id];
       for (int dx = -1; dx <= 1; ++dx) {
         for (int dy = -1; dy <= 1; ++dy) {
           for (int dz = -1; dz <= 1; ++dz) {
-            const auto it = index_of.find(Key(cell.index + Eigen::Vector3i(dx, dy, dz)));
-            if (it == index_of.end()) continue;
+            const auto it = grid->index_of.find(Key(cell.index + Eigen::Vector3i(dx, dy, dz)));
+            if (it == grid->index_of.end()) continue;
             Cell& next = cells[it->second];
             if (!next.wall || next.cluster >= 0) continue;
             const Eigen::Vector3d d = next.centroid - cell.centroid;
@@ -125,12 +138,13 @@ std::optional<WallSlab> FindWall(const std::vector<Eigen::Vector3f>& points,
       }
     }
   }
-  if (clusters.empty()) return std::nullopt;
-  const auto best = static_cast<int>(
-      std::max_element(clusters.begin(), clusters.end(),
-                       [](const Moments& a, const Moments& b) { return a.n < b.n; }) -
-      clusters.begin());
-  const Moments& wall = clusters[best];
+}
+
+// The slab of cluster `best` (moments `wall`): its axes, and its height
+// range from the cells' centroids grown by half a cell, at most
+// max_height_m about its middle.
+WallSlab SlabOfCluster(const std::vector<Cell>& cells, int best, const Moments& wall,
+                       const Eigen::Vector3d& up, const proto::WallSnapshotParams& params) {
   WallSlab slab;
   slab.center = wall.Centroid();
   const Eigen::Vector3d normal = wall.Scatter().eigenvectors().col(0);
@@ -154,6 +168,26 @@ std::optional<WallSlab> FindWall(const std::vector<Eigen::Vector3f>& points,
   const double half = 0.5 * std::min(high - low, params.max_height_m());
   slab.bottom_m = middle - half;
   slab.top_m = middle + half;
+  return slab;
+}
+
+}  // namespace
+
+std::optional<WallSlab> FindWall(const std::vector<Eigen::Vector3f>& points,
+                                 const Eigen::Vector3d& up,
+                                 const proto::WallSnapshotParams& params) {
+  CellGrid grid = BinIntoCells(points, params.cell_m());
+  MarkWallCells(up, params, &grid.cells);
+  std::vector<Moments> clusters;
+  std::vector<int> cluster_cells;
+  GrowWallClusters(params, &grid, &clusters, &cluster_cells);
+  if (clusters.empty()) return std::nullopt;
+  const auto best = static_cast<int>(
+      std::max_element(clusters.begin(), clusters.end(),
+                       [](const Moments& a, const Moments& b) { return a.n < b.n; }) -
+      clusters.begin());
+  const Moments& wall = clusters[best];
+  WallSlab slab = SlabOfCluster(grid.cells, best, wall, up, params);
   slab.cells = cluster_cells[best];
   slab.points = wall.n;
   return slab;

@@ -22,7 +22,7 @@
 
 #include <Eigen/Core>
 
-#include "common/io/png_encoder.h"
+#include "stages/report/png_encoder.h"
 #include "tiltcal/proto/report_params.pb.h"
 
 namespace tiltcal::report {

@@ -10,7 +10,7 @@
 #include "bag/ros1/bag_writer.h"
 #include "bag/sensor_messages.h"
 #include "common/status.h"
-#include "stages/simulate/simulate.h"
+#include "stages/simulate/scenario.h"
 #include "tiltcal/proto/simulate_params.pb.h"
 
 namespace tiltcal::simulate {

@@ -122,6 +122,143 @@ void SetCannotTell(const std::string& reason, proto::SequenceVerification* out) 
   out->add_reasons(reason);
 }
 
+// The difference of the estimate from the reference in frame b and the
+// weight of the test: W = (I + Lambda P_ref)^-1 Lambda, Lambda the data's
+// information; chi2 = d^T W d against the quantile of W's rank.
+struct Comparison {
+  Eigen::VectorXd d;
+  Eigen::MatrixXd w;
+  Eigen::MatrixXd s;       // W^+
+  Eigen::VectorXd values;  // W's eigenvalues (Decompose)
+  int rank = 0;
+  double chi2 = 0.0;
+  double limit = 0.0;
+};
+
+// False when the calibration holds no information about the extrinsic
+// (rank 0); then only d, w, values and rank are set.
+bool Compare(const geometry::ExtrinsicEstimate& est, const geometry::ExtrinsicEstimate& ref,
+             int n, double p_value, Comparison* c) {
+  // Into frame b: rotation rows and columns turned by C_ref.
+  Eigen::MatrixXd to_b = Eigen::MatrixXd::Identity(n, n);
+  to_b.topLeftCorner<3, 3>() = ref.rotation.toRotationMatrix();
+  Eigen::VectorXd d(n);
+  d.head<3>() = geometry::BoxMinus(est.rotation, ref.rotation);
+  d.tail(n - 3) = est.rest - ref.rest;
+  c->d = to_b * d;
+  // The data's information: the solve's prior removed, rounding below zero clipped.
+  const auto data = Decompose(est.covariance.inverse() - est.prior_information, &c->values,
+                              &c->rank);
+  const Eigen::MatrixXd lambda_l =
+      data.eigenvectors() * c->values.asDiagonal() * data.eigenvectors().transpose();
+  const Eigen::MatrixXd lambda = to_b * lambda_l * to_b.transpose();
+  const Eigen::MatrixXd p_ref = to_b * ref.covariance * to_b.transpose();
+  c->w = Symmetric(
+      (Eigen::MatrixXd::Identity(n, n) + lambda * p_ref).partialPivLu().solve(lambda));
+  Decompose(c->w, &c->values, &c->rank);
+  if (c->rank == 0) return false;
+  c->chi2 = c->d.dot(c->w * c->d);
+  c->limit = geometry::ChiSquareUpperQuantile(c->rank, p_value);
+  c->s = PseudoInverse(c->w);
+  return true;
+}
+
+// What the groups (rotation, translation, time offset) give the verdict:
+// (sigma, description) of those that moved and of all, and per group the
+// smallest move detected or why none is.
+struct GroupFindings {
+  std::vector<std::pair<double, std::string>> moved, largest;
+  std::vector<std::string> undecided;
+  std::vector<std::string> detected;
+};
+
+// The difference of group `g`, its sigma and the smallest move of it the
+// check detects (along each axis of b and along the weakest direction).
+void CompareGroup(const Group& g, const Comparison& c, double p_value,
+                  proto::SequenceVerification* out, GroupFindings* findings) {
+  const Eigen::VectorXd d_g = c.d.segment(g.start, g.size);
+  const Eigen::MatrixXd s_gg = c.s.block(g.start, g.start, g.size, g.size);
+  Eigen::VectorXd group_values;
+  int group_rank = 0;
+  Decompose(s_gg, &group_values, &group_rank);
+  const double group_chi2 = d_g.dot(PseudoInverse(s_gg) * d_g);
+  const double sigma = std::sqrt(std::max(group_chi2, 0.0));
+  const std::string description = DescribeDifference(g, d_g, sigma);
+  if (group_rank > 0 && group_chi2 > geometry::ChiSquareUpperQuantile(group_rank, p_value)) {
+    findings->moved.emplace_back(sigma, description);
+  }
+  findings->largest.emplace_back(sigma, description);
+
+  // Detectability: along each axis of b and along the weakest direction.
+  const Eigen::MatrixXd w_gg = c.w.block(g.start, g.start, g.size, g.size);
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(w_gg);
+  const double top = std::max(c.values.maxCoeff(), 0.0);
+  Eigen::Vector3d axes = Eigen::Vector3d::Zero();
+  for (int k = 0; k < g.size; ++k) {
+    const double m = SmallestDetected(w_gg, Eigen::VectorXd::Unit(g.size, k), c.limit, top);
+    axes[k] = std::isfinite(m) ? m : 0.0;
+  }
+  const Eigen::VectorXd weakest = eig.eigenvectors().col(0);
+  const double weakest_m = SmallestDetected(w_gg, weakest, c.limit, top);
+  if (g.start == 0) {
+    *out->mutable_rotation_difference_deg() = ToProto(Eigen::Vector3d(d_g * kDegPerRad));
+    out->set_rotation_difference_sigma(sigma);
+    *out->mutable_detectable_rotation_deg() = ToProto(Eigen::Vector3d(axes * kDegPerRad));
+  } else if (g.start == 3) {
+    *out->mutable_translation_difference_m() = ToProto(Eigen::Vector3d(d_g));
+    out->set_translation_difference_sigma(sigma);
+    *out->mutable_detectable_translation_m() = ToProto(axes);
+  } else {
+    out->set_time_offset_difference_s(d_g[0]);
+    out->set_time_offset_difference_sigma(sigma);
+    out->set_detectable_time_offset_s(axes[0]);
+  }
+  // "rotation about b (…)", "translation along b (…)", "tau change".
+  const std::string what =
+      g.size == 1 ? std::string(g.name) + " change"
+                  : fmt::format("{} {}{}", g.name, g.start == 0 ? "about" : "along",
+                                Direction(weakest));
+  if (!std::isfinite(weakest_m)) {
+    findings->undecided.push_back(fmt::format(
+        "no {} is detected, whatever its size (the sequence holds no information about it)",
+        what));
+  } else if (weakest_m > g.detectable) {
+    findings->undecided.push_back(fmt::format(
+        "a {} below {:.3g} {} goes unnoticed (the check must notice {:.3g} {})", what,
+        weakest_m * g.unit_scale, g.unit, g.detectable * g.unit_scale, g.unit));
+  } else {
+    findings->detected.push_back(
+        fmt::format("{} {:.3g} {}", g.name, weakest_m * g.unit_scale, g.unit));
+  }
+}
+
+// MOVED when chi2 is above its limit, else CANNOT_TELL while a group's
+// detectable move is too large, else HOLDS; with the reasons.
+void SetVerdict(const Comparison& c, GroupFindings* f, proto::SequenceVerification* out) {
+  const auto by_sigma = [](const auto& a, const auto& b) { return a.first > b.first; };
+  std::sort(f->moved.begin(), f->moved.end(), by_sigma);
+  std::sort(f->largest.begin(), f->largest.end(), by_sigma);
+  const std::string test = fmt::format("chi2 {:.1f} {} {:.1f} ({} dof)", c.chi2,
+                                       c.chi2 > c.limit ? ">" : "<=", c.limit, c.rank);
+  if (c.chi2 > c.limit) {
+    out->set_verdict(proto::VerifyResult::MOVED);
+    out->add_reasons("moved: " + test);
+    if (f->moved.empty()) f->moved.push_back(f->largest.front());
+    for (const auto& m : f->moved) out->add_reasons("moved: " + m.second);
+  } else if (!f->undecided.empty()) {
+    out->set_verdict(proto::VerifyResult::CANNOT_TELL);
+    for (const std::string& u : f->undecided) out->add_reasons("cannot tell: " + u);
+    out->add_reasons("no move seen: " + test + ", largest difference " +
+                     f->largest.front().second);
+  } else {
+    out->set_verdict(proto::VerifyResult::HOLDS);
+    std::string smallest;
+    for (const std::string& m : f->detected) smallest += (smallest.empty() ? "" : ", ") + m;
+    out->add_reasons("holds: " + test + ", largest difference " + f->largest.front().second +
+                     "; the smallest moves it notices: " + smallest);
+  }
+}
+
 }  // namespace
 
 void CompareWithReference(const proto::CalibrationResult& estimate,
@@ -144,116 +281,17 @@ void CompareWithReference(const proto::CalibrationResult& estimate,
   }
   const geometry::ExtrinsicEstimate est = calibration::ToEstimate(estimate, n);
   const geometry::ExtrinsicEstimate ref = calibration::ToEstimate(reference, n);
-
-  // Into frame b: rotation rows and columns turned by C_ref.
-  Eigen::MatrixXd to_b = Eigen::MatrixXd::Identity(n, n);
-  to_b.topLeftCorner<3, 3>() = ref.rotation.toRotationMatrix();
-  Eigen::VectorXd d(n);
-  d.head<3>() = geometry::BoxMinus(est.rotation, ref.rotation);
-  d.tail(n - 3) = est.rest - ref.rest;
-  d = to_b * d;
-  // The data's information: the solve's prior removed, rounding below zero clipped.
-  Eigen::VectorXd values;
-  int rank = 0;
-  const auto data = Decompose(est.covariance.inverse() - est.prior_information, &values, &rank);
-  const Eigen::MatrixXd lambda_l =
-      data.eigenvectors() * values.asDiagonal() * data.eigenvectors().transpose();
-  const Eigen::MatrixXd lambda = to_b * lambda_l * to_b.transpose();
-  const Eigen::MatrixXd p_ref = to_b * ref.covariance * to_b.transpose();
-  const Eigen::MatrixXd w = Symmetric(
-      (Eigen::MatrixXd::Identity(n, n) + lambda * p_ref).partialPivLu().solve(lambda));
-  Decompose(w, &values, &rank);
-  if (rank == 0) {
+  Comparison c;
+  if (!Compare(est, ref, n, params.p_value(), &c)) {
     SetCannotTell("the sequence's calibration holds no information about the extrinsic", out);
     return;
   }
-  const double chi2 = d.dot(w * d);
-  const double limit = geometry::ChiSquareUpperQuantile(rank, params.p_value());
-  out->set_chi2(chi2);
-  out->set_dof(rank);
-  out->set_limit(limit);
-  const Eigen::MatrixXd s = PseudoInverse(w);
-
-  std::vector<std::pair<double, std::string>> moved, largest;
-  std::vector<std::string> undecided;
-  std::vector<std::string> detected;
-  for (const Group& g : Groups(params, n)) {
-    const Eigen::VectorXd d_g = d.segment(g.start, g.size);
-    const Eigen::MatrixXd s_gg = s.block(g.start, g.start, g.size, g.size);
-    Eigen::VectorXd group_values;
-    int group_rank = 0;
-    Decompose(s_gg, &group_values, &group_rank);
-    const double group_chi2 = d_g.dot(PseudoInverse(s_gg) * d_g);
-    const double sigma = std::sqrt(std::max(group_chi2, 0.0));
-    const std::string description = DescribeDifference(g, d_g, sigma);
-    if (group_rank > 0 &&
-        group_chi2 > geometry::ChiSquareUpperQuantile(group_rank, params.p_value())) {
-      moved.emplace_back(sigma, description);
-    }
-    largest.emplace_back(sigma, description);
-
-    // Detectability: along each axis of b and along the weakest direction.
-    const Eigen::MatrixXd w_gg = w.block(g.start, g.start, g.size, g.size);
-    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(w_gg);
-    const double top = std::max(values.maxCoeff(), 0.0);
-    Eigen::Vector3d axes = Eigen::Vector3d::Zero();
-    for (int k = 0; k < g.size; ++k) {
-      const double m = SmallestDetected(w_gg, Eigen::VectorXd::Unit(g.size, k), limit, top);
-      axes[k] = std::isfinite(m) ? m : 0.0;
-    }
-    const Eigen::VectorXd weakest = eig.eigenvectors().col(0);
-    const double weakest_m = SmallestDetected(w_gg, weakest, limit, top);
-    if (g.start == 0) {
-      *out->mutable_rotation_difference_deg() = ToProto(Eigen::Vector3d(d_g * kDegPerRad));
-      out->set_rotation_difference_sigma(sigma);
-      *out->mutable_detectable_rotation_deg() = ToProto(Eigen::Vector3d(axes * kDegPerRad));
-    } else if (g.start == 3) {
-      *out->mutable_translation_difference_m() = ToProto(Eigen::Vector3d(d_g));
-      out->set_translation_difference_sigma(sigma);
-      *out->mutable_detectable_translation_m() = ToProto(axes);
-    } else {
-      out->set_time_offset_difference_s(d_g[0]);
-      out->set_time_offset_difference_sigma(sigma);
-      out->set_detectable_time_offset_s(axes[0]);
-    }
-    // "rotation about b (…)", "translation along b (…)", "tau change".
-    const std::string what =
-        g.size == 1 ? std::string(g.name) + " change"
-                    : fmt::format("{} {}{}", g.name, g.start == 0 ? "about" : "along",
-                                  Direction(weakest));
-    if (!std::isfinite(weakest_m)) {
-      undecided.push_back(fmt::format(
-          "no {} is detected, whatever its size (the sequence holds no information about it)",
-          what));
-    } else if (weakest_m > g.detectable) {
-      undecided.push_back(fmt::format(
-          "a {} below {:.3g} {} goes unnoticed (the check must notice {:.3g} {})", what,
-          weakest_m * g.unit_scale, g.unit, g.detectable * g.unit_scale, g.unit));
-    } else {
-      detected.push_back(fmt::format("{} {:.3g} {}", g.name, weakest_m * g.unit_scale, g.unit));
-    }
-  }
-  const auto by_sigma = [](const auto& a, const auto& b) { return a.first > b.first; };
-  std::sort(moved.begin(), moved.end(), by_sigma);
-  std::sort(largest.begin(), largest.end(), by_sigma);
-  const std::string test = fmt::format("chi2 {:.1f} {} {:.1f} ({} dof)", chi2,
-                                       chi2 > limit ? ">" : "<=", limit, rank);
-  if (chi2 > limit) {
-    out->set_verdict(proto::VerifyResult::MOVED);
-    out->add_reasons("moved: " + test);
-    if (moved.empty()) moved.push_back(largest.front());
-    for (const auto& m : moved) out->add_reasons("moved: " + m.second);
-  } else if (!undecided.empty()) {
-    out->set_verdict(proto::VerifyResult::CANNOT_TELL);
-    for (const std::string& u : undecided) out->add_reasons("cannot tell: " + u);
-    out->add_reasons("no move seen: " + test + ", largest difference " + largest.front().second);
-  } else {
-    out->set_verdict(proto::VerifyResult::HOLDS);
-    std::string smallest;
-    for (const std::string& m : detected) smallest += (smallest.empty() ? "" : ", ") + m;
-    out->add_reasons("holds: " + test + ", largest difference " + largest.front().second +
-                     "; the smallest moves it notices: " + smallest);
-  }
+  out->set_chi2(c.chi2);
+  out->set_dof(c.rank);
+  out->set_limit(c.limit);
+  GroupFindings findings;
+  for (const Group& g : Groups(params, n)) CompareGroup(g, c, params.p_value(), out, &findings);
+  SetVerdict(c, &findings, out);
 }
 
 void DecideDatasetVerdict(proto::VerifyResult* result) {

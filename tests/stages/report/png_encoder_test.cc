@@ -1,4 +1,4 @@
-#include "common/io/png_encoder.h"
+#include "stages/report/png_encoder.h"
 
 #include <png.h>
 

@@ -1,5 +1,5 @@
-#ifndef TILTCAL_COMMON_IO_PNG_ENCODER_H_
-#define TILTCAL_COMMON_IO_PNG_ENCODER_H_
+#ifndef TILTCAL_STAGES_REPORT_PNG_ENCODER_H_
+#define TILTCAL_STAGES_REPORT_PNG_ENCODER_H_
 
 // PNG (ISO/IEC 15948) encoding of an 8-bit greyscale image in memory:
 // signature, IHDR (colour type 0, bit depth 8, no interlace), one IDAT of
@@ -24,4 +24,4 @@ std::string EncodePng(const GrayImage& image);
 
 }  // namespace tiltcal
 
-#endif  // TILTCAL_COMMON_IO_PNG_ENCODER_H_
+#endif  // TILTCAL_STAGES_REPORT_PNG_ENCODER_H_
