@@ -33,16 +33,11 @@ bool DeskewScan(const CalibrationState& state, const LidarScan& scan, double nod
   return true;
 }
 
-}  // namespace
-
-OdometryRun RunOdometry(const std::vector<LidarScan>& scans, const CalibrationState& state,
-                        const proto::CalibrateParams& params, bool gyro_aided,
-                        InitialisationReport* report) {
-  report->odometry_scans = 0;
-  report->odometry_registered = 0;
-  report->odometry_quality_scans = 0;
-  report->odometry_mean_fitness_m = 0.0;
-  report->odometry_mean_inlier_fraction = 0.0;
+// Registers every odometry.scan_step-th scan (deskewed with the state's
+// rotation spline and its prediction from the gyro when gyro_aided) into
+// run.poses, with the scan index and C_ab of each pose.
+OdometryRun RegisterScans(const std::vector<LidarScan>& scans, const CalibrationState& state,
+                          const proto::CalibrateParams& params, bool gyro_aided) {
   const double tau = state.time_offset_s[0];
   const int num_threads = std::max(static_cast<int>(params.num_threads()), 1);
   LidarOdometry odometry(params.odometry(), params.scans(), num_threads);
@@ -100,12 +95,19 @@ OdometryRun RunOdometry(const std::vector<LidarScan>& scans, const CalibrationSt
     run.imu_rotations.push_back(current.c_ab);
   }
   run.poses = odometry.poses();
-  report->odometry_scans = static_cast<int>(run.poses.size());
+  return run;
+}
+
+// The poses the coarse tau and the hand-eye use (the first and the
+// registered ones) into run->used, run->imu_used and run->lidar_used, and
+// the odometry's counts and mean registration quality into *report.
+void SelectRegisteredPoses(OdometryRun* run, InitialisationReport* report) {
+  report->odometry_scans = static_cast<int>(run->poses.size());
   double fitness_sum = 0.0;
   double inlier_fraction_sum = 0.0;
   int measured = 0;
-  for (size_t i = 0; i < run.poses.size(); ++i) {
-    const LidarOdometryPose& pose = run.poses[i];
+  for (size_t i = 0; i < run->poses.size(); ++i) {
+    const LidarOdometryPose& pose = run->poses[i];
     if (i > 0 && !pose.registered) continue;
     if (i > 0) {
       ++report->odometry_registered;
@@ -115,15 +117,29 @@ OdometryRun RunOdometry(const std::vector<LidarScan>& scans, const CalibrationSt
         ++measured;
       }
     }
-    run.used.push_back(i);
-    run.imu_used.push_back(run.imu_rotations[i]);
-    run.lidar_used.push_back(Eigen::Quaterniond(pose.l0_from_lidar.rotation()));
+    run->used.push_back(i);
+    run->imu_used.push_back(run->imu_rotations[i]);
+    run->lidar_used.push_back(Eigen::Quaterniond(pose.l0_from_lidar.rotation()));
   }
   report->odometry_quality_scans = measured;
   if (measured > 0) {
     report->odometry_mean_fitness_m = fitness_sum / measured;
     report->odometry_mean_inlier_fraction = inlier_fraction_sum / measured;
   }
+}
+
+}  // namespace
+
+OdometryRun RunOdometry(const std::vector<LidarScan>& scans, const CalibrationState& state,
+                        const proto::CalibrateParams& params, bool gyro_aided,
+                        InitialisationReport* report) {
+  report->odometry_scans = 0;
+  report->odometry_registered = 0;
+  report->odometry_quality_scans = 0;
+  report->odometry_mean_fitness_m = 0.0;
+  report->odometry_mean_inlier_fraction = 0.0;
+  OdometryRun run = RegisterScans(scans, state, params, gyro_aided);
+  SelectRegisteredPoses(&run, report);
   return run;
 }
 

@@ -55,6 +55,94 @@ UsedPoses CollectUsedPoses(const OdometryRun& run, const std::vector<LidarScan>&
   return used;
 }
 
+// What every round of the search reads, and the state and report it
+// updates.
+struct RotationSearch {
+  const std::vector<imu::ImuReading>& imu_samples;
+  const std::vector<LidarScan>& scans;
+  const proto::CalibrateParams& params;
+  proto::CalibrateParams search;  // SearchParams(params)
+  int pair_step;
+  bool has_guess;
+  CalibrationState* state;
+  InitialisationReport* report;
+};
+
+// The motion of one round: the odometry's used poses and their rotation
+// pairs.
+struct RoundMotion {
+  UsedPoses used;
+  std::vector<RotationPair> pairs;
+};
+
+// The odometry with the state's C_bl (gyro-aided or not), tau from it, the
+// rotation pairs and how much they turn; NotDetermined when too little.
+Status MeasureRoundMotion(const RotationSearch& s, bool gyro_aided, RotationFromMotion* result,
+                          RoundMotion* motion) {
+  CalibrationState& state = *s.state;
+  const OdometryRun run = RunOdometry(s.scans, state, s.search, gyro_aided, s.report);
+  if (run.used.size() < 3) {
+    return Status::Error(fmt::format(
+        "the LiDAR odometry registered too few scans ({} of {}) to find the extrinsic "
+        "rotation from the motion",
+        run.used.size(), s.scans.size()));
+  }
+  TILTCAL_RETURN_IF_ERROR(
+      EstimateCoarseTau(run, s.scans, s.imu_samples, s.search, state, s.report));
+  state.time_offset_s[0] = s.report->time_offset_center_s;
+  result->time_offset_s = s.report->time_offset_center_s;
+  motion->used = CollectUsedPoses(run, s.scans, state);
+  const UsedPoses& used = motion->used;
+  motion->pairs = MakeRotationPairs(used.imu_rotations, used.lidar_rotations, s.pair_step);
+  std::vector<std::pair<double, double>> pair_times_s;
+  for (size_t k = 0; k + s.pair_step < used.times_s.size(); k += s.pair_step) {
+    pair_times_s.emplace_back(used.times_s[k], used.times_s[k + s.pair_step]);
+  }
+  result->turning = MeasureTurning(motion->pairs, pair_times_s);
+  const std::string missing = MissingTurning(result->turning, s.params.init());
+  if (!missing.empty()) return Status::NotDetermined(missing);
+  return Status::Ok();
+}
+
+// The round's next C_bl: hand-eye when the motion excites it; else
+// (planar motion) the axes aligned first (any angle), then the rotation
+// about the axis from the accelerations. NotDetermined when neither decides
+// it and there is no guess.
+Status NextRotation(const RotationSearch& s, const RoundMotion& motion,
+                    const Eigen::Quaterniond& c_bl, RotationSearchRound* r,
+                    RotationFromMotion* result, Eigen::Quaterniond* next) {
+  const proto::CalibrateParams& params = s.params;
+  result->hand_eye = EstimateHandEyeRotation(motion.pairs, params.hand_eye());
+  if (result->hand_eye.excited) {
+    r->from_hand_eye = true;
+    *next = result->hand_eye.imu_from_lidar_rotation;
+    result->about_axis_decided = true;
+    return Status::Ok();
+  }
+  *next = AlignRotationAxes(motion.pairs, c_bl);
+  r->axis_turn_deg = AngleDeg(*next, c_bl);
+  s.state->SetImuFromLidarRotation(*next);
+  r->acceleration = CheckRigYawByAccelerations(*s.state, s.imu_samples, motion.used.times_s,
+                                               motion.used.positions_l0, result->axis_b,
+                                               params.init());
+  if (r->acceleration.decided) {
+    *next = Eigen::AngleAxisd(geometry::DegToRad(r->acceleration.yaw_error_deg), result->axis_b) *
+            *next;
+    result->about_axis_decided = true;
+  } else if (!s.has_guess) {
+    return Status::NotDetermined(fmt::format(
+        "the motion turns about one axis only (hand-eye excitation {:.4f} rad, at least "
+        "hand_eye.min_excitation_rad = {} needed), and its horizontal accelerations "
+        "(RMS {:.3f} m/s^2, at least init.min_check_acceleration_mps2 = {} needed) are "
+        "too small to find the rotation about that axis: record driving with starts, "
+        "stops and turns both ways, or give imu_from_lidar in the rig",
+        result->hand_eye.excitation_rad, params.hand_eye().min_excitation_rad(),
+        r->acceleration.rms_horizontal_acceleration_mps2,
+        params.init().min_check_acceleration_mps2()));
+  }
+  return Status::Ok();
+}
+
 }  // namespace
 
 Status FindImuFromLidarRotation(const std::vector<imu::ImuReading>& imu_samples,
@@ -64,7 +152,6 @@ Status FindImuFromLidarRotation(const std::vector<imu::ImuReading>& imu_samples,
                                 const proto::CalibrateParams& params, RotationFromMotion* result) {
   *result = RotationFromMotion();
   const auto start = std::chrono::steady_clock::now();
-  const proto::CalibrateParams search = SearchParams(params);
   const proto::RotationSearchParams& options = params.rotation_search();
   std::optional<CalibrationState> maybe_state;
   TILTCAL_RETURN_IF_ERROR(MakeStateOverImu(imu_samples, params, &maybe_state));
@@ -80,64 +167,18 @@ Status FindImuFromLidarRotation(const std::vector<imu::ImuReading>& imu_samples,
   const int pair_step = std::max(
       1, static_cast<int>(std::lround(static_cast<double>(params.hand_eye().pair_step()) /
                                       std::max<uint32_t>(options.scan_step(), 1))));
+  const RotationSearch search{imu_samples, scans,           params, SearchParams(params),
+                              pair_step,   guess.has_value(), &state, &report};
   for (uint32_t round = 0; round < options.max_rounds(); ++round) {
     RotationSearchRound r;
     // The first odometry uses neither the gyro's deskew nor its prediction:
     // with a guess off by tens of degrees both would turn the wrong way.
     r.gyro_aided = round > 0;
     state.SetImuFromLidarRotation(c_bl);
-    const OdometryRun run = RunOdometry(scans, state, search, r.gyro_aided, &report);
-    if (run.used.size() < 3) {
-      return Status::Error(fmt::format(
-          "the LiDAR odometry registered too few scans ({} of {}) to find the extrinsic "
-          "rotation from the motion",
-          run.used.size(), scans.size()));
-    }
-    TILTCAL_RETURN_IF_ERROR(EstimateCoarseTau(run, scans, imu_samples, search, state, &report));
-    state.time_offset_s[0] = report.time_offset_center_s;
-    result->time_offset_s = report.time_offset_center_s;
-    const UsedPoses used = CollectUsedPoses(run, scans, state);
-    const std::vector<RotationPair> pairs =
-        MakeRotationPairs(used.imu_rotations, used.lidar_rotations, pair_step);
-    std::vector<std::pair<double, double>> pair_times_s;
-    for (size_t k = 0; k + pair_step < used.times_s.size(); k += pair_step) {
-      pair_times_s.emplace_back(used.times_s[k], used.times_s[k + pair_step]);
-    }
-    result->turning = MeasureTurning(pairs, pair_times_s);
-    const std::string missing = MissingTurning(result->turning, params.init());
-    if (!missing.empty()) return Status::NotDetermined(missing);
-
-    result->hand_eye = EstimateHandEyeRotation(pairs, params.hand_eye());
+    RoundMotion motion;
+    TILTCAL_RETURN_IF_ERROR(MeasureRoundMotion(search, r.gyro_aided, result, &motion));
     Eigen::Quaterniond next;
-    if (result->hand_eye.excited) {
-      r.from_hand_eye = true;
-      next = result->hand_eye.imu_from_lidar_rotation;
-      result->about_axis_decided = true;
-    } else {
-      // Planar motion: the axes first (any angle), then the rotation about
-      // the axis from the accelerations.
-      next = AlignRotationAxes(pairs, c_bl);
-      r.axis_turn_deg = AngleDeg(next, c_bl);
-      state.SetImuFromLidarRotation(next);
-      r.acceleration = CheckRigYawByAccelerations(state, imu_samples, used.times_s,
-                                                  used.positions_l0, result->axis_b,
-                                                  params.init());
-      if (r.acceleration.decided) {
-        next = Eigen::AngleAxisd(geometry::DegToRad(r.acceleration.yaw_error_deg), result->axis_b) *
-               next;
-        result->about_axis_decided = true;
-      } else if (!guess.has_value()) {
-        return Status::NotDetermined(fmt::format(
-            "the motion turns about one axis only (hand-eye excitation {:.4f} rad, at least "
-            "hand_eye.min_excitation_rad = {} needed), and its horizontal accelerations "
-            "(RMS {:.3f} m/s^2, at least init.min_check_acceleration_mps2 = {} needed) are "
-            "too small to find the rotation about that axis: record driving with starts, "
-            "stops and turns both ways, or give imu_from_lidar in the rig",
-            result->hand_eye.excitation_rad, params.hand_eye().min_excitation_rad(),
-            r.acceleration.rms_horizontal_acceleration_mps2,
-            params.init().min_check_acceleration_mps2()));
-      }
-    }
+    TILTCAL_RETURN_IF_ERROR(NextRotation(search, motion, c_bl, &r, result, &next));
     r.change_deg = AngleDeg(next.normalized(), c_bl);
     c_bl = next.normalized();
     result->rounds.push_back(r);

@@ -326,13 +326,14 @@ Status AddPlaneResiduals(const GroundBuild& build, const GroundPlaneSample& plan
 
 }  // namespace
 
-Status AddGroundResiduals(const std::vector<proto::GroundPlane>& planes,
-                          const GroundResidualSelection& selection,
-                          const proto::GroundResidualsParams& params,
-                          const GroundSequenceInfo& info,
-                          const GroundLosses& losses, int64_t time_origin_ns,
-                          CalibrationState* state, ceres::Problem* problem,
-                          GroundResidualSummary* summary) {
+Status AddGroundResiduals(const GroundResidualInputs& inputs, CalibrationState* state,
+                          ceres::Problem* problem, GroundResidualSummary* summary) {
+  const std::vector<proto::GroundPlane>& planes = inputs.planes;
+  const GroundResidualSelection& selection = inputs.selection;
+  const proto::GroundResidualsParams& params = inputs.params;
+  const GroundSequenceInfo& info = inputs.info;
+  const GroundLosses& losses = inputs.losses;
+  const int64_t time_origin_ns = inputs.time_origin_ns;
   *summary = GroundResidualSummary();
   summary->num_planes = static_cast<int>(planes.size());
   if (!selection.any()) return Status::Ok();
@@ -375,33 +376,28 @@ Status AddGroundResiduals(const std::vector<proto::GroundPlane>& planes,
   return Status::Ok();
 }
 
-Status MakeGroundResidualAdder(
-    const std::vector<proto::GroundPlane>& planes, int64_t time_origin_ns, const proto::Rig& rig,
-    const proto::GravityReference* gravity, const proto::GroundResidualsParams& params,
-    const GroundLosses* losses, std::ostream* log,
-    std::function<Status(CalibrationState*, ceres::Problem*, int*)>* adder,
-    std::vector<std::string>* used, std::string* reason) {
-  *adder = nullptr;
-  used->clear();
-  const GroundSequenceInfo info = MakeGroundSequenceInfo(rig, gravity);
+Status MakeGroundResidualAdder(const GroundAdderInputs& inputs, GroundAdder* out) {
+  *out = GroundAdder();
+  const GroundSequenceInfo info = MakeGroundSequenceInfo(*inputs.rig, inputs.gravity);
   GroundResidualSelection selection;
-  TILTCAL_RETURN_IF_ERROR(SelectGroundResiduals(params, info, &selection));
-  if (planes.empty()) {
-    *reason = "ground residuals none: no ground planes given (with planes: " +
-              selection.Names() + ")";
+  TILTCAL_RETURN_IF_ERROR(SelectGroundResiduals(*inputs.params, info, &selection));
+  if (inputs.planes->empty()) {
+    out->reason = "ground residuals none: no ground planes given (with planes: " +
+                  selection.Names() + ")";
     return Status::Ok();
   }
-  *reason = selection.reason;
+  out->reason = selection.reason;
   if (!selection.any()) return Status::Ok();
-  if (selection.flat) used->push_back("flat");
-  if (selection.dist) used->push_back("dist");
-  if (selection.incl) used->push_back("incl");
-  if (selection.up) used->push_back("up");
-  *adder = [&planes, &params, losses, log, selection, info, time_origin_ns](
-               CalibrationState* state, ceres::Problem* problem, int* num_added) -> Status {
+  if (selection.flat) out->used.push_back("flat");
+  if (selection.dist) out->used.push_back("dist");
+  if (selection.incl) out->used.push_back("incl");
+  if (selection.up) out->used.push_back("up");
+  out->add = [planes = inputs.planes, params = inputs.params, losses = inputs.losses,
+              log = inputs.log, selection, info, time_origin_ns = inputs.time_origin_ns](
+                 CalibrationState* state, ceres::Problem* problem, int* num_added) -> Status {
     GroundResidualSummary summary;
-    TILTCAL_RETURN_IF_ERROR(AddGroundResiduals(planes, selection, params, info, *losses,
-                                               time_origin_ns, state, problem, &summary));
+    TILTCAL_RETURN_IF_ERROR(AddGroundResiduals(
+        {*planes, selection, *params, info, *losses, time_origin_ns}, state, problem, &summary));
     *num_added = summary.num_flat + summary.num_dist + summary.num_incl + summary.num_up;
     if (log != nullptr) *log << "tiltcal_calibrate: " << summary.ToString() << "\n" << std::flush;
     return Status::Ok();

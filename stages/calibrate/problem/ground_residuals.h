@@ -129,29 +129,46 @@ struct GroundResidualSummary {
 // tau (CalibrationState::TimeWindow) and stay frozen. LiDAR stamps become
 // solver time as t_k = (stamp_ns - time_origin_ns) * 1e-9 s, the same origin
 // as the spline grid (the first IMU stamp).
-Status AddGroundResiduals(const std::vector<proto::GroundPlane>& planes,
-                          const GroundResidualSelection& selection,
-                          const proto::GroundResidualsParams& params,
-                          const GroundSequenceInfo& info,
-                          const GroundLosses& losses, int64_t time_origin_ns,
-                          CalibrationState* state, ceres::Problem* problem,
-                          GroundResidualSummary* summary);
+struct GroundResidualInputs {
+  const std::vector<proto::GroundPlane>& planes;
+  const GroundResidualSelection& selection;
+  const proto::GroundResidualsParams& params;
+  const GroundSequenceInfo& info;
+  const GroundLosses& losses;
+  int64_t time_origin_ns;
+};
+Status AddGroundResiduals(const GroundResidualInputs& inputs, CalibrationState* state,
+                          ceres::Problem* problem, GroundResidualSummary* summary);
+
+// What MakeGroundResidualAdder selects from and what the adder reads:
+// planes, params and losses (and gravity, rig) are referenced by the adder
+// and must outlive it. LiDAR stamps become solver time from time_origin_ns
+// (the first IMU stamp). log (may be null) gets one line per call of the
+// adder with the GroundResidualSummary.
+struct GroundAdderInputs {
+  const std::vector<proto::GroundPlane>* planes = nullptr;
+  int64_t time_origin_ns = 0;
+  const proto::Rig* rig = nullptr;
+  const proto::GravityReference* gravity = nullptr;  // may be null
+  const proto::GroundResidualsParams* params = nullptr;
+  const GroundLosses* losses = nullptr;
+  std::ostream* log = nullptr;
+};
+
+// What it gives: the selected residuals' names ("flat", "dist", ...), the
+// reason (one line) and the adder for CalibrationProblem::AddExtraResiduals
+// (same signature as ExtraResidualAdder), which calls AddGroundResiduals on
+// the current state and reports the number of blocks added; empty when
+// nothing is selected or there are no planes.
+struct GroundAdder {
+  std::function<Status(CalibrationState*, ceres::Problem*, int*)> add;
+  std::vector<std::string> used;
+  std::string reason;
+};
 
 // For tiltcal_calibrate: selects the residuals (SelectGroundResiduals on
-// MakeGroundSequenceInfo(rig, gravity)), names them in *used ("flat",
-// "dist", ...) and *reason (one line), and sets *adder to a function for
-// CalibrationProblem::AddExtraResiduals (same signature as
-// ExtraResidualAdder) that calls AddGroundResiduals on the current state and
-// reports the number of blocks added. *adder stays empty when nothing is
-// selected or there are no planes. planes, params, losses (and gravity, rig)
-// are referenced by the adder and must outlive it. log (may be null) gets one
-// line per call with the GroundResidualSummary.
-Status MakeGroundResidualAdder(
-    const std::vector<proto::GroundPlane>& planes, int64_t time_origin_ns, const proto::Rig& rig,
-    const proto::GravityReference* gravity, const proto::GroundResidualsParams& params,
-    const GroundLosses* losses, std::ostream* log,
-    std::function<Status(CalibrationState*, ceres::Problem*, int*)>* adder,
-    std::vector<std::string>* used, std::string* reason);
+// MakeGroundSequenceInfo(rig, gravity)) and makes the adder.
+Status MakeGroundResidualAdder(const GroundAdderInputs& inputs, GroundAdder* out);
 
 }  // namespace tiltcal::calibrate
 

@@ -77,6 +77,24 @@ CalibrationProblem::CalibrationProblem(CalibrationState* state,
   problem_ = std::make_unique<ceres::Problem>(problem_options);
   ceres::Problem& p = *problem_;
 
+  AddStateBlocks();
+  BoundTimeOffset();
+  AddClockRate();
+  if (!options_.estimate_extrinsic) {
+    p.SetParameterBlockConstant(state_->imu_from_lidar_rotation);
+    p.SetParameterBlockConstant(state_->imu_from_lidar_translation);
+  }
+  if (!options_.estimate_gravity) p.SetParameterBlockConstant(state_->gravity_direction);
+  HoldOrTieBiases();
+  HoldOrPriorImuIntrinsics();
+  AddTranslationPrior();
+  counts_.knots = state_->trajectory.num_knots();
+  rotation_used_.assign(state_->trajectory.num_knots(), 0);
+  position_used_.assign(state_->trajectory.num_knots(), 0);
+}
+
+void CalibrationProblem::AddStateBlocks() {
+  ceres::Problem& p = *problem_;
   spline::SplineTrajectory& traj = state_->trajectory;
   for (int i = 0; i < traj.num_knots(); ++i) {
     p.AddParameterBlock(traj.rotation_knot(i), 4, &quaternion_manifold_);
@@ -95,7 +113,10 @@ CalibrationProblem::CalibrationProblem(CalibrationState* state,
   for (double* b : state_->BiasBlocks()) p.AddParameterBlock(b, 3);
   p.AddParameterBlock(state_->gyro_triad_errors.data(), 9, &lower_triangular_manifold_);
   p.AddParameterBlock(state_->accel_triad_errors.data(), 9, &lower_triangular_manifold_);
+}
 
+void CalibrationProblem::BoundTimeOffset() {
+  ceres::Problem& p = *problem_;
   // tau bounds around the binning value; tau clamped into them.
   const double bound = std::abs(options_.time_offset_bound_s);
   const double lowest = options_.time_offset_center_s - bound;
@@ -110,6 +131,10 @@ CalibrationProblem::CalibrationProblem(CalibrationState* state,
   } else {
     p.SetParameterBlockConstant(state_->time_offset_s);
   }
+}
+
+void CalibrationProblem::AddClockRate() {
+  ceres::Problem& p = *problem_;
   // rho (only with the drift; see problem_builder.h), clamped into its bounds.
   if (options_.estimate_clock_rate) {
     const ClockRateBounds rho = ClockRateBoundsOfBuild(
@@ -132,11 +157,10 @@ CalibrationProblem::CalibrationProblem(CalibrationState* state,
       p.SetParameterBlockConstant(state_->clock_rate);
     }
   }
-  if (!options_.estimate_extrinsic) {
-    p.SetParameterBlockConstant(state_->imu_from_lidar_rotation);
-    p.SetParameterBlockConstant(state_->imu_from_lidar_translation);
-  }
-  if (!options_.estimate_gravity) p.SetParameterBlockConstant(state_->gravity_direction);
+}
+
+void CalibrationProblem::HoldOrTieBiases() {
+  ceres::Problem& p = *problem_;
   const std::pair<BiasSegments*, double> biases[] = {
       {&state_->gyro_bias, imu_noise_.gyro_bias_random_walk_radps2_sqrthz()},
       {&state_->accel_bias, imu_noise_.accel_bias_random_walk_mps3_sqrthz()}};
@@ -152,6 +176,10 @@ CalibrationProblem::CalibrationProblem(CalibrationState* state,
       }
     }
   }
+}
+
+void CalibrationProblem::HoldOrPriorImuIntrinsics() {
+  ceres::Problem& p = *problem_;
   for (double* k : {state_->gyro_triad_errors.data(), state_->accel_triad_errors.data()}) {
     if (!options_.estimate_imu_intrinsics) {
       p.SetParameterBlockConstant(k);
@@ -163,6 +191,10 @@ CalibrationProblem::CalibrationProblem(CalibrationState* state,
         nullptr, k);
     ++counts_.prior_residuals;
   }
+}
+
+void CalibrationProblem::AddTranslationPrior() {
+  ceres::Problem& p = *problem_;
   if (options_.translation_prior_sigma_m > 0.0 && options_.estimate_extrinsic) {
     p.AddResidualBlock(new TranslationPriorCost(options_.translation_prior_m,
                                                 options_.translation_prior_sigma_m,
@@ -170,9 +202,6 @@ CalibrationProblem::CalibrationProblem(CalibrationState* state,
                        nullptr, state_->imu_from_lidar_translation);
     ++counts_.prior_residuals;
   }
-  counts_.knots = traj.num_knots();
-  rotation_used_.assign(traj.num_knots(), 0);
-  position_used_.assign(traj.num_knots(), 0);
 }
 
 void CalibrationProblem::MarkKnots(int first_knot, bool position) {

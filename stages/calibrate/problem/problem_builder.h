@@ -187,6 +187,17 @@ class CalibrationProblem {
   double clock_rate_upper() const { return rho_upper_; }
 
  private:
+  // The steps of the constructor, in this order (Ceres orders the blocks by
+  // insertion): every block of the state with its manifold and the gauge;
+  // tau's bounds; rho with its bounds and prior; the extrinsic and gravity
+  // held when not estimated; the biases held or tied by their random walk;
+  // the IMU intrinsics held or given their prior; the translation's prior.
+  void AddStateBlocks();
+  void BoundTimeOffset();
+  void AddClockRate();
+  void HoldOrTieBiases();
+  void HoldOrPriorImuIntrinsics();
+  void AddTranslationPrior();
   void MarkKnots(int first_knot, bool position);
 
   CalibrationState* state_;

@@ -91,10 +91,14 @@ ClockRateBounds ClockRateBoundsOfBuild(double rho_bin, double max_rate_ppm,
 
 void FillTimeOffsetDriftReport(const proto::TimeOffsetDriftParams& params,
                                const TimeOffsetDriftDecision& decision, const ScanTimeSpan& span,
-                               double tau0_s, double rho, const ClockRateBounds& bounds,
-                               const std::vector<double>& covariance_row, double var_tau0_s2,
+                               const TimeOffsetDriftEstimate& estimate,
                                double weak_time_offset_sigma_s,
                                proto::TimeOffsetDriftReport* report) {
+  const double tau0_s = estimate.tau0_s;
+  const double rho = estimate.rho;
+  const ClockRateBounds& bounds = estimate.bounds;
+  const std::vector<double>& covariance_row = estimate.covariance_row;
+  const double var_tau0_s2 = estimate.var_tau0_s2;
   report->Clear();
   report->set_mode(proto::TimeOffsetDriftParams::Mode_Name(params.mode()));
   report->set_estimated(decision.estimate);

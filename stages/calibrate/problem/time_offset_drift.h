@@ -73,17 +73,26 @@ struct ClockRateBounds {
 ClockRateBounds ClockRateBoundsOfBuild(double rho_bin, double max_rate_ppm,
                                        double time_offset_step_bound_s, double half_length_s);
 
+// The estimate a drift report is made from: tau0 (the state's) and rho, rho's
+// interval, covariance_row: cov(rho, .) with the 7 tangent parameters of the
+// result's covariance (tau0 last), then var(rho) (8 values; empty: no
+// covariance), and var(tau0), s^2.
+struct TimeOffsetDriftEstimate {
+  double tau0_s = 0.0;
+  double rho = 0.0;
+  ClockRateBounds bounds;
+  std::vector<double> covariance_row;
+  double var_tau0_s2 = 0.0;
+};
+
 // Fills *report (mode, decision, span) and, when estimated, the rate and tau
-// at both ends with their sigmas from covariance_row: cov(rho, .) with the 7
-// tangent parameters of the result's covariance (tau0 last), then var(rho)
-// (8 values; empty: no covariance, the sigmas stay 0). weak: tau at the first
-// or the last scan has a sigma above weak_time_offset_sigma_s (tau is then
-// not determined at every time of the sequence, as a single tau with such a
-// sigma is weak). tau0 is the state's.
+// at both ends with their sigmas from the estimate's covariance row (without
+// one the sigmas stay 0). weak: tau at the first or the last scan has a
+// sigma above weak_time_offset_sigma_s (tau is then not determined at every
+// time of the sequence, as a single tau with such a sigma is weak).
 void FillTimeOffsetDriftReport(const proto::TimeOffsetDriftParams& params,
                                const TimeOffsetDriftDecision& decision, const ScanTimeSpan& span,
-                               double tau0_s, double rho, const ClockRateBounds& bounds,
-                               const std::vector<double>& covariance_row, double var_tau0_s2,
+                               const TimeOffsetDriftEstimate& estimate,
                                double weak_time_offset_sigma_s,
                                proto::TimeOffsetDriftReport* report);
 

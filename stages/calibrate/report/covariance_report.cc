@@ -35,6 +35,134 @@ MotionAxis PrincipalRotationAxis(const std::vector<imu::ImuReading>& samples,
   return out;
 }
 
+namespace {
+
+// One of the 7 tangent parameters' groups in covariance order.
+struct Group {
+  double* block;
+  int offset;
+  int size;
+};
+
+// The IMU triad errors when both are free in the problem (12 tangent
+// parameters, marginalised last before the 7), else none.
+struct IntrinsicsBlocks {
+  std::vector<double*> blocks;
+  int size = 0;
+};
+
+IntrinsicsBlocks FreeIntrinsicsBlocks(ceres::Problem* problem, CalibrationState* state) {
+  IntrinsicsBlocks out;
+  for (double* b : {state->gyro_triad_errors.data(), state->accel_triad_errors.data()}) {
+    if (problem->HasParameterBlock(b) && !problem->IsParameterBlockConstant(b)) {
+      out.blocks.push_back(b);
+      out.size += problem->ParameterBlockTangentSize(b);
+    }
+  }
+  if (out.size != 12) return IntrinsicsBlocks();
+  return out;
+}
+
+// The free parameter blocks in elimination order: everything else, then the
+// intrinsics, the free groups of the 7 and rho (null: not kept), the last
+// `kept` tangent parameters being what the marginal covariance is of.
+struct MarginalOrder {
+  std::vector<double*> blocks;
+  std::vector<const Group*> free_groups;
+  int kept = 0;
+};
+
+Status OrderForMarginal(ceres::Problem* problem, const Group (&groups)[3],
+                        const IntrinsicsBlocks& intrinsics, double* clock_rate,
+                        MarginalOrder* order) {
+  std::vector<double*> blocks;
+  problem->GetParameterBlocks(&blocks);
+  std::vector<double*>& ordered = order->blocks;
+  for (double* b : blocks) {
+    const bool calibration = std::any_of(std::begin(groups), std::end(groups),
+                                         [b](const Group& g) { return g.block == b; });
+    const bool last = calibration ||
+                      std::find(intrinsics.blocks.begin(), intrinsics.blocks.end(), b) !=
+                          intrinsics.blocks.end() ||
+                      (clock_rate != nullptr && b == clock_rate);
+    if (!last && !problem->IsParameterBlockConstant(b)) ordered.push_back(b);
+  }
+  ordered.insert(ordered.end(), intrinsics.blocks.begin(), intrinsics.blocks.end());
+  int k = intrinsics.size;
+  for (const Group& g : groups) {
+    if (!problem->HasParameterBlock(g.block)) {
+      return Status::Error("covariance: the extrinsic / time offset is not in the problem");
+    }
+    if (problem->IsParameterBlockConstant(g.block)) continue;
+    ordered.push_back(g.block);
+    order->free_groups.push_back(&g);
+    k += g.size;
+  }
+  if (k == intrinsics.size) {
+    return Status::Error("covariance: the extrinsic and time offset are held constant");
+  }
+  if (clock_rate != nullptr) {
+    ordered.push_back(clock_rate);
+    ++k;
+  }
+  order->kept = k;
+  return Status::Ok();
+}
+
+// The Jacobian of every residual (robust loss applied) in the order's
+// columns, and the marginal covariance of its last `kept` columns.
+Status MarginalOfKept(ceres::Problem* problem, const MarginalOrder& order,
+                      const proto::ObservabilityParams& params, int num_threads,
+                      Eigen::MatrixXd* marginal) {
+  ceres::Problem::EvaluateOptions options;
+  options.parameter_blocks = order.blocks;
+  options.apply_loss_function = true;
+  options.num_threads = std::max(1, num_threads);
+  ceres::CRSMatrix crs;
+  if (!problem->Evaluate(options, nullptr, nullptr, nullptr, &crs)) {
+    return Status::Error("covariance: the residuals could not be evaluated");
+  }
+  const Eigen::Map<const Eigen::SparseMatrix<double, Eigen::RowMajor>> jacobian(
+      crs.num_rows, crs.num_cols, static_cast<Eigen::Index>(crs.values.size()), crs.rows.data(),
+      crs.cols.data(), crs.values.data());
+  return MarginalCovarianceOfLastColumns(jacobian, order.kept, params.min_relative_pivot(),
+                                         marginal);
+}
+
+// The free groups' blocks of the marginal (after the intrinsics' rows) into
+// the 7x7; held groups keep zero rows and columns.
+void CopyExtrinsicBlocks(const Eigen::MatrixXd& marginal, const MarginalOrder& order,
+                         int intrinsics_size, Matrix7d* covariance) {
+  int row = intrinsics_size;
+  for (const Group* gi : order.free_groups) {
+    int col = intrinsics_size;
+    for (const Group* gj : order.free_groups) {
+      covariance->block(gi->offset, gj->offset, gi->size, gj->size) =
+          marginal.block(row, col, gi->size, gj->size);
+      col += gj->size;
+    }
+    row += gi->size;
+  }
+}
+
+// rho's row (the marginal's last): its covariance with the free groups, then
+// its variance.
+void CopyClockRateRow(const Eigen::MatrixXd& marginal, const MarginalOrder& order,
+                      int intrinsics_size, std::vector<double>* clock_rate_row) {
+  const Eigen::Index rate = marginal.rows() - 1;
+  clock_rate_row->assign(8, 0.0);
+  int col = intrinsics_size;
+  for (const Group* g : order.free_groups) {
+    for (int j = 0; j < g->size; ++j) {
+      (*clock_rate_row)[static_cast<size_t>(g->offset + j)] = marginal(rate, col + j);
+    }
+    col += g->size;
+  }
+  (*clock_rate_row)[7] = marginal(rate, rate);
+}
+
+}  // namespace
+
 Status ComputeExtrinsicCovariance(ceres::Problem* problem, CalibrationState* state,
                                   const proto::ObservabilityParams& params, int num_threads,
                                   Matrix7d* covariance, Eigen::MatrixXd* intrinsics_covariance,
@@ -48,101 +176,24 @@ Status ComputeExtrinsicCovariance(ceres::Problem* problem, CalibrationState* sta
   if (intrinsics_covariance != nullptr) intrinsics_covariance->resize(0, 0);
   // The triad errors, marginalised last (before the 7) when asked for
   // and free.
-  std::vector<double*> intrinsics;
-  int intrinsics_size = 0;
-  if (intrinsics_covariance != nullptr) {
-    for (double* b : {state->gyro_triad_errors.data(), state->accel_triad_errors.data()}) {
-      if (problem->HasParameterBlock(b) && !problem->IsParameterBlockConstant(b)) {
-        intrinsics.push_back(b);
-        intrinsics_size += problem->ParameterBlockTangentSize(b);
-      }
-    }
-    if (intrinsics_size != 12) {
-      intrinsics.clear();
-      intrinsics_size = 0;
-    }
-  }
-  // The 7 tangent parameters in covariance order; a constant block (e.g. tau
-  // with a zero bound) keeps zero rows and columns.
-  struct Group {
-    double* block;
-    int offset;
-    int size;
-  };
+  const IntrinsicsBlocks intrinsics = intrinsics_covariance != nullptr
+                                          ? FreeIntrinsicsBlocks(problem, state)
+                                          : IntrinsicsBlocks();
+  // A constant block (e.g. tau with a zero bound) keeps zero rows and
+  // columns.
   const Group groups[] = {{state->imu_from_lidar_rotation, 0, 3},
                           {state->imu_from_lidar_translation, 3, 3},
                           {state->time_offset_s, 6, 1}};
-  std::vector<double*> blocks;
-  problem->GetParameterBlocks(&blocks);
-  std::vector<double*> ordered;
-  for (double* b : blocks) {
-    const bool calibration = std::any_of(std::begin(groups), std::end(groups),
-                                         [b](const Group& g) { return g.block == b; });
-    const bool last = calibration ||
-                      std::find(intrinsics.begin(), intrinsics.end(), b) != intrinsics.end() ||
-                      (with_rate && b == state->clock_rate);
-    if (!last && !problem->IsParameterBlockConstant(b)) ordered.push_back(b);
-  }
-  ordered.insert(ordered.end(), intrinsics.begin(), intrinsics.end());
-  int k = intrinsics_size;
-  std::vector<const Group*> free_groups;
-  for (const Group& g : groups) {
-    if (!problem->HasParameterBlock(g.block)) {
-      return Status::Error("covariance: the extrinsic / time offset is not in the problem");
-    }
-    if (problem->IsParameterBlockConstant(g.block)) continue;
-    ordered.push_back(g.block);
-    free_groups.push_back(&g);
-    k += g.size;
-  }
-  if (k == intrinsics_size) {
-    return Status::Error("covariance: the extrinsic and time offset are held constant");
-  }
-  if (with_rate) {
-    ordered.push_back(state->clock_rate);
-    ++k;
-  }
-
-  ceres::Problem::EvaluateOptions options;
-  options.parameter_blocks = ordered;
-  options.apply_loss_function = true;
-  options.num_threads = std::max(1, num_threads);
-  ceres::CRSMatrix crs;
-  if (!problem->Evaluate(options, nullptr, nullptr, nullptr, &crs)) {
-    return Status::Error("covariance: the residuals could not be evaluated");
-  }
-  const Eigen::Map<const Eigen::SparseMatrix<double, Eigen::RowMajor>> jacobian(
-      crs.num_rows, crs.num_cols, static_cast<Eigen::Index>(crs.values.size()), crs.rows.data(),
-      crs.cols.data(), crs.values.data());
+  MarginalOrder order;
+  TILTCAL_RETURN_IF_ERROR(OrderForMarginal(problem, groups, intrinsics,
+                                           with_rate ? state->clock_rate : nullptr, &order));
   Eigen::MatrixXd marginal;
-  TILTCAL_RETURN_IF_ERROR(
-      MarginalCovarianceOfLastColumns(jacobian, k, params.min_relative_pivot(), &marginal));
-  if (intrinsics_size > 0) {
-    *intrinsics_covariance = marginal.topLeftCorner(intrinsics_size, intrinsics_size);
+  TILTCAL_RETURN_IF_ERROR(MarginalOfKept(problem, order, params, num_threads, &marginal));
+  if (intrinsics.size > 0) {
+    *intrinsics_covariance = marginal.topLeftCorner(intrinsics.size, intrinsics.size);
   }
-  int row = intrinsics_size;
-  for (const Group* gi : free_groups) {
-    int col = intrinsics_size;
-    for (const Group* gj : free_groups) {
-      covariance->block(gi->offset, gj->offset, gi->size, gj->size) =
-          marginal.block(row, col, gi->size, gj->size);
-      col += gj->size;
-    }
-    row += gi->size;
-  }
-  if (with_rate) {
-    // rho's row: its covariance with the free groups, then its variance.
-    const Eigen::Index rate = marginal.rows() - 1;
-    clock_rate_row->assign(8, 0.0);
-    int col = intrinsics_size;
-    for (const Group* g : free_groups) {
-      for (int j = 0; j < g->size; ++j) {
-        (*clock_rate_row)[static_cast<size_t>(g->offset + j)] = marginal(rate, col + j);
-      }
-      col += g->size;
-    }
-    (*clock_rate_row)[7] = marginal(rate, rate);
-  }
+  CopyExtrinsicBlocks(marginal, order, intrinsics.size, covariance);
+  if (with_rate) CopyClockRateRow(marginal, order, intrinsics.size, clock_rate_row);
   return Status::Ok();
 }
 
@@ -210,10 +261,27 @@ std::string DescribeDirection(const Eigen::Vector3d& v) {
 
 namespace {
 
+// One 3x3 group of the covariance as the observability report names it:
+// its offset in the 7, the rotation of its directions into b, the factor to
+// the reported unit and the sigma above which a direction is weak.
+struct DirectionGroup {
+  const char* what;
+  const char* unit;
+  int offset;
+  Eigen::Matrix3d to_b;
+  double scale;
+  double threshold;
+};
+
 // Eigen-directions of a 3x3 covariance block, largest sigma first.
-void AddGroup(const Eigen::Matrix3d& cov_block, const Eigen::Matrix3d& to_b, int offset,
-              double scale, double threshold, const char* what, const char* unit,
+void AddGroup(const Eigen::Matrix3d& cov_block, const DirectionGroup& group,
               const MotionAxis& motion, proto::CalibrationResult* result) {
+  const Eigen::Matrix3d& to_b = group.to_b;
+  const int offset = group.offset;
+  const double scale = group.scale;
+  const double threshold = group.threshold;
+  const char* what = group.what;
+  const char* unit = group.unit;
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(0.5 * (cov_block + cov_block.transpose()));
   for (int i = 2; i >= 0; --i) {
     const double sigma = std::sqrt(std::max(0.0, eig.eigenvalues()[i])) * scale;
@@ -259,10 +327,13 @@ void FillCovarianceReport(const Matrix7d& covariance, const Eigen::Matrix3d& c_b
 
   result->clear_observability();
   // Marginal covariance of each group is the corresponding block.
-  AddGroup(covariance.block<3, 3>(0, 0), c_bl, 0, rad_to_deg, params.weak_rotation_sigma_deg(),
-           "rotation", "deg", motion, result);
-  AddGroup(covariance.block<3, 3>(3, 3), Eigen::Matrix3d::Identity(), 3, 1.0,
-           params.weak_translation_sigma_m(), "translation", "m", motion, result);
+  AddGroup(covariance.block<3, 3>(0, 0),
+           {"rotation", "deg", 0, c_bl, rad_to_deg, params.weak_rotation_sigma_deg()}, motion,
+           result);
+  AddGroup(covariance.block<3, 3>(3, 3),
+           {"translation", "m", 3, Eigen::Matrix3d::Identity(), 1.0,
+            params.weak_translation_sigma_m()},
+           motion, result);
   const double tau_sigma = std::sqrt(std::max(0.0, covariance(6, 6)));
   proto::ObservabilityDirection* d = result->add_observability();
   for (int j = 0; j < 7; ++j) d->add_direction(j == 6 ? 1.0 : 0.0);

@@ -164,9 +164,7 @@ double CostOf(const Scenario& sc, bool level, GroundResidualSelection selection,
   ceres::Problem problem{ProblemOptions()};
   AddStateBlocks(&state, &problem);
   GroundResidualSummary local;
-  const Status status = AddGroundResiduals(sc.Planes(), selection, UnitSigmaParams(),
-                                           InfoFor(sc, level), NoLosses(), kOriginNs, &state, &problem,
-                                           summary ? summary : &local);
+  const Status status = AddGroundResiduals({sc.Planes(), selection, UnitSigmaParams(), InfoFor(sc, level), NoLosses(), kOriginNs}, &state, &problem, summary ? summary : &local);
   EXPECT_TRUE(status.ok()) << status.message();
   double cost = 0.0;
   problem.Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr, nullptr, nullptr);
@@ -221,8 +219,7 @@ TEST(GroundResidualsTest, WrongExtrinsicGivesNonZeroResiduals) {
     AddStateBlocks(&state, &problem);
     GroundResidualSummary summary;
     const GroundResidualSelection sel = Only(false, kind == 0, kind == 1, kind == 2);
-    ASSERT_TRUE(AddGroundResiduals(truth.Planes(), sel, UnitSigmaParams(), InfoFor(truth, false),
-                                   NoLosses(), kOriginNs, &state, &problem, &summary)
+    ASSERT_TRUE(AddGroundResiduals({truth.Planes(), sel, UnitSigmaParams(), InfoFor(truth, false), NoLosses(), kOriginNs}, &state, &problem, &summary)
                     .ok());
     double cost = 0.0;
     problem.Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr, nullptr, nullptr);
@@ -252,8 +249,7 @@ TEST(GroundResidualsTest, InvalidAndOutOfSplinePlanesAreSkipped) {
   ceres::Problem problem{ProblemOptions()};
   AddStateBlocks(&state, &problem);
   GroundResidualSummary summary;
-  ASSERT_TRUE(AddGroundResiduals(planes, Only(true, true, true, true), UnitSigmaParams(),
-                                 InfoFor(sc, false), NoLosses(), kOriginNs, &state, &problem, &summary)
+  ASSERT_TRUE(AddGroundResiduals({planes, Only(true, true, true, true), UnitSigmaParams(), InfoFor(sc, false), NoLosses(), kOriginNs}, &state, &problem, &summary)
                   .ok());
   EXPECT_EQ(summary.num_planes, good + 6);
   EXPECT_EQ(summary.num_invalid, 4);
@@ -285,8 +281,7 @@ TEST(GroundResidualsTest, CauchyLossPerResidualType) {
   ceres::Problem problem{ProblemOptions()};
   AddStateBlocks(&state, &problem);
   GroundResidualSummary summary;
-  ASSERT_TRUE(AddGroundResiduals({plane}, Only(false, true, false, true), params,
-                                 InfoFor(sc, false), losses, kOriginNs, &state, &problem, &summary)
+  ASSERT_TRUE(AddGroundResiduals({{plane}, Only(false, true, false, true), params, InfoFor(sc, false), losses, kOriginNs}, &state, &problem, &summary)
                   .ok());
   double cost = 0.0;
   problem.Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr, nullptr, nullptr);
@@ -301,9 +296,7 @@ TEST(GroundResidualsTest, MissingParameterBlockIsAnError) {
   sc.FillState(&state);
   ceres::Problem problem{ProblemOptions()};  // no blocks added
   GroundResidualSummary summary;
-  const Status status = AddGroundResiduals(sc.Planes(), Only(false, true, false, false),
-                                           UnitSigmaParams(), InfoFor(sc, false), NoLosses(), kOriginNs,
-                                           &state, &problem, &summary);
+  const Status status = AddGroundResiduals({sc.Planes(), Only(false, true, false, false), UnitSigmaParams(), InfoFor(sc, false), NoLosses(), kOriginNs}, &state, &problem, &summary);
   EXPECT_FALSE(status.ok());
   EXPECT_NE(status.message().find("imu_from_lidar_rotation"), std::string::npos);
 }
@@ -347,8 +340,7 @@ TEST(GroundResidualsTest, PlaneCovarianceWhitening) {
     ceres::Problem problem{ProblemOptions()};
     AddStateBlocks(&state, &problem);
     GroundResidualSummary summary;
-    ASSERT_TRUE(AddGroundResiduals({plane}, Only(kind == 0, kind == 1, kind == 2, kind == 3),
-                                   params, info, NoLosses(), kOriginNs, &state, &problem, &summary)
+    ASSERT_TRUE(AddGroundResiduals({{plane}, Only(kind == 0, kind == 1, kind == 2, kind == 3), params, info, NoLosses(), kOriginNs}, &state, &problem, &summary)
                     .ok());
     EXPECT_EQ(summary.num_without_covariance, 0);
     double cost = 0.0;
@@ -389,8 +381,7 @@ TEST(GroundResidualsTest, PlaneCovarianceWhitening) {
   ceres::Problem problem{ProblemOptions()};
   AddStateBlocks(&state, &problem);
   GroundResidualSummary summary;
-  ASSERT_TRUE(AddGroundResiduals({bare}, Only(false, true, false, false), params, info, NoLosses(), kOriginNs,
-                                 &state, &problem, &summary)
+  ASSERT_TRUE(AddGroundResiduals({{bare}, Only(false, true, false, false), params, info, NoLosses(), kOriginNs}, &state, &problem, &summary)
                   .ok());
   EXPECT_EQ(summary.num_without_covariance, 1);
   EXPECT_EQ(summary.num_dist, 1);
@@ -414,8 +405,7 @@ TEST(GroundResidualsTest, DistAndUpRecoverTheirObservableDirections) {
     GroundResidualSummary summary;
     proto::GroundResidualsParams params = UnitSigmaParams();
     params.mutable_dist()->set_sigma(0.02);
-    ASSERT_TRUE(AddGroundResiduals(sc.Planes(), Only(false, true, false, false), params,
-                                   InfoFor(sc, false), NoLosses(), kOriginNs, &state, &problem, &summary)
+    ASSERT_TRUE(AddGroundResiduals({sc.Planes(), Only(false, true, false, false), params, InfoFor(sc, false), NoLosses(), kOriginNs}, &state, &problem, &summary)
                     .ok());
     problem.SetParameterBlockConstant(state.imu_from_lidar_rotation);
     ceres::Solver::Options options;
@@ -436,8 +426,7 @@ TEST(GroundResidualsTest, DistAndUpRecoverTheirObservableDirections) {
     ceres::Problem problem{ProblemOptions()};
     AddStateBlocks(&state, &problem);
     GroundResidualSummary summary;
-    ASSERT_TRUE(AddGroundResiduals(sc.Planes(), Only(false, false, false, true), UnitSigmaParams(),
-                                   InfoFor(sc, false), NoLosses(), kOriginNs, &state, &problem, &summary)
+    ASSERT_TRUE(AddGroundResiduals({sc.Planes(), Only(false, false, false, true), UnitSigmaParams(), InfoFor(sc, false), NoLosses(), kOriginNs}, &state, &problem, &summary)
                     .ok());
     ceres::Solver::Options options;
     options.linear_solver_type = ceres::DENSE_QR;
@@ -468,37 +457,41 @@ TEST(GroundResidualsTest, AdderForTheProblemBuilder) {
   gravity.mutable_gravity_flat_in_imu()->set_z(g_f.z());
   const proto::GroundResidualsParams params = UnitSigmaParams();
   const GroundLosses losses(params);
-  std::function<Status(CalibrationState*, ceres::Problem*, int*)> adder;
-  std::vector<std::string> used;
-  std::string reason;
-  ASSERT_TRUE(MakeGroundResidualAdder(planes, kOriginNs, rig, &gravity, params, &losses, nullptr,
-                                      &adder, &used, &reason)
-                  .ok());
-  EXPECT_EQ(used, (std::vector<std::string>{"dist", "incl"}));
-  EXPECT_EQ(reason.rfind("ground residuals dist+incl: ", 0), 0u) << reason;
-  ASSERT_TRUE(static_cast<bool>(adder));
+  GroundAdderInputs inputs;
+  inputs.planes = &planes;
+  inputs.time_origin_ns = kOriginNs;
+  inputs.rig = &rig;
+  inputs.gravity = &gravity;
+  inputs.params = &params;
+  inputs.losses = &losses;
+  GroundAdder ground;
+  ASSERT_TRUE(MakeGroundResidualAdder(inputs, &ground).ok());
+  EXPECT_EQ(ground.used, (std::vector<std::string>{"dist", "incl"}));
+  EXPECT_EQ(ground.reason.rfind("ground residuals dist+incl: ", 0), 0u) << ground.reason;
+  ASSERT_TRUE(static_cast<bool>(ground.add));
   CalibrationState state(sc.Grid());
   sc.FillState(&state);
   ceres::Problem problem{ProblemOptions()};
   AddStateBlocks(&state, &problem);
   int added = 0;
-  ASSERT_TRUE(adder(&state, &problem, &added).ok());
+  ASSERT_TRUE(ground.add(&state, &problem, &added).ok());
   EXPECT_EQ(added, 2 * static_cast<int>(planes.size()));
   EXPECT_EQ(problem.NumResidualBlocks(), added);
   // No planes: no adder, and the reason says why.
   const std::vector<proto::GroundPlane> none;
-  ASSERT_TRUE(MakeGroundResidualAdder(none, kOriginNs, rig, &gravity, params, &losses, nullptr,
-                                      &adder, &used, &reason)
-                  .ok());
-  EXPECT_FALSE(static_cast<bool>(adder));
-  EXPECT_TRUE(used.empty());
-  EXPECT_NE(reason.find("no ground planes"), std::string::npos) << reason;
+  GroundAdderInputs no_planes = inputs;
+  no_planes.planes = &none;
+  ASSERT_TRUE(MakeGroundResidualAdder(no_planes, &ground).ok());
+  EXPECT_FALSE(static_cast<bool>(ground.add));
+  EXPECT_TRUE(ground.used.empty());
+  EXPECT_NE(ground.reason.find("no ground planes"), std::string::npos) << ground.reason;
   // ON without its input is an error here too.
   proto::GroundResidualsParams on = params;
   on.mutable_up()->set_mode(proto::GroundResidualParams::ON);
-  EXPECT_FALSE(MakeGroundResidualAdder(planes, kOriginNs, rig, nullptr, on, &losses, nullptr,
-                                       &adder, &used, &reason)
-                   .ok());
+  GroundAdderInputs forced = inputs;
+  forced.gravity = nullptr;
+  forced.params = &on;
+  EXPECT_FALSE(MakeGroundResidualAdder(forced, &ground).ok());
 }
 
 // ------------------------------------------------------------ selection

@@ -84,9 +84,9 @@ TEST(TimeOffsetDriftTest, EndsAndTheirSigmas) {
   row[6] = 2e-12;                // cov(tau0, rho), s
   row[7] = 1e-14;                // var rho (0.1 ppm)
   const double var_tau0 = 1e-8;  // (0.1 ms)^2
+  TimeOffsetDriftEstimate estimate{0.012, -50e-6, {-1e-3, 1e-3}, row, var_tau0};
   proto::TimeOffsetDriftReport r;
-  FillTimeOffsetDriftReport(DriftParams(), decision, span, 0.012, -50e-6, {-1e-3, 1e-3}, row,
-                            var_tau0, 5e-4, &r);
+  FillTimeOffsetDriftReport(DriftParams(), decision, span, estimate, 5e-4, &r);
   EXPECT_TRUE(r.estimated());
   EXPECT_DOUBLE_EQ(r.rate_ppm(), 50.0);
   EXPECT_NEAR(r.rate_sigma_ppm(), 0.1, 1e-9);
@@ -97,9 +97,8 @@ TEST(TimeOffsetDriftTest, EndsAndTheirSigmas) {
   EXPECT_NEAR(r.time_offset_end_sigma_s(),
               std::sqrt(var_tau0 + 6400.0 * 1e-14 + 2.0 * 80.0 * 2e-12), 1e-15);
   EXPECT_FALSE(r.weak());  // 0.1 ppm over 160 s: 16 us
-  row[7] = 4e-11;          // 6.3 ppm: tau at the ends known to 0.52 ms
-  FillTimeOffsetDriftReport(DriftParams(), decision, span, 0.012, -50e-6, {-1e-3, 1e-3}, row,
-                            var_tau0, 5e-4, &r);
+  estimate.covariance_row[7] = 4e-11;  // 6.3 ppm: tau at the ends known to 0.52 ms
+  FillTimeOffsetDriftReport(DriftParams(), decision, span, estimate, 5e-4, &r);
   EXPECT_TRUE(r.weak());
   EXPECT_NE(DescribeTimeOffsetDrift(r).find("+50.0 ± 6.3 ppm"), std::string::npos)
       << DescribeTimeOffsetDrift(r);
