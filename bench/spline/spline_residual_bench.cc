@@ -37,9 +37,9 @@
 #include "common/spline/knot_grid.h"
 #include "common/spline/quaternion_manifold.h"
 #include "common/spline/spline_trajectory.h"
-#include "stages/calibrate/accel_cost_function.h"
-#include "stages/calibrate/gyro_cost_function.h"
-#include "stages/calibrate/point_to_plane_cost_function.h"
+#include "stages/calibrate/residuals/accel_cost_function.h"
+#include "stages/calibrate/residuals/gyro_cost_function.h"
+#include "stages/calibrate/residuals/point_to_plane_cost_function.h"
 #include "tests/testing/cost_function_twins.h"
 
 namespace tiltcal {

@@ -27,8 +27,8 @@
 
 #include "common/imu/imu_reading.h"
 #include "common/status.h"
-#include "stages/calibrate/calibration_state.h"
-#include "stages/calibrate/lidar_scans.h"
+#include "stages/calibrate/problem/calibration_state.h"
+#include "stages/calibrate/problem/lidar_scans.h"
 #include "tiltcal/proto/calibrate_params.pb.h"
 #include "tiltcal/proto/calibration.pb.h"
 #include "tiltcal/proto/gravity.pb.h"

@@ -6,8 +6,8 @@
 #include <google/protobuf/text_format.h>
 
 #include "common/io/params.h"
-#include "stages/calibrate/bias_segments.h"
 #include "stages/calibrate/default_params_text.h"
+#include "stages/calibrate/problem/bias_segments.h"
 
 namespace tiltcal::calibrate {
 namespace {

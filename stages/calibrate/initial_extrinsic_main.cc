@@ -6,7 +6,7 @@
 
 #include "common/cli/command_line.h"
 #include "stages/calibrate/calibrate_params_validation.h"
-#include "stages/calibrate/initial_extrinsic.h"
+#include "stages/calibrate/init/initial_extrinsic.h"
 
 namespace {
 

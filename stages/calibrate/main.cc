@@ -6,7 +6,7 @@
 #include "common/cli/command_line.h"
 #include "stages/calibrate/calibrate.h"
 #include "stages/calibrate/calibrate_params_validation.h"
-#include "stages/calibrate/verdict.h"
+#include "stages/calibrate/report/verdict.h"
 
 namespace {
 

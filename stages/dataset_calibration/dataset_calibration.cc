@@ -16,7 +16,7 @@
 #include "common/io/eigen_proto.h"
 #include "common/io/provenance.h"
 #include "common/io/text_proto.h"
-#include "stages/calibrate/covariance_report.h"
+#include "stages/calibrate/report/covariance_report.h"
 
 namespace tiltcal::dataset {
 namespace {

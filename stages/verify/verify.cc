@@ -11,8 +11,8 @@
 #include "common/io/provenance.h"
 #include "common/io/text_proto.h"
 #include "stages/calibrate/calibrate.h"
-#include "stages/calibrate/initial_extrinsic.h"
-#include "stages/calibrate/map_sharpness.h"
+#include "stages/calibrate/init/initial_extrinsic.h"
+#include "stages/calibrate/report/map_sharpness.h"
 #include "stages/verify/reference_comparison.h"
 
 namespace tiltcal::verify {

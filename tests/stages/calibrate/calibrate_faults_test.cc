@@ -18,11 +18,11 @@
 #include "common/io/eigen_proto.h"
 #include "common/io/record_stream.h"
 #include "common/io/text_proto.h"
-#include "tiltcal/proto/imu.pb.h"
-#include "tiltcal/proto/simulate_params.pb.h"
-#include "stages/calibrate/rotation_from_motion.h"
+#include "stages/calibrate/init/rotation_from_motion.h"
 #include "tests/stages/calibrate/short_sequence_fixture.h"
 #include "tests/stages/calibrate/simulated_calibration.h"
+#include "tiltcal/proto/imu.pb.h"
+#include "tiltcal/proto/simulate_params.pb.h"
 
 namespace tiltcal::calibrate {
 namespace {

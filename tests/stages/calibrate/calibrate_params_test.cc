@@ -12,10 +12,10 @@
 
 #include "common/io/atomic_file.h"
 #include "common/io/params.h"
-#include "stages/calibrate/bias_segments.h"
 #include "stages/calibrate/calibrate.h"
 #include "stages/calibrate/calibrate_params_validation.h"
 #include "stages/calibrate/default_params_text.h"
+#include "stages/calibrate/problem/bias_segments.h"
 #include "tests/stages/calibrate/calibrate_params_text.h"
 #include "tests/testing/test_env.h"
 
