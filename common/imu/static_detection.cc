@@ -41,29 +41,22 @@ StaticInterval Statistics(const std::vector<ImuReading>& samples, size_t begin, 
   return s;
 }
 
-}  // namespace
+// A maximal run of static windows, [begin_s, end_s].
+struct StaticRun {
+  double begin_s = 0.0;
+  double end_s = 0.0;
+};
 
-std::vector<StaticInterval> DetectStaticIntervals(const std::vector<ImuReading>& samples,
-                                                  const StaticDetectionOptions& options) {
-  std::vector<StaticInterval> intervals;
-  if (samples.size() < 2 || !(options.window_s > 0.0) || !(options.hop_s > 0.0)) {
-    return intervals;
-  }
+// The runs of static windows of `samples` (the window tests of
+// DetectStaticIntervals), in time order, whatever their duration.
+std::vector<StaticRun> FindStaticRuns(const std::vector<ImuReading>& samples,
+                                      const StaticDetectionOptions& options) {
+  std::vector<StaticRun> runs;
+  if (samples.size() < 2 || !(options.window_s > 0.0) || !(options.hop_s > 0.0)) return runs;
   const double t0 = samples.front().time_s;
   const double t_last = samples.back().time_s;
   bool in_run = false;
-  double run_begin = 0.0, run_end = 0.0;
-  auto close_run = [&] {
-    if (in_run && run_end - run_begin >= options.min_duration_s) {
-      StaticInterval interval = Statistics(samples, LowerIndex(samples, run_begin),
-                                           LowerIndex(samples, run_end));
-      interval.found = true;
-      interval.begin_s = run_begin;
-      interval.end_s = run_end;
-      intervals.push_back(interval);
-    }
-    in_run = false;
-  };
+  auto close_run = [&] { in_run = false; };
   // Windows holding fewer than two samples are never static; the loop jumps
   // over them to the first window that can reach the next sample, so the
   // work is bounded by the samples (times window_s / hop_s), not by the span
@@ -89,15 +82,51 @@ std::vector<StaticInterval> DetectStaticIntervals(const std::vector<ImuReading>&
                            s.accel_std_mps2 <= options.max_accel_std_mps2 &&
                            s.mean_gyro_radps.norm() <= options.max_gyro_mean_radps;
     if (is_static) {
-      if (!in_run) run_begin = begin_t;
+      if (!in_run) runs.push_back({begin_t, end_t});
       in_run = true;
-      run_end = end_t;
+      runs.back().end_s = end_t;
     } else {
       close_run();
     }
     ++k;
   }
-  close_run();
+  return runs;
+}
+
+// The runs found on the low-passed readings, with a run that reaches (within
+// a hop) the edge the filter's half span left out extended to the readings'
+// first or last time.
+std::vector<StaticRun> FindLowPassedStaticRuns(const std::vector<ImuReading>& samples,
+                                               const StaticDetectionOptions& options) {
+  const std::vector<ImuReading> low = LowPassAndDecimateImu(samples, options.low_pass, 1);
+  std::vector<StaticRun> runs = FindStaticRuns(low, options);
+  if (runs.empty()) return runs;
+  if (runs.front().begin_s <= low.front().time_s + 1e-9) {
+    runs.front().begin_s = samples.front().time_s;
+  }
+  if (runs.back().end_s >= low.back().time_s - options.hop_s) {
+    runs.back().end_s = samples.back().time_s;
+  }
+  return runs;
+}
+
+}  // namespace
+
+std::vector<StaticInterval> DetectStaticIntervals(const std::vector<ImuReading>& samples,
+                                                  const StaticDetectionOptions& options) {
+  const std::vector<StaticRun> runs = options.low_pass.cutoff_hz > 0.0
+                                          ? FindLowPassedStaticRuns(samples, options)
+                                          : FindStaticRuns(samples, options);
+  std::vector<StaticInterval> intervals;
+  for (const StaticRun& run : runs) {
+    if (run.end_s - run.begin_s < options.min_duration_s) continue;
+    StaticInterval interval =
+        Statistics(samples, LowerIndex(samples, run.begin_s), LowerIndex(samples, run.end_s));
+    interval.found = true;
+    interval.begin_s = run.begin_s;
+    interval.end_s = run.end_s;
+    intervals.push_back(interval);
+  }
   return intervals;
 }
 

@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 
 #include "common/imu/imu_reading.h"
+#include "common/imu/vibration.h"
 
 namespace tiltcal::imu {
 
@@ -18,6 +19,11 @@ struct StaticDetectionOptions {
   double max_accel_std_mps2;  // per-axis standard deviation bound, m/s²
   double max_gyro_mean_radps;  // |mean gyro| bound (rules out steady turning), rad/s
   double min_duration_s;  // shorter static runs are not reported
+  // The window tests run on the zero-phase low-pass of the readings at this
+  // cut-off (common/imu/vibration.h), so that an engine or wheels the IMU
+  // feels while the vehicle stands (vibration far above the cut-off) do not
+  // hide a still interval; 0: on the readings as recorded.
+  LowPassOptions low_pass;
 };
 
 // A time interval in which the IMU stood still: [begin_s, end_s] and the
@@ -35,7 +41,13 @@ struct StaticInterval {
 };
 
 // Every maximal run of static windows lasting at least min_duration_s, in
-// time order. Window k covers [t0 + k hop, t0 + k hop + window); it is static
+// time order.
+// With low_pass.cutoff_hz > 0 the windows are tested on the low-passed
+// readings, which lack the first and last low_pass.span_s / 2 (the filter's
+// half span); a run that begins within one hop of the low-passed readings'
+// first sample begins at the first reading, and likewise at the end. The
+// interval's indices, means and standard deviations are those of the
+// readings as recorded (a zero-mean vibration averages out of the means). Window k covers [t0 + k hop, t0 + k hop + window); it is static
 // when every axis of gyro and accelerometer has a standard deviation below the
 // bounds and the mean gyro norm is below max_gyro_mean_radps. Samples must be
 // valid (ValidateImuReadings).

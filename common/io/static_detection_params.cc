@@ -10,6 +10,9 @@ imu::StaticDetectionOptions ToStaticDetectionOptions(const proto::StaticDetectio
   options.max_accel_std_mps2 = params.max_accel_std_mps2();
   options.max_gyro_mean_radps = params.max_gyro_mean_radps();
   options.min_duration_s = params.min_duration_s();
+  options.low_pass.cutoff_hz = params.low_pass().cutoff_hz();
+  options.low_pass.span_s = params.low_pass().span_s();
+  options.low_pass.max_gap_s = params.low_pass().max_gap_s();
   return options;
 }
 

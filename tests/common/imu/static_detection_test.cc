@@ -171,6 +171,72 @@ TEST(StaticDetection, StampFarInTheFutureIsBoundedWork) {
   ExpectSameIntervals(DetectStaticIntervals(readings, StaticDetectionTestOptions()), reference);
 }
 
+// The still-and-turning readings of FindsEveryStillIntervalWithItsMeans with
+// an engine's vibration on every sample: 0.3 m/s² and 0.02 rad/s at 23.7 Hz.
+std::vector<ImuReading> VibratingStillAndTurning(const Eigen::Vector3d& bias) {
+  std::vector<ImuReading> readings = testing::SyntheticImu(
+      200, 10, Omega, Eigen::Quaterniond::Identity(), {0, 0, -9.81}, bias, 0.001, 0.01, nullptr);
+  const double w = 2.0 * M_PI * 23.7;
+  for (ImuReading& r : readings) {
+    r.linear_acceleration_mps2 += 0.3 * Eigen::Vector3d(std::sin(w * r.time_s),
+                                                         std::cos(w * r.time_s),
+                                                         std::sin(w * r.time_s + 1.0));
+    r.angular_velocity_radps += 0.02 * Eigen::Vector3d(std::cos(w * r.time_s), 0.0,
+                                                       std::sin(w * r.time_s));
+  }
+  return readings;
+}
+
+StaticDetectionOptions LowPassedTestOptions() {
+  StaticDetectionOptions options = StaticDetectionTestOptions();
+  options.low_pass.cutoff_hz = 5.0;
+  options.low_pass.span_s = 0.5;
+  options.low_pass.max_gap_s = 0.1;
+  return options;
+}
+
+TEST(StaticDetection, VibrationHidesStillnessFromTheRecordedReadings) {
+  // The test below is needed: on the readings as recorded a vibrating IMU
+  // never looks still.
+  const auto readings = VibratingStillAndTurning(Eigen::Vector3d::Zero());
+  EXPECT_TRUE(DetectStaticIntervals(readings, StaticDetectionTestOptions()).empty());
+}
+
+TEST(StaticDetection, LowPassFindsTheStillIntervalsOfAVibratingImu) {
+  const Eigen::Vector3d bias(0.002, -0.001, 0.003);
+  const auto readings = VibratingStillAndTurning(bias);
+  const StaticDetectionOptions options = LowPassedTestOptions();
+  const auto intervals = DetectStaticIntervals(readings, options);
+  ASSERT_EQ(intervals.size(), 2u);
+  // The static start begins at the first reading (the filter's half span
+  // before its first low-passed sample is given to the run that reaches it).
+  EXPECT_EQ(intervals[0].begin_index, 0u);
+  EXPECT_NEAR(intervals[0].begin_s, 0.0, 1e-9);
+  // The low-pass spreads the motion's onset by at most its half span: the
+  // intervals end no later than the truth and not much earlier.
+  EXPECT_LE(intervals[0].end_s, 3.0 + 1e-9);
+  EXPECT_GE(intervals[0].end_s, 3.0 - 0.25 - options.hop_s);
+  EXPECT_GE(intervals[1].begin_s, 6.0 - 1e-9);
+  EXPECT_LE(intervals[1].begin_s, 6.0 + 0.25 + options.hop_s);
+  EXPECT_LE(intervals[1].end_s, 8.0 + 1e-9);
+  EXPECT_GE(intervals[1].end_s, 8.0 - 0.25 - options.hop_s);
+  // The means are the recorded readings': the vibration averages out.
+  EXPECT_LT((intervals[0].mean_gyro_radps - bias).norm(), 3e-4);
+  EXPECT_LT((intervals[0].mean_accel_mps2 - Eigen::Vector3d(0, 0, 9.81)).norm(), 3e-3);
+  EXPECT_TRUE(DetectStaticStart(readings, options).found);
+}
+
+TEST(StaticDetection, LowPassKeepsTheStillIntervalsOfACleanImu) {
+  const auto readings = testing::SyntheticImu(200, 10, Omega, Eigen::Quaterniond::Identity(),
+                                              {0, 0, -9.81}, Eigen::Vector3d::Zero(), 0.001,
+                                              0.01, nullptr);
+  const auto intervals = DetectStaticIntervals(readings, LowPassedTestOptions());
+  ASSERT_EQ(intervals.size(), 2u);
+  EXPECT_EQ(intervals[0].begin_index, 0u);
+  EXPECT_GE(intervals[0].end_s, 2.65);
+  EXPECT_LE(intervals[0].end_s, 3.0 + 1e-9);
+}
+
 TEST(ImuReadings, ValidationNamesTheSample) {
   std::vector<ImuReading> readings(3);
   readings[1].time_s = 0.1;
