@@ -350,14 +350,14 @@ TEST_F(DecodeCli, ImuInGAndDegreesIsConvertedAndSaid) {
   std::string output;
   ASSERT_EQ(Decode(bag, params_, &output, "--rig=" + WriteRigWithTopics()), 0) << output;
   const std::string accel_line =
-      "  imu: accelerometer in g, detected: median |f| 1.0003 over 400 static samples; "
+      "  imu: accelerometer in g, detected: median |f| 1.0002 over 410 static samples; "
       "converted to m/s² (× 9.80665)\n";
   const std::string gyro_line =
       "  imu: gyro in deg/s, detected: |ω| at percentile 99 is 34.6, above 5 rad/s, the fastest "
       "turn of a ground vehicle; converted to rad/s (× π/180)\n";
   EXPECT_NE(output.find(accel_line), std::string::npos) << output;
   EXPECT_NE(output.find(gyro_line), std::string::npos) << output;
-  EXPECT_NE(output.find("  imu: accelerometer sign checked: the mean specific force over 400 "
+  EXPECT_NE(output.find("  imu: accelerometer sign checked: the mean specific force over 410 "
                         "static samples, (0.002, 0.003, 9.810) m/s² in the IMU frame, points "
                         "0.0 deg from the LiDAR's +z"),
             std::string::npos)
@@ -369,7 +369,7 @@ TEST_F(DecodeCli, ImuInGAndDegreesIsConvertedAndSaid) {
                 &info),
             0)
       << info;
-  EXPECT_NE(info.find("notes: \"accelerometer in g, detected: median |f| 1.0003"),
+  EXPECT_NE(info.find("notes: \"accelerometer in g, detected: median |f| 1.0002"),
             std::string::npos)
       << info;
   EXPECT_NE(info.find("notes: \"gyro in deg/s, detected:"), std::string::npos) << info;
@@ -383,7 +383,7 @@ TEST_F(DecodeCli, RigStatingTheWrongAccelerometerUnit) {
   EXPECT_EQ(rc, 1);
   EXPECT_EQ(output, "tiltcal_decode: " + rig + ": imu_accel_unit is MPS2 but the accelerometer of " +
                         bag +
-                        " reads in g: median |f| 1.0003 over 400 static samples (one g is 9.81 "
+                        " reads in g: median |f| 1.0002 over 410 static samples (one g is 9.81 "
                         "in m/s², 1 in g)\n");
   ExpectCleanFailure(rc, output, {});
 }
@@ -443,7 +443,7 @@ TEST_F(DecodeCli, SignFlippedAccelerometer) {
   EXPECT_EQ(rc, 1);
   EXPECT_EQ(output,
             "tiltcal_decode: " + rig +
-                ": the mean specific force over 400 static samples, (-0.002, -0.003, -9.810) "
+                ": the mean specific force over 410 static samples, (-0.002, -0.003, -9.810) "
                 "m/s² in the IMU frame, points 180.0 deg from up (−gravity_flat_in_imu of the "
                 "rig; more than 90): the accelerometer of " +
                 bag +
@@ -454,7 +454,7 @@ TEST_F(DecodeCli, SignFlippedAccelerometer) {
 
   ASSERT_EQ(Decode(bag, params_, &output, "--rig=" + WriteRigWithTopics()), 0) << output;
   const std::string warning =
-      "  WARNING: imu: the mean specific force over 400 static samples, (-0.002, -0.003, "
+      "  WARNING: imu: the mean specific force over 410 static samples, (-0.002, -0.003, "
       "-9.810) m/s² in the IMU frame, points 180.0 deg from the LiDAR's +z (through "
       "imu_from_lidar of the rig; more than 90): the accelerometer publishes gravity instead of "
       "specific force (sign-flipped), or the rig's rotation is wrong (an IMU mounted upside "

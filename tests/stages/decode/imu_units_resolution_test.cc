@@ -90,8 +90,10 @@ TEST(ResolveImuUnits, ZDownImuDeclaredByTheRigPassesTheSignCheck) {
             std::string::npos);
 }
 
-// A specific force whose mean has no clear direction (here: half the
-// samples flipped) is not used for the sign; said so.
+// A specific force whose mean has no clear direction (here: every other
+// sample flipped) is not used for the sign; said so. The flips are at the
+// Nyquist frequency, which the static detection's low-pass removes: the
+// still start is found, and its mean force is near zero.
 TEST(ResolveImuUnits, MeanForceWithoutDirectionIsNotChecked) {
   std::vector<imu::ImuReading> readings = testing::VehicleBagImu(12.0);
   for (size_t i = 0; i < readings.size(); i += 2) readings[i].linear_acceleration_mps2 *= -1.0;
@@ -102,6 +104,18 @@ TEST(ResolveImuUnits, MeanForceWithoutDirectionIsNotChecked) {
       {"a.bag", "rig.txtpb"}, params.imu_units(), &resolution);
   ASSERT_TRUE(status.ok()) << status.message();
   EXPECT_TRUE(resolution.warnings.empty());
+  EXPECT_NE(AllNotes(resolution).find("accelerometer sign not checked: the mean specific force "
+                                      "over 410 static samples is 0.00"),
+            std::string::npos)
+      << AllNotes(resolution);
+  EXPECT_NE(AllNotes(resolution).find("(no clear direction at rest)"), std::string::npos)
+      << AllNotes(resolution);
+  // On the readings as recorded no interval is still; the mean is taken over all.
+  params.mutable_imu_units()->mutable_static_detection()->clear_low_pass();
+  ASSERT_TRUE(ResolveImuUnits(readings,
+                              testing::ParamsFromText<proto::Rig>("imu_from_lidar { rotation { w: 1 } }"),
+                              {"a.bag", "rig.txtpb"}, params.imu_units(), &resolution)
+                  .ok());
   EXPECT_NE(AllNotes(resolution).find("accelerometer sign not checked: the mean specific force "
                                       "over all 2401 samples (no static interval) is"),
             std::string::npos)

@@ -101,7 +101,7 @@ TEST_F(UnitsAndClocks, ImuInGAndDegreesGivesTheSameStreamAsSi) {
   EXPECT_EQ(g_summary.gyro_to_si, M_PI / 180.0);
   const std::string si_notes = Notes(si_summary);
   const std::string g_notes = Notes(g_summary);
-  EXPECT_NE(si_notes.find("accelerometer in m/s², detected: median |f| 9.809"), std::string::npos)
+  EXPECT_NE(si_notes.find("accelerometer in m/s², detected: median |f| 9.8089"), std::string::npos)
       << si_notes;
   EXPECT_NE(si_notes.find("static samples; written as published"), std::string::npos)
       << si_notes;
