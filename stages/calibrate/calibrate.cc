@@ -51,6 +51,7 @@ Status ReadCalibrateInputs(const CalibratePaths& paths, const proto::CalibratePa
   TILTCAL_RETURN_IF_ERROR(LoadRigWithExtrinsic(paths.rig, &inputs->rig));
   TILTCAL_RETURN_IF_ERROR(
       ReadImuReadings(paths.imu, &inputs->imu, &inputs->first_imu_stamp_ns));
+  inputs->imu_source = paths.imu;
   TILTCAL_RETURN_IF_ERROR(ReadClockDriftNote(paths.imu, &inputs->clock_drift));
   TILTCAL_RETURN_IF_ERROR(
       ReadLidarScans(paths.scans, inputs->first_imu_stamp_ns, params.scans(), &inputs->scans));
@@ -302,6 +303,23 @@ Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& pa
   return Status::Ok();
 }
 
+Status CalibrateSequence(const proto::CalibrateParams& params, CalibrateInputs* inputs,
+                         proto::CalibrationResult* result, CalibrationState* final_state,
+                         std::ostream* log) {
+  proto::CalibrateParams solve = params;
+  proto::ImuVibrationReport vibration;
+  TILTCAL_RETURN_IF_ERROR(HandleImuVibration(params.imu_vibration(), &inputs->imu,
+                                             solve.mutable_imu_noise(), &vibration)
+                              .WithContext(inputs->imu_source));
+  inputs->imu_decimation = vibration.decimation();
+  const std::string vibration_note = DescribeImuVibration(vibration);
+  if (!vibration_note.empty()) Log(log, vibration_note);
+  TILTCAL_RETURN_IF_ERROR(Calibrate(*inputs, solve, result, final_state, log));
+  *result->mutable_imu_vibration() = vibration;
+  if (!vibration_note.empty()) result->add_verdict_notes(vibration_note);
+  return Status::Ok();
+}
+
 Status Run(const CalibratePaths& paths, const proto::CalibrateParams& params, std::ostream* log,
            proto::CalibrationResult* written) {
   const auto start = Clock::now();
@@ -320,20 +338,9 @@ Status Run(const CalibratePaths& paths, const proto::CalibrateParams& params, st
     Log(log, fmt::format("no translation guess: prior sigma {} m at zero",
                          params.unknown_translation_prior_sigma_m()));
   }
-  // The solve weighs filtered readings with the thinned sigmas
-  // (imu_vibration.h); the provenance keeps imu_noise as given, so that the
-  // recorded params rerun to the same result.
-  proto::CalibrateParams solve = used;
-  proto::ImuVibrationReport vibration;
-  TILTCAL_RETURN_IF_ERROR(HandleImuVibration(params.imu_vibration(), &inputs.imu,
-                                             solve.mutable_imu_noise(), &vibration)
-                              .WithContext(paths.imu));
-  inputs.imu_decimation = vibration.decimation();
-  const std::string vibration_note = DescribeImuVibration(vibration);
-  if (!vibration_note.empty()) Log(log, vibration_note);
-  TILTCAL_RETURN_IF_ERROR(Calibrate(inputs, solve, &result, &final_state, log));
-  *result.mutable_imu_vibration() = vibration;
-  if (!vibration_note.empty()) result.add_verdict_notes(vibration_note);
+  // The provenance keeps imu_noise as given, so that the recorded params
+  // rerun to the same result.
+  TILTCAL_RETURN_IF_ERROR(CalibrateSequence(used, &inputs, &result, &final_state, log));
   TILTCAL_RETURN_IF_ERROR(WriteMaps(paths, params, inputs, final_state, log));
   proto::PhaseTiming* t = result.add_timings();
   t->set_phase("read_inputs");

@@ -56,6 +56,7 @@ struct CalibratePaths {
 struct CalibrateInputs {
   std::vector<imu::ImuReading> imu;  // times from first_imu_stamp_ns
   int64_t first_imu_stamp_ns = 0;
+  std::string imu_source;  // where imu was read from (names it in errors)
   std::vector<LidarScan> scans;
   std::vector<proto::GroundPlane> ground;  // may be empty
   bool has_gravity = false;
@@ -78,6 +79,15 @@ Status ReadCalibrateInputs(const CalibratePaths& paths, const proto::CalibratePa
 Status Calibrate(const CalibrateInputs& inputs, const proto::CalibrateParams& params,
                  proto::CalibrationResult* result, CalibrationState* final_state,
                  std::ostream* log);
+
+// Calibrate on the readings as tiltcal_calibrate weighs them: a vibrating
+// IMU is first low-passed and thinned (report/imu_vibration.h: *inputs'
+// readings are replaced and the solve weighs them with the thinned sigmas,
+// params' imu_noise divided by sqrt of the thinning); its report and note go
+// into *result.
+Status CalibrateSequence(const proto::CalibrateParams& params, CalibrateInputs* inputs,
+                         proto::CalibrationResult* result, CalibrationState* final_state,
+                         std::ostream* log);
 
 // Reads, calibrates, writes the maps when asked and then calibration.txtpb,
 // each atomically, the calibration with provenance;

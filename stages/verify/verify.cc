@@ -91,7 +91,7 @@ Status VerifySequence(const std::string& dir, const VerifyPaths& paths,
   calibrate::CalibrationState state(
       spline::UniformKnotGrid::ForDuration(0.0, 1.0, calibrate_params.spline().knot_spacing_s()));
   const Status calibrated =
-      calibrate::Calibrate(inputs, calibrate_params, &estimate, &state, nullptr);
+      calibrate::CalibrateSequence(calibrate_params, &inputs, &estimate, &state, nullptr);
   if (!calibrated.ok()) {
     if (!calibrated.not_determined()) return calibrated.WithContext(dir);
     out->set_verdict(proto::VerifyResult::CANNOT_TELL);
