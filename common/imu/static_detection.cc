@@ -56,7 +56,6 @@ std::vector<StaticRun> FindStaticRuns(const std::vector<ImuReading>& samples,
   const double t0 = samples.front().time_s;
   const double t_last = samples.back().time_s;
   bool in_run = false;
-  auto close_run = [&] { in_run = false; };
   // Windows holding fewer than two samples are never static; the loop jumps
   // over them to the first window that can reach the next sample, so the
   // work is bounded by the samples (times window_s / hop_s), not by the span
@@ -68,7 +67,7 @@ std::vector<StaticRun> FindStaticRuns(const std::vector<ImuReading>& samples,
     const size_t begin = LowerIndex(samples, begin_t);
     const size_t end = LowerIndex(samples, end_t);
     if (end < begin + 2) {  // too sparse to judge
-      close_run();
+      in_run = false;
       // First window whose end reaches the sample after samples[begin].
       const double next_t = samples[std::min(begin + 1, samples.size() - 1)].time_s;
       const double k_reach = std::floor((next_t - options.window_s - t0) / options.hop_s);
@@ -86,7 +85,7 @@ std::vector<StaticRun> FindStaticRuns(const std::vector<ImuReading>& samples,
       in_run = true;
       runs.back().end_s = end_t;
     } else {
-      close_run();
+      in_run = false;
     }
     ++k;
   }
