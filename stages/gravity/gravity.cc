@@ -79,7 +79,8 @@ void AddInclinationSamples(const GravityInputs& inputs, const imu::ImuInitialisa
     *sample->mutable_up_in_imu() = ToProto(up_in_imu);
     ups->push_back(up_in_imu);
     if (plane.valid()) {
-      const double slope = AngleBetweenDeg(up_in_imu, imu_from_lidar * ToEigen(plane.normal_in_lidar()));
+      const double slope =
+          AngleBetweenDeg(up_in_imu, imu_from_lidar * ToEigen(plane.normal_in_lidar()));
       sample->set_ground_slope_deg(slope);
       slopes->push_back(slope);
     }
