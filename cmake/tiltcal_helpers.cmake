@@ -8,6 +8,12 @@ check_linker_flag(CXX -fuse-ld=lld TILTCAL_HAVE_LLD)
 
 function(tiltcal_set_target_options target)
   target_compile_options(${target} PRIVATE -Wall -Wextra -Wno-unused-parameter)
+  if(TILTCAL_UNITY_BUILD AND CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
+    # In a batch a file is no longer the main file, and GCC then warns about
+    # a class with external linkage holding a type of an anonymous namespace
+    # (subobject-linkage), which the same file compiled alone does not.
+    target_compile_options(${target} PRIVATE -Wno-subobject-linkage)
+  endif()
   if(TILTCAL_HAVE_LLD)
     target_link_options(${target} PRIVATE -fuse-ld=lld)
   endif()
@@ -82,12 +88,17 @@ function(tiltcal_use_pch target kind)
 endfunction()
 
 # tiltcal_add_library(NAME SRCS ... DEPS ... [OWN_PCH])
+# A unity build with TILTCAL_UNITY_BUILD (default): the sources are compiled
+# in batches of 8 as one file each, so the headers and templates they share
+# are compiled once per batch. Names at file scope, anonymous namespaces
+# included, must then differ between the files of one library.
 # OWN_PCH: the target makes its own precompiled header (for options that
 # change what the headers define or how they compile, as -fopenmp does, or
 # PCL's -fPIC).
 function(tiltcal_add_library)
   cmake_parse_arguments(ARG "OWN_PCH" "NAME" "SRCS;DEPS" ${ARGN})
   add_library(${ARG_NAME} STATIC ${ARG_SRCS})
+  set_target_properties(${ARG_NAME} PROPERTIES UNITY_BUILD ${TILTCAL_UNITY_BUILD})
   target_include_directories(${ARG_NAME} PUBLIC ${PROJECT_SOURCE_DIR} ${PROJECT_BINARY_DIR}/generated)
   target_link_libraries(${ARG_NAME} PUBLIC ${ARG_DEPS})
   tiltcal_set_target_options(${ARG_NAME})
@@ -132,10 +143,11 @@ endfunction()
 #                  [ONE_PROCESS_SUITES SUITE ...])
 # One GoogleTest executable; every test case is registered with CTest. Tests
 # find the shared fixtures and the project tree through compile definitions.
-# The executable is a unity build: its sources are compiled as one file, so
-# the headers and templates they share are compiled once for it (about half
-# the CPU time of compiling them one by one). Names at file scope, anonymous
-# namespaces included, must then differ between the files of one executable.
+# The executable is a unity build (TILTCAL_UNITY_BUILD): its sources are
+# compiled in batches as one file, so the headers and templates they share
+# are compiled once per batch (about half the CPU time of compiling them one
+# by one). Names at file scope, anonymous namespaces included, must then
+# differ between the files of one executable.
 # COST: about the seconds of its slowest test case. ctest -j starts the tests
 # of highest cost first; a fresh build has no timings of an earlier run, and
 # without it the long tests declared last would run alone at the end.
@@ -148,7 +160,7 @@ function(tiltcal_add_test)
   add_executable(${ARG_NAME} ${ARG_SRCS})
   target_link_libraries(${ARG_NAME} PRIVATE ${ARG_DEPS} tiltcal_testing GTest::gtest GTest::gtest_main)
   set_target_properties(${ARG_NAME} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR}/tests
-                                               UNITY_BUILD ON)
+                                               UNITY_BUILD ${TILTCAL_UNITY_BUILD})
   tiltcal_set_target_options(${ARG_NAME})
   tiltcal_use_pch(${ARG_NAME} TEST)
   if(NOT ARG_LABELS)

@@ -3,7 +3,7 @@
 # clang, ASan + UBSan (float-cast-overflow included, stop at the first
 # finding) and libFuzzer coverage, only what the I/O, bag and decode tests
 # and the fuzz harnesses need; runs those tests; then runs each harness for
-# FUZZ_SECONDS (default 10) from its committed seed corpus (fuzz/corpus/).
+# FUZZ_SECONDS (default 5) from its committed seed corpus (fuzz/corpus/).
 # Tests and harnesses run JOBS (default: the number of cores) at a time; each
 # harness still gets its FUZZ_SECONDS. New inputs go to a temporary
 # directory; a crash leaves its input as crash-* in $BUILD_DIR/fuzz-artifacts/
@@ -14,7 +14,7 @@ cd "$(dirname "$0")/.."
 source scripts/phase_time.sh
 source scripts/compiler_cache.sh
 BUILD_DIR=${SANITIZE_BUILD_DIR:-build-sanitize}
-FUZZ_SECONDS=${FUZZ_SECONDS:-10}
+FUZZ_SECONDS=${FUZZ_SECONDS:-5}
 JOBS=${JOBS:-$(nproc)}
 FUZZERS=(ros1_bag_reader_fuzzer record_stream_fuzzer text_proto_fuzzer point_cloud2_fuzzer
          cdr_messages_fuzzer mcap_reader_fuzzer sqlite_bag_reader_fuzzer

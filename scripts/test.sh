@@ -11,7 +11,9 @@ scripts/setup.sh --cluster
 # benchmarks (bench/, run by hand, never by a test) left out.
 scripts/build.sh -DTILTCAL_WERROR=ON -DTILTCAL_BUILD_TESTS=ON -DTILTCAL_BUILD_BENCHMARKS=OFF
 source scripts/phase_time.sh
-(cd "${BUILD_DIR:-build}" && ctest --output-on-failure -j "$(nproc)" "$@")
+# One test more than the cores: some wait much of their time (make's lock
+# trials, the Slurm daemons, the browser), and a core would stay idle.
+(cd "${BUILD_DIR:-build}" && ctest --output-on-failure -j "$(($(nproc) + 1))" "$@")
 phase_done ctest
 # The parsers under ASan + UBSan and a few seconds of fuzzing each
 # (scripts/sanitize_and_fuzz.sh); SKIP_SANITIZERS=1 leaves them out.

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 namespace tiltcal::geometry {
 
@@ -15,6 +16,7 @@ namespace tiltcal::geometry {
 // last bit (about 1e-16 relative).
 inline constexpr double kDegPerRad = 180.0 / M_PI;  // deg per rad
 inline constexpr double kRadPerDeg = M_PI / 180.0;  // rad per deg
+inline constexpr double kTwoPi = 2.0 * M_PI;       // rad per turn
 
 constexpr double RadToDeg(double angle_rad) { return angle_rad * 180.0 / M_PI; }
 constexpr double DegToRad(double angle_deg) { return angle_deg * M_PI / 180.0; }
@@ -25,6 +27,13 @@ inline Eigen::Vector3d RadToDeg(const Eigen::Vector3d& angles_rad) {
 }
 inline Eigen::Vector3d DegToRad(const Eigen::Vector3d& angles_deg) {
   return angles_deg * M_PI / 180.0;
+}
+
+// Angle between two non-zero vectors, deg in [0, 180]:
+// atan2(|a × b|, a · b), accurate at every angle (acos of the normalised dot
+// product loses precision near 0 and 180 deg).
+inline double AngleBetweenDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return std::atan2(a.cross(b).norm(), a.dot(b)) * kDegPerRad;
 }
 
 }  // namespace tiltcal::geometry

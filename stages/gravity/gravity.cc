@@ -24,11 +24,7 @@ namespace tiltcal::gravity {
 
 namespace {
 
-using geometry::kDegPerRad;
-
-double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  return kDegPerRad * std::atan2(a.cross(b).norm(), a.dot(b));
-}
+using geometry::AngleBetweenDeg;
 
 // Linear-interpolated percentile (0..100) of non-empty `values`.
 double Percentile(std::vector<double> values, double percentile) {
@@ -83,7 +79,8 @@ void AddInclinationSamples(const GravityInputs& inputs, const imu::ImuInitialisa
     *sample->mutable_up_in_imu() = ToProto(up_in_imu);
     ups->push_back(up_in_imu);
     if (plane.valid()) {
-      const double slope = AngleDeg(up_in_imu, imu_from_lidar * ToEigen(plane.normal_in_lidar()));
+      const double slope =
+          AngleBetweenDeg(up_in_imu, imu_from_lidar * ToEigen(plane.normal_in_lidar()));
       sample->set_ground_slope_deg(slope);
       slopes->push_back(slope);
     }
@@ -132,7 +129,7 @@ void SetFlatGravity(const GravityInputs& inputs, double gravity_norm_mps2,
     *out->mutable_gravity_from_calibration() = inputs.flat_calibration->gravity_in_world();
   }
   if (from_static && from_calibration) {
-    out->set_sources_disagreement_deg(AngleDeg(ToEigen(out->gravity_from_static()),
+    out->set_sources_disagreement_deg(AngleBetweenDeg(ToEigen(out->gravity_from_static()),
                                                ToEigen(out->gravity_from_calibration())));
   }
   if (from_static || from_calibration) {
@@ -168,7 +165,7 @@ Status EstimateGravityReference(const GravityInputs& inputs, const proto::Gravit
   if (out->has_gravity_flat()) {
     const Eigen::Vector3d up_flat = -ToEigen(out->gravity_flat_in_imu()).normalized();
     for (int i = 0; i < out->inclination_size(); ++i) {
-      out->mutable_inclination(i)->set_inclination_deg(AngleDeg(ups[i], up_flat));
+      out->mutable_inclination(i)->set_inclination_deg(AngleBetweenDeg(ups[i], up_flat));
     }
   }
   return Status::Ok();

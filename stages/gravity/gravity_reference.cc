@@ -16,11 +16,8 @@
 namespace tiltcal::gravity {
 namespace {
 
+using geometry::AngleBetweenDeg;
 using geometry::kDegPerRad;
-
-double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  return std::atan2(a.cross(b).norm(), a.dot(b)) * kDegPerRad;
-}
 
 std::string FormatVector(const Eigen::Vector3d& v) {
   return fmt::format("({:.6g}, {:.6g}, {:.6g})", v.x(), v.y(), v.z());
@@ -88,8 +85,8 @@ Status CheckCommonDirection(const std::vector<FlatCalibration>& calibrations,
       const FlatCalibration& cb = calibrations[used[b]];
       const Eigen::Vector3d ga = ToEigen(ca.result.gravity_in_world());
       const Eigen::Vector3d gb = ToEigen(cb.result.gravity_in_world());
-      if (AngleDeg(ga, gb) > widest_deg) {
-        widest_deg = AngleDeg(ga, gb);
+      if (AngleBetweenDeg(ga, gb) > widest_deg) {
+        widest_deg = AngleBetweenDeg(ga, gb);
         pair = fmt::format("{} g_a {} and {} g_a {}", ca.path, FormatVector(ga), cb.path,
                            FormatVector(gb));
       }
@@ -149,7 +146,7 @@ Status CombineFlatCalibrations(const std::vector<FlatCalibration>& calibrations,
   std::string far;
   for (proto::FlatCalibrationGravity& entry : *out->mutable_flat_calibrations()) {
     if (!entry.used()) continue;
-    entry.set_angle_from_combined_deg(AngleDeg(ToEigen(entry.gravity_in_imu()), g_f));
+    entry.set_angle_from_combined_deg(AngleBetweenDeg(ToEigen(entry.gravity_in_imu()), g_f));
     max_angle_deg = std::max(max_angle_deg, entry.angle_from_combined_deg());
     if (entry.angle_from_combined_deg() > params.max_angle_from_combined_deg()) {
       far += fmt::format("; {}: {:.3f} deg (g_a {})", entry.calibration(),

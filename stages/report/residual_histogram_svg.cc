@@ -10,8 +10,6 @@
 namespace tiltcal::report {
 namespace {
 
-// Plot area in SVG units: x in [kLeft, kLeft + kWidth], y down from kTop.
-constexpr double kLeft = 30, kTop = 22, kWidth = 240, kHeight = 110;
 constexpr double kMaxDensity = 0.6;  // the normal's peak is 0.399
 
 double NormalDensity(double r) { return std::exp(-0.5 * r * r) / std::sqrt(2.0 * M_PI); }
@@ -19,6 +17,8 @@ double NormalDensity(double r) { return std::exp(-0.5 * r * r) / std::sqrt(2.0 *
 }  // namespace
 
 std::string ResidualHistogramSvg(const proto::ResidualStatistics& s) {
+  // Plot area in SVG units: x in [kLeft, kLeft + kWidth], y down from kTop.
+  constexpr double kLeft = 30, kTop = 22, kWidth = 240, kHeight = 110;
   const int bins = s.histogram_counts_size();
   const double w = s.histogram_bin_width();
   if (bins == 0 || w <= 0 || s.count() <= 0) {

@@ -9,15 +9,11 @@
 #include "stages/report/html_escape.h"
 
 namespace tiltcal::report {
-namespace {
-
-// Plot area in SVG units: x in [kLeft, kLeft + kWidth], y down from kTop;
-// r in [-kRange, kRange].
-constexpr double kLeft = 30, kTop = 22, kWidth = 480, kHeight = 120, kRange = 5;
-
-}  // namespace
 
 std::string ResidualTimeSvg(const proto::ResidualStatistics& s) {
+  // Plot area in SVG units: x in [kLeft, kLeft + kWidth], y down from kTop;
+  // r in [-kRange, kRange].
+  constexpr double kLeft = 30, kTop = 22, kWidth = 480, kHeight = 120, kRange = 5;
   const int bins = s.time_bin_count_size();
   const double w = s.time_bin_s();
   if (bins == 0 || !(w > 0) || s.time_bin_rms_size() != bins || s.time_bin_p05_size() != bins ||

@@ -2,13 +2,12 @@
 
 #include <cmath>
 
+#include "common/geometry/angles.h"
 #include "stages/simulate/random.h"
 
 namespace tiltcal::simulate {
 
-namespace {
-constexpr double kTwoPi = 2.0 * M_PI;
-}  // namespace
+using geometry::kTwoPi;
 
 ImuVibration::ImuVibration(const proto::SimImuVibration& p, uint64_t seed)
     : frequency_hz_(p.frequency_hz()),

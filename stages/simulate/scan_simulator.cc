@@ -4,13 +4,14 @@
 #include <cmath>
 #include <limits>
 
+#include "common/geometry/angles.h"
 #include "stages/simulate/random.h"
 
 namespace tiltcal::simulate {
 
 namespace {
 
-constexpr double kTwoPi = 2.0 * M_PI;
+using geometry::kTwoPi;
 
 int VelodyneSequences(const ScanConfig& config) {
   return static_cast<int>(std::floor(1.0 / (config.scan_rate_hz * config.model.sequence_period_s)));

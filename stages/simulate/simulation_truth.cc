@@ -11,7 +11,7 @@
 namespace tiltcal::simulate {
 namespace {
 
-using geometry::kDegPerRad;
+using geometry::AngleBetweenDeg;
 
 // The unit quaternion of `rotation` with w >= 0, the form written to disk.
 proto::Rigid3 RigidToProto(const Eigen::Matrix3d& rotation, const Eigen::Vector3d& translation) {
@@ -20,11 +20,6 @@ proto::Rigid3 RigidToProto(const Eigen::Matrix3d& rotation, const Eigen::Vector3
   if (q.w() < 0) q.coeffs() = -q.coeffs();
   return ToProto(Rigid3d{q, translation});
 }
-
-double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  return std::atan2(a.cross(b).norm(), a.dot(b)) * kDegPerRad;
-}
-
 
 // The values the faults drew (only for the faults the scenario has, so a
 // clean scenario's truth keeps its fields).
@@ -78,10 +73,10 @@ void FillTruthScan(const Scenario& scenario, const TruthFrames& f, const Simulat
   ts->set_true_stamp_ns(start_ns + true_rel_ns);
   *ts->mutable_ground_normal_in_lidar() = ToProto(Eigen::Vector3d(c_wl.transpose() * f.n_w));
   ts->set_ground_height_m(f.n_w.dot(r_wl));  // the plane passes through the origin
-  ts->set_inclination_deg(AngleDeg(f.n_w, f.up_w));
+  ts->set_inclination_deg(AngleBetweenDeg(f.n_w, f.up_w));
   *ts->mutable_world_from_imu() =
       RigidToProto(f.c_aw * s.world_from_imu, f.c_aw * (s.position_w - f.r_wb0));
-  ts->set_vehicle_inclination_deg(AngleDeg(s.world_from_imu.transpose() * f.up_w, f.up_f));
+  ts->set_vehicle_inclination_deg(AngleBetweenDeg(s.world_from_imu.transpose() * f.up_w, f.up_f));
   ts->set_num_points(scan.num_valid);
   ts->set_num_ground_points(scan.num_ground);
 }
@@ -115,7 +110,7 @@ void FillSequenceTruth(const proto::SimulateParams& params, const Scenario& scen
   truth->set_gyro_noise_density_radps_sqrthz(ip.gyro_noise_density_radps_sqrthz());
   truth->set_accel_noise_density_mps2_sqrthz(ip.accel_noise_density_mps2_sqrthz());
   *truth->mutable_world_from_sim_world() = RigidToProto(f.c_aw, -f.c_aw * f.r_wb0);
-  truth->set_inclination_deg(AngleDeg(f.n_w, f.up_w));
+  truth->set_inclination_deg(AngleBetweenDeg(f.n_w, f.up_w));
   truth->set_time_offset_ns(scenario.time_offset_ns);
   truth->set_imu_clock_shift_ns(scenario.imu_clock_shift_ns);
   if (params.has_faults()) *truth->mutable_faults() = params.faults();

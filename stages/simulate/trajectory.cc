@@ -3,12 +3,13 @@
 #include <algorithm>
 #include <cmath>
 
+#include "common/geometry/angles.h"
 #include "common/geometry/euler_angles.h"
 
 namespace tiltcal::simulate {
 
 namespace {
-constexpr double kTwoPi = 2.0 * M_PI;
+using geometry::kTwoPi;
 // Frequency ratio of the pitch vibration to the roll vibration (incommensurate).
 constexpr double kPitchFrequencyRatio = 1.37;
 }  // namespace

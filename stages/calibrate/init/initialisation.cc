@@ -12,6 +12,7 @@
 #include "common/geometry/angles.h"
 #include "common/imu/gyro_integrator.h"
 #include "common/io/static_detection_params.h"
+#include "common/spline/linear_interpolation.h"
 #include "common/spline/so3_spline.h"
 #include "stages/calibrate/init/coarse_time_offset.h"
 #include "stages/calibrate/init/init_odometry.h"
@@ -74,16 +75,6 @@ double SolveFit(const proto::CalibrateParams& params, ceres::Problem* problem) {
   ceres::Solver::Summary summary;
   ceres::Solve(solver, problem, &summary);
   return RmsResidual(summary);
-}
-
-// Linear interpolation of (times, values) at t, clamped at the ends.
-Eigen::Vector3d Interpolate(const std::vector<double>& times,
-                            const std::vector<Eigen::Vector3d>& values, double t) {
-  if (t <= times.front()) return values.front();
-  if (t >= times.back()) return values.back();
-  const size_t i = std::upper_bound(times.begin(), times.end(), t) - times.begin();
-  const double f = (t - times[i - 1]) / (times[i] - times[i - 1]);
-  return (1.0 - f) * values[i - 1] + f * values[i];
 }
 
 }  // namespace
@@ -210,7 +201,8 @@ double FitPositionSpline(const std::vector<double>& times_s,
   }
   if (times.empty()) return 0.0;
   for (int i = 0; i < traj.num_knots(); ++i) {
-    traj.SetPositionKnot(i, Interpolate(times, imu_positions, grid.t0_s() + (i - 1) * grid.dt_s()));
+    const double knot_time_s = grid.t0_s() + (i - 1) * grid.dt_s();
+    traj.SetPositionKnot(i, spline::InterpolateLinearly(times, imu_positions, knot_time_s));
   }
   // The accelerometer bias and g_a are estimated with the positions: with
   // the bias held at 0, its double integral (~ b t^2 / 2, metres within
@@ -253,7 +245,6 @@ double FitPositionSpline(const std::vector<double>& times_s,
 }
 
 namespace {
-
 
 // Step 4: an error when the motion turned too little to decide the rotation
 // (MissingTurning); else C_bl from the rig, or hand-eye when excited; without
@@ -342,7 +333,6 @@ Eigen::Quaterniond RefineHeading(const OdometryRun& run, const std::vector<Lidar
   }
   return anchor;
 }
-
 
 // Scans whose sweep at t_l + tau is not inside the IMU's spline.
 int CountScansOutsideImu(const std::vector<LidarScan>& scans, const CalibrationState& state) {

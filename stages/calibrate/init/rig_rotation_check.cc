@@ -8,22 +8,13 @@
 #include <fmt/format.h>
 
 #include "common/geometry/angles.h"
+#include "common/spline/linear_interpolation.h"
 #include "common/spline/so3_spline.h"
 
 namespace tiltcal::calibrate {
 namespace {
 
 using geometry::kDegPerRad;
-
-// Linear interpolation of (times, values) at t; t within the span.
-Eigen::Vector3d Interpolate(const std::vector<double>& times,
-                            const std::vector<Eigen::Vector3d>& values, double t) {
-  if (t <= times.front()) return values.front();
-  if (t >= times.back()) return values.back();
-  const size_t i = std::upper_bound(times.begin(), times.end(), t) - times.begin();
-  const double f = (t - times[i - 1]) / (times[i] - times[i - 1]);
-  return (1.0 - f) * values[i - 1] + f * values[i];
-}
 
 // World acceleration of the IMU, C_ab f_m + g_a, per IMU sample inside the
 // spline (times and values).
@@ -157,9 +148,9 @@ AccelerationCheck CheckRigYawByAccelerations(const CalibrationState& state,
       continue;
     }
     const Eigen::Vector3d lidar_l0 =
-        (Interpolate(lidar_times_s, lidar_positions_l0, t + h) -
-         2.0 * Interpolate(lidar_times_s, lidar_positions_l0, t) +
-         Interpolate(lidar_times_s, lidar_positions_l0, t - h)) / (h * h);
+        (spline::InterpolateLinearly(lidar_times_s, lidar_positions_l0, t + h) -
+         2.0 * spline::InterpolateLinearly(lidar_times_s, lidar_positions_l0, t) +
+         spline::InterpolateLinearly(lidar_times_s, lidar_positions_l0, t - h)) / (h * h);
     Eigen::Vector3d u = b0_from_a * (imu_mean + (q_plus - 2.0 * q_0 + q_minus) / (h * h));
     Eigen::Vector3d w = c_bl * lidar_l0;
     u -= axis * axis.dot(u);
