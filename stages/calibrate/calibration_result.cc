@@ -47,27 +47,88 @@ void FillStartingExtrinsicNotes(const proto::Rig& rig, const CalibrationState& s
   }
 }
 
+// The covariance (and rho's row, when the drift is estimated) with the data's
+// information divided by one variance factor, the priors' kept
+// (ScaleDataInformation): the translation prior and rho's.
+void ScaleByOneFactor(double sigma0_squared, double clock_rate_prior_sigma,
+                      const proto::CalibrationResult& result, Matrix7d* cov,
+                      std::vector<double>* clock_rate_row) {
+  Matrix7d prior_information = Matrix7d::Zero();
+  prior_information.block<3, 3>(3, 3) = geometry::TranslationPriorInformation(
+      result.translation_prior_sigma_m(), ToEigen(result.translation_prior_axis_b()));
+  if (clock_rate_row->size() != 8) {
+    *cov = ScaleDataInformation(*cov, prior_information, sigma0_squared);
+    return;
+  }
+  // The 7 and rho together; rho's prior (decode's rate) kept unscaled.
+  Eigen::MatrixXd full = Eigen::MatrixXd::Zero(8, 8);
+  full.topLeftCorner<7, 7>() = *cov;
+  for (int j = 0; j < 8; ++j) {
+    full(7, j) = full(j, 7) = (*clock_rate_row)[static_cast<size_t>(j)];
+  }
+  Eigen::MatrixXd prior_full = Eigen::MatrixXd::Zero(8, 8);
+  prior_full.topLeftCorner<7, 7>() = prior_information;
+  if (clock_rate_prior_sigma > 0.0) {
+    prior_full(7, 7) = 1.0 / (clock_rate_prior_sigma * clock_rate_prior_sigma);
+  }
+  full = ScaleDataInformation(full, prior_full, sigma0_squared);
+  *cov = full.topLeftCorner<7, 7>();
+  for (int j = 0; j < 8; ++j) (*clock_rate_row)[static_cast<size_t>(j)] = full(7, j);
+}
+
+// The variance components per residual type of the default sample's problem
+// into the result, and their weights.
+Status FillVarianceComponents(const SolvedCalibration& solved, proto::CalibrationResult* result,
+                              ResidualTypeWeights* weights) {
+  std::vector<VarianceComponent> components;
+  TILTCAL_RETURN_IF_ERROR(ComputeResidualTypeComponents(
+      ReportProblem(solved.loop)->problem(), solved.inputs.imu_decimation != 1,
+      solved.params.observability(), static_cast<int>(solved.params.num_threads()),
+      &components));
+  result->clear_variance_components();
+  for (int t = 0; t < kNumResidualTypes; ++t) {
+    const VarianceComponent& c = components[static_cast<size_t>(t)];
+    (*weights)[static_cast<size_t>(t)] = c.weight;
+    if (c.rows == 0) continue;
+    proto::VarianceComponentReport* r = result->add_variance_components();
+    r->set_type(ResidualTypeName(static_cast<ResidualType>(t)));
+    r->set_rows(c.rows);
+    r->set_redundancy(c.redundancy);
+    r->set_variance_factor(c.sigma0_squared);
+    r->set_weight(c.weight);
+  }
+  return Status::Ok();
+}
+
 }  // namespace
 
 void FillCovariance(const SolvedCalibration& solved, proto::CalibrationResult* result,
                     CovarianceExtras* extras) {
   const CalibrateInputs& inputs = solved.inputs;
   const proto::CalibrateParams& params = solved.params;
+  const proto::ObservabilityParams& observability = params.observability();
   CalibrationProblem* problem = solved.loop.problem.get();
   CalibrationProblem* noise_problem = ReportProblem(solved.loop);
   CalibrationState* state = solved.state;
-  const double clock_rate_prior_sigma = solved.drift.decision.prior_sigma;
   Eigen::MatrixXd* intrinsics_covariance = &extras->intrinsics_covariance;
   std::vector<double>* clock_rate_row = &extras->clock_rate_row;
   const auto start = Clock::now();
   intrinsics_covariance->resize(0, 0);
   clock_rate_row->clear();
-  if (params.observability().compute_covariance()) {
+  if (observability.compute_covariance()) {
+    const bool per_type = observability.scale_by_variance_factor() &&
+                          observability.variance_factors() == proto::ObservabilityParams::PER_TYPE;
+    ResidualTypeWeights weights;
+    weights.fill(1.0);
+    Status cs = per_type ? FillVarianceComponents(solved, result, &weights) : Status::Ok();
     Matrix7d cov;
-    Status cs = ComputeExtrinsicCovariance(
-        problem->problem(), state, params.observability(), static_cast<int>(params.num_threads()),
-        &cov, intrinsics_covariance,
-        ClockRateInProblem(*state, *problem->problem()) ? clock_rate_row : nullptr);
+    if (cs.ok()) {
+      cs = ComputeExtrinsicCovariance(
+          problem->problem(), state, observability, static_cast<int>(params.num_threads()), &cov,
+          intrinsics_covariance,
+          ClockRateInProblem(*state, *problem->problem()) ? clock_rate_row : nullptr,
+          per_type ? &weights : nullptr);
+    }
     if (cs.ok()) {
       const VarianceFactor factor = ComputeVarianceFactor(noise_problem->problem());
       result->set_variance_factor(factor.sigma0_squared);
@@ -76,29 +137,12 @@ void FillCovariance(const SolvedCalibration& solved, proto::CalibrationResult* r
       // residuals' RMS says nothing of their noise, so a factor below 1
       // must not shrink the covariance on their account.
       const bool shrink_allowed = inputs.imu_decimation == 1 || factor.sigma0_squared > 1.0;
-      if (params.observability().scale_by_variance_factor() && factor.redundancy > 0 &&
-          shrink_allowed) {
-        Matrix7d prior_information = Matrix7d::Zero();
-        prior_information.block<3, 3>(3, 3) = geometry::TranslationPriorInformation(
-            result->translation_prior_sigma_m(), ToEigen(result->translation_prior_axis_b()));
-        if (clock_rate_row->size() == 8) {
-          // The 7 and rho together; rho's prior (decode's rate) kept unscaled.
-          Eigen::MatrixXd full = Eigen::MatrixXd::Zero(8, 8);
-          full.topLeftCorner<7, 7>() = cov;
-          for (int j = 0; j < 8; ++j) {
-            full(7, j) = full(j, 7) = (*clock_rate_row)[static_cast<size_t>(j)];
-          }
-          Eigen::MatrixXd prior_full = Eigen::MatrixXd::Zero(8, 8);
-          prior_full.topLeftCorner<7, 7>() = prior_information;
-          if (clock_rate_prior_sigma > 0.0) {
-            prior_full(7, 7) = 1.0 / (clock_rate_prior_sigma * clock_rate_prior_sigma);
-          }
-          full = ScaleDataInformation(full, prior_full, factor.sigma0_squared);
-          cov = full.topLeftCorner<7, 7>();
-          for (int j = 0; j < 8; ++j) (*clock_rate_row)[static_cast<size_t>(j)] = full(7, j);
-        } else {
-          cov = ScaleDataInformation(cov, prior_information, factor.sigma0_squared);
-        }
+      if (per_type) {
+        result->set_covariance_scaled_by_variance_factor(true);
+      } else if (observability.scale_by_variance_factor() && factor.redundancy > 0 &&
+                 shrink_allowed) {
+        ScaleByOneFactor(factor.sigma0_squared, solved.drift.decision.prior_sigma, *result, &cov,
+                         clock_rate_row);
         result->set_covariance_scaled_by_variance_factor(true);
       }
       // A covariance that is not finite is no covariance (SUSPECT), never
@@ -112,7 +156,7 @@ void FillCovariance(const SolvedCalibration& solved, proto::CalibrationResult* r
       const MotionAxis motion = PrincipalRotationAxis(inputs.imu, state->GyroBias());
       *result->mutable_motion_rotation_axis_b() = ToProto(motion.axis_b);
       FillCovarianceReport(cov, state->ImuFromLidarRotation().toRotationMatrix(), motion,
-                           params.observability(), result);
+                           observability, result);
     } else {
       clock_rate_row->clear();
       proto::ObservabilityDirection* d = result->add_observability();

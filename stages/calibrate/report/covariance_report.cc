@@ -7,13 +7,12 @@
 #include <utility>
 #include <vector>
 
-#include <ceres/crs_matrix.h>
-
 #include <Eigen/Eigenvalues>
 #include <Eigen/SparseCore>
 
 #include "common/geometry/angles.h"
 #include "stages/calibrate/report/marginal_covariance.h"
+#include "stages/calibrate/report/typed_jacobian.h"
 
 namespace tiltcal::calibrate {
 
@@ -110,22 +109,25 @@ Status OrderForMarginal(ceres::Problem* problem, const Group (&groups)[3],
 }
 
 // The Jacobian of every residual (robust loss applied) in the order's
-// columns, and the marginal covariance of its last `kept` columns.
+// columns, each residual type's rows weighted by type_weights (none: 1), and
+// the marginal covariance of its last `kept` columns.
 Status MarginalOfKept(ceres::Problem* problem, const MarginalOrder& order,
                       const proto::ObservabilityParams& params, int num_threads,
-                      Eigen::MatrixXd* marginal) {
-  ceres::Problem::EvaluateOptions options;
-  options.parameter_blocks = order.blocks;
-  options.apply_loss_function = true;
-  options.num_threads = std::max(1, num_threads);
-  ceres::CRSMatrix crs;
-  if (!problem->Evaluate(options, nullptr, nullptr, nullptr, &crs)) {
-    return Status::Error("covariance: the residuals could not be evaluated");
+                      const ResidualTypeWeights* type_weights, Eigen::MatrixXd* marginal) {
+  TypedJacobian typed;
+  const Status evaluated = EvaluateTypedJacobian(problem, order.blocks, num_threads, &typed);
+  if (!evaluated.ok()) return Status::Error("covariance: " + evaluated.message());
+  if (type_weights != nullptr) {
+    for (int r = 0; r < typed.jacobian.outerSize(); ++r) {
+      const double scale =
+          std::sqrt((*type_weights)[static_cast<size_t>(typed.row_type[static_cast<size_t>(r)])]);
+      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(typed.jacobian, r); it;
+           ++it) {
+        it.valueRef() *= scale;
+      }
+    }
   }
-  const Eigen::Map<const Eigen::SparseMatrix<double, Eigen::RowMajor>> jacobian(
-      crs.num_rows, crs.num_cols, static_cast<Eigen::Index>(crs.values.size()), crs.rows.data(),
-      crs.cols.data(), crs.values.data());
-  return MarginalCovarianceOfLastColumns(jacobian, order.kept, params.min_relative_pivot(),
+  return MarginalCovarianceOfLastColumns(typed.jacobian, order.kept, params.min_relative_pivot(),
                                          marginal);
 }
 
@@ -166,7 +168,8 @@ void CopyClockRateRow(const Eigen::MatrixXd& marginal, const MarginalOrder& orde
 Status ComputeExtrinsicCovariance(ceres::Problem* problem, CalibrationState* state,
                                   const proto::ObservabilityParams& params, int num_threads,
                                   Matrix7d* covariance, Eigen::MatrixXd* intrinsics_covariance,
-                                  std::vector<double>* clock_rate_row) {
+                                  std::vector<double>* clock_rate_row,
+                                  const ResidualTypeWeights* type_weights) {
   covariance->setZero();
   if (clock_rate_row != nullptr) clock_rate_row->clear();
   // rho, marginalised last when asked for and free.
@@ -188,7 +191,8 @@ Status ComputeExtrinsicCovariance(ceres::Problem* problem, CalibrationState* sta
   TILTCAL_RETURN_IF_ERROR(OrderForMarginal(problem, groups, intrinsics,
                                            with_rate ? state->clock_rate : nullptr, &order));
   Eigen::MatrixXd marginal;
-  TILTCAL_RETURN_IF_ERROR(MarginalOfKept(problem, order, params, num_threads, &marginal));
+  TILTCAL_RETURN_IF_ERROR(
+      MarginalOfKept(problem, order, params, num_threads, type_weights, &marginal));
   if (intrinsics.size > 0) {
     *intrinsics_covariance = marginal.topLeftCorner(intrinsics.size, intrinsics.size);
   }
@@ -216,6 +220,28 @@ VarianceFactor ComputeVarianceFactor(ceres::Problem* problem) {
   out.redundancy = redundancy;
   out.sigma0_squared = 2.0 * cost / static_cast<double>(redundancy);
   return out;
+}
+
+Status ComputeResidualTypeComponents(ceres::Problem* problem, bool imu_filtered,
+                                     const proto::ObservabilityParams& params, int num_threads,
+                                     std::vector<VarianceComponent>* components) {
+  std::vector<double*> blocks;
+  problem->GetParameterBlocks(&blocks);
+  blocks.erase(std::remove_if(blocks.begin(), blocks.end(),
+                              [problem](double* b) { return problem->IsParameterBlockConstant(b); }),
+               blocks.end());
+  TypedJacobian typed;
+  const Status evaluated = EvaluateTypedJacobian(problem, blocks, num_threads, &typed);
+  if (!evaluated.ok()) return Status::Error("variance components: " + evaluated.message());
+  std::vector<VarianceComponentGroup> groups(kNumResidualTypes);
+  for (int t = 0; t < kNumResidualTypes; ++t) {
+    VarianceComponentGroup& g = groups[static_cast<size_t>(t)];
+    g.square_sum = typed.square_sum[static_cast<size_t>(t)];
+    g.estimated = t != kOther;
+    g.may_shrink = t == kLidar || (!imu_filtered && (t == kGyro || t == kAccel));
+  }
+  return EstimateVarianceComponents(typed.jacobian, typed.row_type, groups,
+                                    params.min_relative_pivot(), components);
 }
 
 Matrix7d ScaleDataInformation(const Matrix7d& covariance, const Matrix7d& prior_information,

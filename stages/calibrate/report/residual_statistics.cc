@@ -4,39 +4,11 @@
 #include <cmath>
 #include <functional>
 
-#include "stages/calibrate/residuals/accel_cost_function.h"
-#include "stages/calibrate/residuals/drifting_time_offset_cost_function.h"
-#include "stages/calibrate/residuals/ground_cost_functions.h"
-#include "stages/calibrate/residuals/gyro_cost_function.h"
-#include "stages/calibrate/residuals/point_to_plane_cost_function.h"
+#include "stages/calibrate/report/residual_type.h"
 #include "stages/calibrate/residuals/stacked_cost_function.h"
 
 namespace tiltcal::calibrate {
 namespace {
-
-enum ResidualType { kGyro = 0, kAccel, kLidar, kGround, kOther };
-constexpr const char* kTypeNames[] = {"gyro", "accel", "lidar", "ground"};
-
-// The type of a residual block's cost function; a stacked block has its
-// rows' type.
-ResidualType TypeOf(const ceres::CostFunction* f) {
-  if (const auto* stacked = dynamic_cast<const StackedCostFunction*>(f)) {
-    return TypeOf(&stacked->row(0));
-  }
-  if (const auto* drifting = dynamic_cast<const DriftingTimeOffsetCostFunction*>(f)) {
-    return TypeOf(&drifting->inner());
-  }
-  if (dynamic_cast<const GyroCostFunction*>(f) != nullptr) return kGyro;
-  if (dynamic_cast<const AccelCostFunction*>(f) != nullptr) return kAccel;
-  if (dynamic_cast<const PointToPlaneCostFunction*>(f) != nullptr) return kLidar;
-  if (dynamic_cast<const FlatGroundCostFunction*>(f) != nullptr ||
-      dynamic_cast<const DistanceCostFunction*>(f) != nullptr ||
-      dynamic_cast<const InclinationCostFunction*>(f) != nullptr ||
-      dynamic_cast<const UpCostFunction*>(f) != nullptr) {
-    return kGround;
-  }
-  return kOther;
-}
 
 // 40 bins of 0.25 over [-5, 5): a standard normal fills the middle 24.
 constexpr double kHistogramMin = -5.0;
@@ -173,7 +145,7 @@ std::vector<proto::ResidualStatistics> ComputeResidualStatistics(
         for (const double r : block_residuals) timed.push_back({time_s, r});
       }
     }
-    proto::ResidualStatistics s = SummariseResiduals(kTypeNames[t], std::move(residuals));
+    proto::ResidualStatistics s = SummariseResiduals(ResidualTypeName(static_cast<ResidualType>(t)), std::move(residuals));
     FillTimeSeries(timed, start_s, end_s, static_cast<int>(params.bins()), &s);
     out.push_back(std::move(s));
   }

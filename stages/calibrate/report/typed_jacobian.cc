@@ -1,0 +1,40 @@
+#include "stages/calibrate/report/typed_jacobian.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <ceres/crs_matrix.h>
+
+namespace tiltcal::calibrate {
+
+Status EvaluateTypedJacobian(ceres::Problem* problem, const std::vector<double*>& parameter_blocks,
+                             int num_threads, TypedJacobian* out) {
+  ceres::Problem::EvaluateOptions options;
+  options.parameter_blocks = parameter_blocks;
+  problem->GetResidualBlocks(&options.residual_blocks);
+  options.apply_loss_function = true;
+  options.num_threads = std::max(1, num_threads);
+  out->row_type.clear();
+  out->square_sum.fill(0.0);
+  for (const ceres::ResidualBlockId id : options.residual_blocks) {
+    const ResidualType type = TypeOf(problem->GetCostFunctionForResidualBlock(id));
+    out->row_type.insert(out->row_type.end(),
+                         static_cast<size_t>(problem->GetCostFunctionForResidualBlock(id)->num_residuals()),
+                         type);
+    double cost = 0.0;
+    if (!problem->EvaluateResidualBlock(id, true, &cost, nullptr, nullptr) || !std::isfinite(cost)) {
+      return Status::Error("the residuals could not be evaluated");
+    }
+    out->square_sum[type] += 2.0 * cost;
+  }
+  ceres::CRSMatrix crs;
+  if (!problem->Evaluate(options, nullptr, nullptr, nullptr, &crs)) {
+    return Status::Error("the residuals could not be evaluated");
+  }
+  out->jacobian = Eigen::Map<const Eigen::SparseMatrix<double, Eigen::RowMajor>>(
+      crs.num_rows, crs.num_cols, static_cast<Eigen::Index>(crs.values.size()), crs.rows.data(),
+      crs.cols.data(), crs.values.data());
+  return Status::Ok();
+}
+
+}  // namespace tiltcal::calibrate
