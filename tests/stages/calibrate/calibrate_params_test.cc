@@ -91,6 +91,21 @@ TEST(CalibrateParamsTest, ParamsWithoutTheClockDriftBlockGetItsDefaults) {
   EXPECT_DOUBLE_EQ(params.time_offset_drift().max_rate_ppm(), 2000.0);
 }
 
+// A params file written before observability.variance_factors existed gets
+// the per-type variance components, as the defaults do.
+TEST(CalibrateParamsTest, ParamsWithoutVarianceFactorsGetThePerTypeComponents) {
+  std::string text(DefaultParamsText());
+  const size_t at = text.find("variance_factors: PER_TYPE");
+  ASSERT_NE(at, std::string::npos);
+  text.erase(at, std::string("variance_factors: PER_TYPE").size());
+  tiltcal::testing::TempDir dir;
+  ASSERT_TRUE(WriteFileAtomically(dir.File("old.txtpb"), text).ok());
+  proto::CalibrateParams params;
+  const Status status = LoadCalibrateParams(dir.File("old.txtpb"), &params);
+  ASSERT_TRUE(status.ok()) << status.message();
+  EXPECT_EQ(params.observability().variance_factors(), proto::ObservabilityParams::PER_TYPE);
+}
+
 // The error of ValidateCalibrateParams on the defaults with `override_text`.
 std::string ErrorWith(const std::string& override_text) {
   proto::CalibrateParams params = tiltcal::testing::DefaultCalibrateParamsWith();
