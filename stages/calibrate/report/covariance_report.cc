@@ -227,9 +227,8 @@ Status ComputeResidualTypeComponents(ceres::Problem* problem, bool imu_filtered,
                                      std::vector<VarianceComponent>* components) {
   std::vector<double*> blocks;
   problem->GetParameterBlocks(&blocks);
-  blocks.erase(std::remove_if(blocks.begin(), blocks.end(),
-                              [problem](double* b) { return problem->IsParameterBlockConstant(b); }),
-               blocks.end());
+  const auto held = [problem](double* b) { return problem->IsParameterBlockConstant(b); };
+  blocks.erase(std::remove_if(blocks.begin(), blocks.end(), held), blocks.end());
   TypedJacobian typed;
   const Status evaluated = EvaluateTypedJacobian(problem, blocks, num_threads, &typed);
   if (!evaluated.ok()) return Status::Error("variance components: " + evaluated.message());

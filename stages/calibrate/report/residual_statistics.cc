@@ -145,7 +145,8 @@ std::vector<proto::ResidualStatistics> ComputeResidualStatistics(
         for (const double r : block_residuals) timed.push_back({time_s, r});
       }
     }
-    proto::ResidualStatistics s = SummariseResiduals(ResidualTypeName(static_cast<ResidualType>(t)), std::move(residuals));
+    proto::ResidualStatistics s =
+        SummariseResiduals(ResidualTypeName(static_cast<ResidualType>(t)), std::move(residuals));
     FillTimeSeries(timed, start_s, end_s, static_cast<int>(params.bins()), &s);
     out.push_back(std::move(s));
   }

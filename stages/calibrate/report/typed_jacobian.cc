@@ -17,12 +17,13 @@ Status EvaluateTypedJacobian(ceres::Problem* problem, const std::vector<double*>
   out->row_type.clear();
   out->square_sum.fill(0.0);
   for (const ceres::ResidualBlockId id : options.residual_blocks) {
-    const ResidualType type = TypeOf(problem->GetCostFunctionForResidualBlock(id));
+    const ceres::CostFunction* cost_function = problem->GetCostFunctionForResidualBlock(id);
+    const ResidualType type = TypeOf(cost_function);
     out->row_type.insert(out->row_type.end(),
-                         static_cast<size_t>(problem->GetCostFunctionForResidualBlock(id)->num_residuals()),
-                         type);
+                         static_cast<size_t>(cost_function->num_residuals()), type);
     double cost = 0.0;
-    if (!problem->EvaluateResidualBlock(id, true, &cost, nullptr, nullptr) || !std::isfinite(cost)) {
+    if (!problem->EvaluateResidualBlock(id, true, &cost, nullptr, nullptr) ||
+        !std::isfinite(cost)) {
       return Status::Error("the residuals could not be evaluated");
     }
     out->square_sum[type] += 2.0 * cost;
