@@ -2,7 +2,6 @@
 // against the dense inverse, and its rank tests.
 
 #include <cmath>
-#include <random>
 #include <string>
 #include <vector>
 
@@ -12,27 +11,16 @@
 #include <Eigen/SparseCore>
 
 #include "stages/calibrate/report/marginal_covariance.h"
+#include "tests/stages/calibrate/report/banded_jacobian.h"
 
 namespace tiltcal::calibrate {
 namespace {
 
 using RowMajorSparse = Eigen::SparseMatrix<double, Eigen::RowMajor>;
 
-// A spline-like Jacobian: each row touches 4 consecutive "knot" columns of
-// the first n - k and every one of the last k; column j is scaled by
-// 10^(j mod 9 - 4) so that the units differ by 8 orders of magnitude.
+// A spline-like Jacobian whose units differ by 8 orders of magnitude.
 Eigen::MatrixXd BandedJacobian(int rows, int n, int k, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> normal;
-  Eigen::MatrixXd j = Eigen::MatrixXd::Zero(rows, n);
-  const int knots = n - k;
-  for (int r = 0; r < rows; ++r) {
-    const int first = (r * (knots - 3)) / rows;
-    for (int c = first; c < first + 4; ++c) j(r, c) = normal(rng);
-    for (int c = knots; c < n; ++c) j(r, c) = normal(rng);
-  }
-  for (int c = 0; c < n; ++c) j.col(c) *= std::pow(10.0, c % 9 - 4);
-  return j;
+  return testing::BandedJacobian(rows, n, k, seed, 9);
 }
 
 TEST(MarginalCovarianceTest, EqualsTheBlockOfTheDenseInverse) {

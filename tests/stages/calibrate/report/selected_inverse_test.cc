@@ -2,7 +2,6 @@
 // dense inverse, and its rank test.
 
 #include <cmath>
-#include <random>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -11,24 +10,14 @@
 #include <Eigen/SparseCore>
 
 #include "stages/calibrate/report/selected_inverse.h"
+#include "tests/stages/calibrate/report/banded_jacobian.h"
 
 namespace tiltcal::calibrate {
 namespace {
 
-// J^T J of a spline-like Jacobian: each row touches 4 consecutive columns of
-// the first n - k and every one of the last k; column j scaled by
-// 10^(j mod 7 - 3).
+// J^T J of a spline-like Jacobian, units over 6 orders of magnitude.
 Eigen::MatrixXd BandedNormalMatrix(int rows, int n, int k, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> normal;
-  Eigen::MatrixXd j = Eigen::MatrixXd::Zero(rows, n);
-  const int band = n - k;
-  for (int r = 0; r < rows; ++r) {
-    const int first = (r * (band - 3)) / rows;
-    for (int c = first; c < first + 4; ++c) j(r, c) = normal(rng);
-    for (int c = band; c < n; ++c) j(r, c) = normal(rng);
-  }
-  for (int c = 0; c < n; ++c) j.col(c) *= std::pow(10.0, c % 7 - 3);
+  const Eigen::MatrixXd j = testing::BandedJacobian(rows, n, k, seed, 7);
   return j.transpose() * j;
 }
 
