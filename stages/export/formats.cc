@@ -5,7 +5,7 @@
 #include <fmt/format.h>
 
 #include "common/geometry/euler_angles.h"
-#include "stages/export/escaping.h"
+#include "common/io/escaping.h"
 
 namespace tiltcal::exporter {
 

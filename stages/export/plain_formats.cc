@@ -2,7 +2,7 @@
 // directions, and one JSON object with everything.
 #include <fmt/format.h>
 
-#include "stages/export/escaping.h"
+#include "common/io/escaping.h"
 #include "stages/export/formats.h"
 
 namespace tiltcal::exporter {

@@ -4,7 +4,7 @@
 // R = C_bl = Rz(yaw) Ry(pitch) Rx(roll) and t = r_b^{lb}.
 #include <fmt/format.h>
 
-#include "stages/export/escaping.h"
+#include "common/io/escaping.h"
 #include "stages/export/formats.h"
 
 namespace tiltcal::exporter {

@@ -1,7 +1,7 @@
 // YAML for FAST-LIO, LIO-SAM and Kalibr-style consumers.
 #include <fmt/format.h>
 
-#include "stages/export/escaping.h"
+#include "common/io/escaping.h"
 #include "stages/export/formats.h"
 
 namespace tiltcal::exporter {

@@ -6,7 +6,7 @@
 
 #include <fmt/format.h>
 
-#include "stages/export/escaping.h"
+#include "common/io/escaping.h"
 
 namespace tiltcal::inspect {
 namespace {
@@ -99,7 +99,7 @@ void WriteMetadataText(const BagInfo& info, std::ostream& out) {
   if (!m.topics.empty()) Table(out, rows, "    ");
 }
 
-std::string Json(const std::string& text) { return exporter::QuotedString(text); }
+std::string Json(const std::string& text) { return QuotedString(text); }
 std::string JsonInt(int64_t v, bool present = true) {
   return present ? fmt::format("{}", v) : "null";
 }

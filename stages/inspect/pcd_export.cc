@@ -2,11 +2,10 @@
 
 #include <cstdio>
 #include <cstring>
-
-#include <pcl/PCLPointCloud2.h>
-#include <pcl/io/pcd_io.h>
+#include <vector>
 
 #include "common/io/atomic_file.h"
+#include "common/io/binary_pcd.h"
 #include "common/io/record_stream.h"
 #include "tiltcal/proto/ground.pb.h"
 #include "tiltcal/proto/scan.pb.h"
@@ -18,16 +17,6 @@ namespace {
 bool Bit(const google::protobuf::RepeatedField<uint64_t>& mask, size_t i) {
   const size_t word = i >> 6;
   return word < static_cast<size_t>(mask.size()) && ((mask.Get(word) >> (i & 63u)) & 1u);
-}
-
-void AddField(const std::string& name, uint32_t offset, uint8_t datatype,
-              pcl::PCLPointCloud2* cloud) {
-  pcl::PCLPointField field;
-  field.name = name;
-  field.offset = offset;
-  field.datatype = datatype;
-  field.count = 1;
-  cloud->fields.push_back(field);
 }
 
 // Scan `record` of the stream at `scans_path`, with equal point columns.
@@ -79,31 +68,22 @@ struct LabelCounts {
   size_t inliers = 0;  // labelled 2
 };
 
-// Packed binary layout: x y z intensity ring time_offset_ns [label], the
-// label from `plane`'s masks when it is given.
-pcl::PCLPointCloud2 MakeCloud(const proto::Scan& scan, const proto::GroundPlane* plane,
-                              LabelCounts* counts) {
-  pcl::PCLPointCloud2 cloud;
-  AddField("x", 0, pcl::PCLPointField::FLOAT32, &cloud);
-  AddField("y", 4, pcl::PCLPointField::FLOAT32, &cloud);
-  AddField("z", 8, pcl::PCLPointField::FLOAT32, &cloud);
-  AddField("intensity", 12, pcl::PCLPointField::FLOAT32, &cloud);
-  AddField("ring", 16, pcl::PCLPointField::UINT32, &cloud);
-  AddField("time_offset_ns", 20, pcl::PCLPointField::INT32, &cloud);
-  uint32_t step = 24;
-  if (plane != nullptr) {
-    AddField("label", 24, pcl::PCLPointField::UINT8, &cloud);
-    step = 25;
-  }
+// The binary PCD of `scan`: the header, then per point x y z intensity
+// (float32), ring (uint32), time_offset_ns (int32) and, when `plane` is
+// given, label (uint8) from its masks, packed.
+std::string MakePcd(const proto::Scan& scan, const proto::GroundPlane* plane,
+                    LabelCounts* counts) {
+  std::vector<PcdField> fields = {{"x", 4, 'F'},    {"y", 4, 'F'},    {"z", 4, 'F'},
+                                  {"intensity", 4, 'F'}, {"ring", 4, 'U'},
+                                  {"time_offset_ns", 4, 'I'}};
+  if (plane != nullptr) fields.push_back({"label", 1, 'U'});
+  const size_t step = plane != nullptr ? 25 : 24;
   const size_t n = static_cast<size_t>(scan.x_size());
-  cloud.height = 1;
-  cloud.width = static_cast<uint32_t>(n);
-  cloud.point_step = step;
-  cloud.row_step = step * cloud.width;
-  cloud.is_dense = true;
-  cloud.data.resize(static_cast<size_t>(cloud.row_step));
+  std::string pcd = BinaryPcdHeader(fields, n);
+  const size_t begin = pcd.size();
+  pcd.resize(begin + n * step);
   for (size_t i = 0; i < n; ++i) {
-    uint8_t* p = cloud.data.data() + i * step;
+    char* p = pcd.data() + begin + i * step;
     const float xyz[4] = {scan.x(i), scan.y(i), scan.z(i),
                           i < static_cast<size_t>(scan.intensity_size()) ? scan.intensity(i)
                                                                          : 0.0f};
@@ -123,22 +103,10 @@ pcl::PCLPointCloud2 MakeCloud(const proto::Scan& scan, const proto::GroundPlane*
         label = 1;
         ++counts->ground;
       }
-      p[24] = label;
+      p[24] = static_cast<char>(label);
     }
   }
-  return cloud;
-}
-
-// Writes `cloud` as a binary PCD (PCL's header, then the packed points as
-// PCDWriter::writeBinary lays them out) through WriteFileAtomically: a write
-// error (a full disk) is reported, never a signal from a memory map.
-Status WritePcdAtomically(const std::string& path, const pcl::PCLPointCloud2& cloud) {
-  pcl::PCDWriter writer;
-  std::string contents =
-      writer.generateHeaderBinary(cloud, Eigen::Vector4f::Zero(), Eigen::Quaternionf::Identity());
-  contents += "DATA binary\n";
-  contents.append(reinterpret_cast<const char*>(cloud.data.data()), cloud.data.size());
-  return WriteFileAtomically(path, contents);
+  return pcd;
 }
 
 }  // namespace
@@ -153,8 +121,8 @@ Status RunPcd(const std::string& scans_path, const PcdOptions& options, std::ost
   const bool have_ground = !options.ground_path.empty();
   if (have_ground) TILTCAL_RETURN_IF_ERROR(ReadGroundOfScan(options.ground_path, scan, &plane));
   LabelCounts counts;
-  const pcl::PCLPointCloud2 cloud = MakeCloud(scan, have_ground ? &plane : nullptr, &counts);
-  TILTCAL_RETURN_IF_ERROR(WritePcdAtomically(options.out_path, cloud));
+  TILTCAL_RETURN_IF_ERROR(WriteFileAtomically(
+      options.out_path, MakePcd(scan, have_ground ? &plane : nullptr, &counts)));
   log << "tiltcal_inspect pcd: scan " << options.record << " (index " << scan.index() << ", "
       << scan.x_size() << " points";
   if (have_ground) {

@@ -16,7 +16,7 @@ struct PcdOptions {
 };
 
 // `tiltcal_inspect pcd SCANS --record=N [--ground=ground.binpb] --out=scan.pcd`:
-// writes scan N (raw or deskewed) as a binary PCD (PCL io) with the fields
+// writes scan N (raw or deskewed) as a binary PCD (binary_pcd.h) with the fields
 // x y z intensity (float32), ring (uint32), time_offset_ns (int32) and, with
 // a ground file, label (uint8: 0 non-ground, 1 ground, 2 ground used by the
 // plane fit) for pcl_viewer / CloudCompare. The ground record is the one with

@@ -7,7 +7,7 @@
 #include "common/geometry/angles.h"
 #include "common/geometry/euler_angles.h"
 #include "common/io/eigen_proto.h"
-#include "stages/export/escaping.h"
+#include "common/io/escaping.h"
 #include "stages/report/html_escape.h"
 #include "stages/report/residual_histogram_svg.h"
 #include "stages/report/residual_time_svg.h"
@@ -190,7 +190,7 @@ std::string ExportsBlock(const std::vector<PageExport>& exports, const std::stri
       "<details class=\"exports\"{}>\n<summary>Exports for FAST-LIO, LIO-SAM, URDF, tf, Kalibr "
       "(<code>tiltcal_export --calibration={} --format=NAME</code>; README.md, Using the "
       "result)</summary>\n",
-      open ? " open" : "", EscapeHtml(exporter::ShellWord(calibration_link)));
+      open ? " open" : "", EscapeHtml(ShellWord(calibration_link)));
   for (const PageExport& e : exports) {
     out += fmt::format("<h4>{0}</h4>\n<pre class=\"export\" data-format=\"{0}\">{1}</pre>\n",
                        EscapeHtml(e.format), EscapeHtml(e.text));

@@ -3,9 +3,8 @@
 #include <algorithm>
 #include <cstring>
 
-#include <fmt/format.h>
-
 #include "common/io/atomic_file.h"
+#include "common/io/binary_pcd.h"
 
 namespace tiltcal::calibrate {
 
@@ -30,20 +29,8 @@ std::vector<MapPoint> BuildMapPoints(const CalibrationState& state, const Rigid3
 }
 
 Status WriteMapPcd(const std::string& path, const std::vector<MapPoint>& points) {
-  const std::string header = fmt::format(
-      "# .PCD v0.7 - Point Cloud Data file format\n"
-      "VERSION 0.7\n"
-      "FIELDS x y z scan\n"
-      "SIZE 4 4 4 4\n"
-      "TYPE F F F U\n"
-      "COUNT 1 1 1 1\n"
-      "WIDTH {0}\n"
-      "HEIGHT 1\n"
-      "VIEWPOINT 0 0 0 1 0 0 0\n"
-      "POINTS {0}\n"
-      "DATA binary\n",
-      points.size());
-  std::string data(header);
+  std::string data =
+      BinaryPcdHeader({{"x", 4, 'F'}, {"y", 4, 'F'}, {"z", 4, 'F'}, {"scan", 4, 'U'}}, points.size());
   const size_t offset = data.size();
   data.resize(offset + points.size() * 16);
   char* out = data.data() + offset;

@@ -219,8 +219,7 @@ TEST(GroundCli, InspectCsvAndPcdShowThePlanesAndLabels) {
     EXPECT_NE(pcd_header.find("POINTS " + std::to_string(planes[2].num_points())),
               std::string::npos) << pcd_header;
     const size_t begin = data_pos + std::string("DATA binary\n").size();
-    // PCL's binary writer pads the file with zeros to its mapping size.
-    ASSERT_GE(bytes.size() - begin, static_cast<size_t>(planes[2].num_points()) * 25)
+    ASSERT_EQ(bytes.size() - begin, static_cast<size_t>(planes[2].num_points()) * 25)
         << pcd_header;
     uint32_t ground = 0, inliers = 0;
     for (uint32_t i = 0; i < planes[2].num_points(); ++i) {

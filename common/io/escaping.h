@@ -1,5 +1,5 @@
-#ifndef TILTCAL_STAGES_EXPORT_ESCAPING_H_
-#define TILTCAL_STAGES_EXPORT_ESCAPING_H_
+#ifndef TILTCAL_COMMON_IO_ESCAPING_H_
+#define TILTCAL_COMMON_IO_ESCAPING_H_
 
 // How a string from the calibration or the command line (the source path,
 // the verdict reasons, the frame names) enters each export syntax: one rule
@@ -9,7 +9,7 @@
 
 #include <string>
 
-namespace tiltcal::exporter {
+namespace tiltcal {
 
 // `text` as comment lines: one line per line of `text` (split at '\n'),
 // each `prefix` + the line + '\n' ("" gives one empty comment line). Every
@@ -40,6 +40,6 @@ std::string QuotedString(const std::string& text);
 // CommentLines.
 std::string XmlAttribute(const std::string& text);
 
-}  // namespace tiltcal::exporter
+}  // namespace tiltcal
 
-#endif  // TILTCAL_STAGES_EXPORT_ESCAPING_H_
+#endif  // TILTCAL_COMMON_IO_ESCAPING_H_

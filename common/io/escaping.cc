@@ -1,10 +1,10 @@
-#include "stages/export/escaping.h"
+#include "common/io/escaping.h"
 
 #include <cstdint>
 
 #include <fmt/format.h>
 
-namespace tiltcal::exporter {
+namespace tiltcal {
 namespace {
 
 // One UTF-8 character of `text` at `i`: its code point and length, or
@@ -165,4 +165,4 @@ std::string XmlAttribute(const std::string& text) {
   return out;
 }
 
-}  // namespace tiltcal::exporter
+}  // namespace tiltcal

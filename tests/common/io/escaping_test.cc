@@ -1,10 +1,10 @@
-#include "stages/export/escaping.h"
+#include "common/io/escaping.h"
 
 #include <string>
 
 #include <gtest/gtest.h>
 
-namespace tiltcal::exporter {
+namespace tiltcal {
 namespace {
 
 TEST(CommentLines, OneLinePerInputLineEachPrefixed) {
@@ -57,4 +57,4 @@ TEST(XmlAttribute, EntitiesAndReferences) {
 }
 
 }  // namespace
-}  // namespace tiltcal::exporter
+}  // namespace tiltcal
