@@ -7,6 +7,20 @@ cd "$(dirname "$0")/.."
 # Slurm and munge too, so that the one-node cluster test (pipeline.slurm)
 # runs rather than skips; build.sh installs the rest.
 scripts/setup.sh --cluster
+# The parsers under ASan + UBSan and a few seconds of fuzzing each
+# (scripts/sanitize_and_fuzz.sh); SKIP_SANITIZERS=1 leaves them out. Their
+# clang build runs beside the release build and ctest at a lower priority,
+# on the cores those leave idle (a link, the last long tests); its output
+# follows ctest's.
+sanitizers=0
+if [ "${SKIP_SANITIZERS:-0}" != 1 ]; then
+  sanitizers=1
+  sanitizer_log=$(mktemp)
+  # Its own process group, so that an early exit stops the whole build.
+  setsid nice -n 10 scripts/sanitize_and_fuzz.sh --build_only > "$sanitizer_log" 2>&1 &
+  sanitizer_build=$!
+  trap 'kill -- -"$sanitizer_build" 2> /dev/null || true; rm -f "$sanitizer_log"' EXIT
+fi
 # Tests on, whatever an earlier configure of the build directory chose; the
 # benchmarks (bench/, run by hand, never by a test) left out.
 scripts/build.sh -DTILTCAL_WERROR=ON -DTILTCAL_BUILD_TESTS=ON -DTILTCAL_BUILD_BENCHMARKS=OFF
@@ -15,8 +29,11 @@ source scripts/phase_time.sh
 # trials, the Slurm daemons, the browser), and a core would stay idle.
 (cd "${BUILD_DIR:-build}" && ctest --output-on-failure -j "$(($(nproc) + 1))" "$@")
 phase_done ctest
-# The parsers under ASan + UBSan and a few seconds of fuzzing each
-# (scripts/sanitize_and_fuzz.sh); SKIP_SANITIZERS=1 leaves them out.
-if [ "${SKIP_SANITIZERS:-0}" != 1 ]; then
+if [ "$sanitizers" = 1 ]; then
+  status=0
+  wait "$sanitizer_build" || status=$?
+  cat "$sanitizer_log" >&2
+  [ "$status" = 0 ] || { echo "the sanitizer build failed" >&2; exit 1; }
+  phase_done "sanitizer build, the rest after ctest"
   scripts/sanitize_and_fuzz.sh
 fi

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# One run per dataset: two makes started together on one dataset, 20 times.
+# One run per dataset: two makes started together on one dataset, 8 times.
 # Makefile.pipeline holds a lock on out/ for the whole run, so the second
 # make waits (saying so) and then finds everything up to date: both exit 0,
 # every stage ran once per sequence, every output is present and newer than
@@ -9,7 +9,7 @@
 set -uo pipefail
 SRC=$(cd "$(dirname "$0")/../.." && pwd)
 MAKEFILE=${1:-$SRC/Makefile.pipeline}
-TRIALS=${2:-20}
+TRIALS=${2:-8}
 WORK=$(mktemp -d)
 trap 'rm -rf "$WORK"' EXIT
 BIN=$WORK/bin
