@@ -26,16 +26,14 @@ TESTS=(decode_bags_test io_test checked_conversion_test imu_test ros1_unit_test
 
 if [ ! -f "$BUILD_DIR/build.ninja" ]; then
   # -O1 and line tables only: half the compile time of -O2 -g, still
-  # symbolised reports; the tests' own code at -O0 (a third less compile
-  # time again), since their time goes to the code they test. Clang goes
-  # without precompiled headers; a unity build (each target's sources
-  # compiled as one file) parses the headers once per target instead.
+  # symbolised reports. Clang goes without precompiled headers; a unity
+  # build (each target's sources compiled as one file) parses the headers
+  # once per target instead.
   cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_UNITY_BUILD=ON \
     -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only -DNDEBUG" \
     -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only -DNDEBUG" \
     -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ "${COMPILER_CACHE[@]}" \
     -DTILTCAL_SANITIZE=address,undefined -DTILTCAL_FUZZ=ON -DTILTCAL_BUILD_BENCHMARKS=OFF \
-    -DTILTCAL_TEST_OPTIMIZATION=-O0 \
     >/dev/null
 fi
 cmake --build "$BUILD_DIR" -j "$(nproc)" --target "${FUZZERS[@]}" "${TESTS[@]}" tiltcal_decode \

@@ -10,8 +10,8 @@ scripts/setup.sh --cluster
 # The parsers under ASan + UBSan and a few seconds of fuzzing each
 # (scripts/sanitize_and_fuzz.sh); SKIP_SANITIZERS=1 leaves them out. Their
 # clang build runs beside the release build and ctest at a lower priority,
-# on the cores those leave idle (a link, the last long tests); its output
-# follows ctest's.
+# on the cores those leave idle (a link, the last long tests); its phase
+# times follow ctest's (its whole output when it fails).
 sanitizers=0
 if [ "${SKIP_SANITIZERS:-0}" != 1 ]; then
   sanitizers=1
@@ -32,8 +32,8 @@ phase_done ctest
 if [ "$sanitizers" = 1 ]; then
   status=0
   wait "$sanitizer_build" || status=$?
-  cat "$sanitizer_log" >&2
-  [ "$status" = 0 ] || { echo "the sanitizer build failed" >&2; exit 1; }
+  [ "$status" = 0 ] || { cat "$sanitizer_log" >&2; echo "the sanitizer build failed" >&2; exit 1; }
+  grep "^phase: " "$sanitizer_log" >&2
   phase_done "sanitizer build, the rest after ctest"
   scripts/sanitize_and_fuzz.sh
 fi

@@ -1,5 +1,5 @@
 # Sourced by the pipeline tests (bash): simulate_flat_pair BIN SRC WORK DATA
-# writes two flat 20 s sequences (the flat_vlp16 scenario in a 10 x 5 m
+# writes two flat 12 s sequences (the flat_vlp16 scenario in a 10 x 5 m
 # figure-eight at 1.2 m/s, seeds 41 and 42, headings 30 and 60 deg) into
 # DATA as seq_1.bag, seq_2.bag with their truths, and the rig DATA/rig.txtpb;
 # the scenario files go to WORK.
@@ -7,7 +7,7 @@ simulate_flat_pair() {
   local bin=$1 src=$2 work=$3 data=$4 i rig
   mkdir -p "$data"
   for i in 1 2; do
-    sed -E -e "s/^seed: .*/seed: $((40 + i))/" -e "s/^duration_s: .*/duration_s: 20/" \
+    sed -E -e "s/^seed: .*/seed: $((40 + i))/" -e "s/^duration_s: .*/duration_s: 12/" \
       -e "s/^([[:space:]]*heading_deg:).*/\1 $((30 * i))/" \
       -e "s/^(  length_m:).*/\1 10/" -e "s/^(  width_m:).*/\1 5/" -e "s/^(  speed_mps:).*/\1 1.2/" \
       "$src/stages/simulate/scenarios/flat_vlp16.txtpb" > "$work/seq_$i.txtpb"

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Setup of the CTest fixture pipeline_flat_pair, which end_to_end_test.sh and
-# slurm_test.sh read: the two flat 20 s sequences (flat_pair_dataset.sh)
+# slurm_test.sh read: the two flat 12 s sequences (flat_pair_dataset.sh)
 # simulated once and run once through every stage with Makefile.pipeline
 # (-j2), in the folder flat_pair_fixture names.
 #   flat_pair_fixture.sh BUILD_DIR

@@ -32,7 +32,7 @@ cleanup() {
 trap cleanup EXIT
 trap 'exit 143' TERM INT HUP
 
-# The two flat 20 s sequences of end_to_end_test.sh and their local run:
+# The two flat 12 s sequences of end_to_end_test.sh and their local run:
 # the fixture's dataset and local/flat (flat_pair_dataset.sh).
 source "$(dirname "$0")/flat_pair_dataset.sh"
 FIXTURE=$(flat_pair_fixture "$BUILD")
