@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The IMUs users have, measured: the demo's 40 s Husky-like sequence (IMU
 # upside down), flat and tilted (8 deg pitch, 3 deg roll, g_f from the flat
-# sequence of the same seed), with one fault per run:
+# sequence of the same seed), with one fault per run, or all of them:
 #   consumer        gyroscope and accelerometer scale errors drawn up to
 #                   SCALE ppm and axis misalignments up to MIS deg per seed
 #                   (SimTriadErrors); compared: imu_intrinsics AUTO / OFF
@@ -14,9 +14,16 @@
 #                   time_offset_drift AUTO (rate estimated, with decode's
 #                   rate as prior) / DATA (AUTO without that prior:
 #                   use_decode_rate false) / OFF (one tau)
+#   all             every fault at once: the faults block of
+#                   stages/simulate/scenarios/faulty_vehicle_vlp16_40s.txtpb
+#                   (scale errors up to 5000 ppm and misalignments up to
+#                   0.5 deg drawn per seed, 25 Hz vibration from the static
+#                   start on, the LiDAR clock 50 ppm fast, 2 % of the scans
+#                   dropped, grass, rolling ground, four pedestrians; the
+#                   fault flags below do not apply)
 # Each sequence is calibrated by `make -f Makefile.pipeline` as a one-bag
 # dataset with the simulator's rig, once with the defaults (AUTO) and once
-# with the fault's params block OFF.
+# with the fault's params block OFF (all: the defaults only).
 # Prints one row per seed, ground and mode: exit code, verdict, rotation
 # (deg), translation per axis (mm) and tau (ms) errors against the truth,
 # whether the intrinsics were estimated, the score, the gyro z scale and
@@ -35,7 +42,7 @@ set -euo pipefail
 . "$(dirname "$0")/../common.sh"
 SRC=$REPO
 bench_flag --seeds SEEDS 101,102,103 "simulator seeds, comma separated"
-bench_flag --fault FAULT consumer "consumer, vibration, idle_vibration or drift"
+bench_flag --fault FAULT consumer "consumer, vibration, idle_vibration, drift or all"
 bench_flag --scale_ppm SCALE 10000 "largest scale error, ppm (consumer)"
 bench_flag --misalignment_deg MIS 0.5 "largest axis misalignment, deg (consumer)"
 bench_flag --vibration_hz HZ 37 "vibration frequency, Hz"
@@ -48,6 +55,7 @@ case "$FAULT" in
   consumer) BLOCK=imu_intrinsics ;;
   vibration|idle_vibration) BLOCK=imu_vibration ;;
   drift) BLOCK=time_offset_drift ;;
+  all) BLOCK="" ;;
   *) echo "unknown fault $FAULT (see --help)" >&2; exit 2 ;;
 esac
 require_binaries tiltcal_simulate tiltcal_decode tiltcal_ground tiltcal_gravity tiltcal_calibrate
@@ -73,6 +81,9 @@ scenario() {
       echo "    gyro_amplitude_radps: $GYRO when: $when }" ;;
     drift)
       echo "  lidar_clock_drift_ppm: $DRIFT" ;;
+    all)
+      sed -n '/^faults {/,/^}/{/^faults {/d;/^}/d;p}' \
+        "$SRC/stages/simulate/scenarios/faulty_vehicle_vlp16_40s.txtpb" ;;
   esac
   echo "}"
 }
@@ -138,13 +149,14 @@ run() {
   cp "$SCRATCH/$bag.bag" "$d/seq.bag"
   sed '/^gravity_reference:/d' "$SCRATCH/$bag.rig.txtpb" > "$d/rig.txtpb"
   [ -n "$ref" ] && echo "gravity_reference: \"$ref\"" >> "$d/rig.txtpb"
-  if [ "$mode" = DATA ]; then
-    sed -E "/^$BLOCK \{/,/^\}/ s/^  use_decode_rate: true$/  use_decode_rate: false/" \
-      "$SRC/stages/calibrate/default_params.txtpb" > "$d/params/calibrate.txtpb"
-  else
-    sed -E "/^$BLOCK \{/,/^\}/ s/^  mode: AUTO$/  mode: $mode/" \
-      "$SRC/stages/calibrate/default_params.txtpb" > "$d/params/calibrate.txtpb"
-  fi
+  local defaults=$SRC/stages/calibrate/default_params.txtpb
+  case $mode in
+    AUTO) cp "$defaults" "$d/params/calibrate.txtpb" ;;
+    DATA) sed -E "/^$BLOCK \{/,/^\}/ s/^  use_decode_rate: true$/  use_decode_rate: false/" \
+      "$defaults" > "$d/params/calibrate.txtpb" ;;
+    *) sed -E "/^$BLOCK \{/,/^\}/ s/^  mode: AUTO$/  mode: $mode/" \
+      "$defaults" > "$d/params/calibrate.txtpb" ;;
+  esac
   local start=$SECONDS rc=0
   make -s -f "$SRC/Makefile.pipeline" DATASET="$d" BIN="$BIN" > "$d/make.log" 2>&1 || rc=$?
   local cal=$d/out/seq/calibration.txtpb
@@ -160,7 +172,7 @@ run() {
 }
 
 export SRC
-echo "fault $FAULT; mode: $BLOCK.mode"
+if [ -n "$BLOCK" ]; then echo "fault $FAULT; mode: $BLOCK.mode"; else echo "fault $FAULT; defaults"; fi
 echo "seed  ground  mode  exit  verdict  rot_deg  dx_mm  dy_mm  dz_mm  tau_ms  est  score  gyro_z/truth  acc_x/truth  acc_y/truth  filtered  rate_ppm  tau_start/end_err_ms  calibrate_s  make"
 for seed in ${SEEDS//,/ }; do
   for kind in flat tilted; do
@@ -169,8 +181,11 @@ for seed in ${SEEDS//,/ }; do
       --out_bag="$SCRATCH/$kind.$seed.bag" --out_truth="$SCRATCH/$kind.$seed.truth.txtpb" \
       --out_rig="$SCRATCH/$kind.$seed.rig.txtpb" 2> /dev/null
   done
-  MODES="AUTO OFF"
-  [ "$FAULT" = drift ] && MODES="AUTO DATA OFF"
+  case "$FAULT" in
+    drift) MODES="AUTO DATA OFF" ;;
+    all) MODES=AUTO ;;
+    *) MODES="AUTO OFF" ;;
+  esac
   for mode in $MODES; do
     run "${seed}_flat_$mode" "flat.$seed" $mode
     run "${seed}_tilted_$mode" "tilted.$seed" $mode "../${seed}_flat_AUTO"
