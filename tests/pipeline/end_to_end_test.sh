@@ -65,11 +65,11 @@ fi
 info=$("$BIN/tiltcal_inspect" info "$DATA/out/seq_1/scans.binpb.lz4")
 grep -qE "^records: 11[0-9]$" <<<"$info" || fail "inspect info does not count the scans"
 
-# The check against a stored calibration (here the dataset's own). These 20 s
-# sequences notice about 0.4 deg, 2 cm and 2 ms (measured: 0.41 deg, 18.9-22.9
-# mm, 1.9 ms), at the edge of the defaults' 2 cm and 2 ms for 40 s ones
-# (stages/verify/README.md): the dataset's params/verify.txtpb asks for 1 deg,
-# 3 cm and 3 ms.
+# The check against a stored calibration (here the dataset's own). These 12 s
+# sequences notice about 0.4 deg, 2 cm and 0.7 ms (measured: 0.384 / 0.386
+# deg, 17.6 / 16.9 mm, 0.67 / 0.70 ms), at the edge of the defaults' 2 cm
+# for 40 s ones (stages/verify/README.md): the dataset's params/verify.txtpb
+# asks for 1 deg, 3 cm and 3 ms.
 mkdir -p "$DATA/params"
 sed -e 's/^\(  rotation_deg:\).*/\1 1.0/' -e 's/^\(  translation_m:\).*/\1 0.03/' \
   -e 's/^\(  time_offset_s:\).*/\1 0.003/' \
