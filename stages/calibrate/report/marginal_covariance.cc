@@ -1,11 +1,12 @@
 #include "stages/calibrate/report/marginal_covariance.h"
 
-#include <cmath>
 #include <string>
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/OrderingMethods>
 #include <Eigen/SparseCholesky>
+
+#include "stages/calibrate/report/unit_diagonal.h"
 
 namespace tiltcal::calibrate {
 
@@ -22,14 +23,10 @@ Status MarginalCovarianceOfLastColumns(
   Eigen::SparseMatrix<double> h = jacobian.transpose() * jacobian;
 
   // S H S with S = diag(H)^{-1/2}: unit diagonal.
-  Eigen::VectorXd scale(n);
-  for (int c = 0; c < n; ++c) {
-    const double d = h.coeff(c, c);
-    if (!(d > 0.0)) {
-      return Status::Error("covariance: the Jacobian is rank deficient (parameter " + std::to_string(c) +
-                           " of " + std::to_string(n) + " has no residual)");
-    }
-    scale[c] = 1.0 / std::sqrt(d);
+  Eigen::VectorXd scale;
+  if (const int c = UnitDiagonalScale(h, &scale); c >= 0) {
+    return Status::Error("covariance: the Jacobian is rank deficient (parameter " + std::to_string(c) +
+                         " of " + std::to_string(n) + " has no residual)");
   }
   for (int c = 0; c < n; ++c) {
     for (Eigen::SparseMatrix<double>::InnerIterator it(h, c); it; ++it) {

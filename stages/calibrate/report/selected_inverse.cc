@@ -1,12 +1,13 @@
 #include "stages/calibrate/report/selected_inverse.h"
 
 #include <algorithm>
-#include <cmath>
 #include <string>
 #include <vector>
 
 #include <Eigen/OrderingMethods>
 #include <Eigen/SparseCholesky>
+
+#include "stages/calibrate/report/unit_diagonal.h"
 
 namespace tiltcal::calibrate {
 namespace {
@@ -50,14 +51,10 @@ class PatternInverse {
 Status InverseOnPattern(const Eigen::SparseMatrix<double>& h, double min_relative_pivot,
                         Eigen::SparseMatrix<double>* inverse) {
   const int n = static_cast<int>(h.cols());
-  Eigen::VectorXd scale(n);
-  for (int c = 0; c < n; ++c) {
-    const double d = h.coeff(c, c);
-    if (!(d > 0.0)) {
-      return Status::Error("selected inverse: parameter " + std::to_string(c) + " of " +
-                           std::to_string(n) + " has no information");
-    }
-    scale[c] = 1.0 / std::sqrt(d);
+  Eigen::VectorXd scale;
+  if (const int c = UnitDiagonalScale(h, &scale); c >= 0) {
+    return Status::Error("selected inverse: parameter " + std::to_string(c) + " of " +
+                         std::to_string(n) + " has no information");
   }
   const Eigen::SparseMatrix<double> scaled = scale.asDiagonal() * h * scale.asDiagonal();
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>> ldlt(
