@@ -40,16 +40,16 @@ function(tiltcal_set_target_options target)
   endif()
 endfunction()
 
-# Precompiled headers (TILTCAL_PCH, GCC only): cmake/pch.h for the
-# libraries, cmake/pch_test.h for the tests, each compiled once, by an empty
-# object library with the same options, and reused by every target
-# (REUSE_FROM). GCC uses a precompiled header only when it was made with the
-# same options and macros, and otherwise reads the header as text: a target
-# that cannot share one (tiltcal_registration, compiled with -fopenmp) makes
-# its own. Under clang (the sanitizer build) a mismatch would be an error, so
-# clang builds go without.
+# Precompiled headers (TILTCAL_PCH): cmake/pch.h for the libraries,
+# cmake/pch_test.h for the tests, each compiled once, by an empty object
+# library with the same options, and reused by every target (REUSE_FROM).
+# GCC uses a precompiled header only when it was made with the same options
+# and macros, and otherwise reads the header as text: a target that cannot
+# share one (tiltcal_registration, compiled with -fopenmp) makes its own.
+# Clang (the sanitizer build) stops with an error on such a mismatch instead,
+# so a target whose options differ fails there loudly, never silently slower.
 function(tiltcal_pch_enabled out)
-  if(TILTCAL_PCH AND CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
+  if(TILTCAL_PCH)
     set(${out} TRUE PARENT_SCOPE)
   else()
     set(${out} FALSE PARENT_SCOPE)
