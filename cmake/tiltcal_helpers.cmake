@@ -6,6 +6,8 @@
 include(CheckLinkerFlag)
 check_linker_flag(CXX -fuse-ld=lld TILTCAL_HAVE_LLD)
 
+# tiltcal_set_target_options(TARGET [TEST]): TEST for a test executable (and
+# its precompiled header), whose own code needs no fuzzing coverage.
 function(tiltcal_set_target_options target)
   target_compile_options(${target} PRIVATE -Wall -Wextra -Wno-unused-parameter)
   if(TILTCAL_UNITY_BUILD AND CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
@@ -31,8 +33,9 @@ function(tiltcal_set_target_options target)
                                              -fno-omit-frame-pointer)
     target_link_options(${target} PRIVATE -fsanitize=${sanitize})
   endif()
-  if(TILTCAL_FUZZ)
-    # Coverage for libFuzzer in every target; the harnesses add its main.
+  if(TILTCAL_FUZZ AND NOT "TEST" IN_LIST ARGN)
+    # Coverage for libFuzzer in every library and harness (the tests link the
+    # same instrumented libraries); the harnesses add its main.
     target_compile_options(${target} PRIVATE -fsanitize=fuzzer-no-link)
   endif()
   if(CMAKE_BUILD_TYPE STREQUAL "Debug")
@@ -81,7 +84,7 @@ function(tiltcal_use_pch target kind)
     add_library(${owner} OBJECT ${PROJECT_SOURCE_DIR}/cmake/pch_owner.cc)
     target_include_directories(${owner} PRIVATE ${PROJECT_SOURCE_DIR})
     target_link_libraries(${owner} PRIVATE ${deps})
-    tiltcal_set_target_options(${owner})
+    tiltcal_set_target_options(${owner} ${kind})
     target_precompile_headers(${owner} PRIVATE ${header})
   endif()
   target_precompile_headers(${target} REUSE_FROM ${owner})
@@ -161,7 +164,7 @@ function(tiltcal_add_test)
   target_link_libraries(${ARG_NAME} PRIVATE ${ARG_DEPS} tiltcal_testing GTest::gtest GTest::gtest_main)
   set_target_properties(${ARG_NAME} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR}/tests
                                                UNITY_BUILD ${TILTCAL_UNITY_BUILD})
-  tiltcal_set_target_options(${ARG_NAME})
+  tiltcal_set_target_options(${ARG_NAME} TEST)
   tiltcal_use_pch(${ARG_NAME} TEST)
   if(NOT ARG_LABELS)
     set(ARG_LABELS unit)

@@ -7,11 +7,18 @@
 # Tests and harnesses run JOBS (default: the number of cores) at a time; each
 # harness still gets its FUZZ_SECONDS. New inputs go to a temporary
 # directory; a crash leaves its input as crash-* in $BUILD_DIR/fuzz-artifacts/
-# and fails the script. With --build_only it builds and stops (scripts/test.sh
-# builds beside the release build and its tests, then runs the rest).
-#   scripts/sanitize_and_fuzz.sh [--build_only]
+# and fails the script. With --no_fuzz it builds, runs the tests and stops;
+# with --fuzz_only it builds (nothing to do after --no_fuzz) and fuzzes
+# (scripts/test.sh runs the first beside the release build and its tests,
+# the second after them).
+#   scripts/sanitize_and_fuzz.sh [--no_fuzz | --fuzz_only]
 set -euo pipefail
 cd "$(dirname "$0")/.."
+MODE=${1:-}
+case $MODE in
+  "" | --no_fuzz | --fuzz_only) ;;
+  *) echo "usage: scripts/sanitize_and_fuzz.sh [--no_fuzz | --fuzz_only]" >&2; exit 2 ;;
+esac
 source scripts/phase_time.sh
 source scripts/compiler_cache.sh
 BUILD_DIR=${SANITIZE_BUILD_DIR:-build-sanitize}
@@ -39,7 +46,6 @@ fi
 cmake --build "$BUILD_DIR" -j "$(nproc)" --target "${FUZZERS[@]}" "${TESTS[@]}" tiltcal_decode \
   tiltcal_inspect
 phase_done "sanitizer configure + build"
-[ "${1:-}" = --build_only ] && exit 0
 
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
@@ -62,13 +68,16 @@ passed() { [ "$(cat "$status_dir/$1")" = 0 ]; }
 sanitized_test() {
   cd "$BUILD_DIR" && "tests/$1" --gtest_brief=1 > "tests/$1.log" 2>&1
 }
-run_jobs sanitized_test "${TESTS[@]}"
-for t in "${TESTS[@]}"; do
-  passed "$t" ||
-    { tail -60 "$BUILD_DIR/tests/$t.log" >&2; echo "$t failed under the sanitizers" >&2; exit 1; }
-  echo "$t: passed under ASan + UBSan"
-done
-phase_done "sanitizer tests"
+if [ "$MODE" != --fuzz_only ]; then
+  run_jobs sanitized_test "${TESTS[@]}"
+  for t in "${TESTS[@]}"; do
+    passed "$t" ||
+      { tail -60 "$BUILD_DIR/tests/$t.log" >&2; echo "$t failed under the sanitizers" >&2; exit 1; }
+    echo "$t: passed under ASan + UBSan"
+  done
+  phase_done "sanitizer tests"
+fi
+[ "$MODE" = --no_fuzz ] && exit 0
 
 artifacts=$BUILD_DIR/fuzz-artifacts
 mkdir -p "$artifacts"

@@ -9,15 +9,16 @@ cd "$(dirname "$0")/.."
 scripts/setup.sh --cluster
 # The parsers under ASan + UBSan and a few seconds of fuzzing each
 # (scripts/sanitize_and_fuzz.sh); SKIP_SANITIZERS=1 leaves them out. Their
-# clang build runs beside the release build and ctest at a lower priority,
-# on the cores those leave idle (a link, the last long tests); its phase
-# times follow ctest's (its whole output when it fails).
+# clang build and their tests run beside the release build and ctest at a
+# lower priority, on the cores those leave idle (a link, the last long
+# tests); their phase times follow ctest's (their whole output when they
+# fail), then the fuzzing runs.
 sanitizers=0
 if [ "${SKIP_SANITIZERS:-0}" != 1 ]; then
   sanitizers=1
   sanitizer_log=$(mktemp)
-  # Its own process group, so that an early exit stops the whole build.
-  setsid nice -n 10 scripts/sanitize_and_fuzz.sh --build_only > "$sanitizer_log" 2>&1 &
+  # Its own process group, so that an early exit stops the whole run.
+  setsid nice -n 10 scripts/sanitize_and_fuzz.sh --no_fuzz > "$sanitizer_log" 2>&1 &
   sanitizer_build=$!
   trap 'kill -- -"$sanitizer_build" 2> /dev/null || true; rm -f "$sanitizer_log"' EXIT
 fi
@@ -32,8 +33,10 @@ phase_done ctest
 if [ "$sanitizers" = 1 ]; then
   status=0
   wait "$sanitizer_build" || status=$?
-  [ "$status" = 0 ] || { cat "$sanitizer_log" >&2; echo "the sanitizer build failed" >&2; exit 1; }
+  [ "$status" = 0 ] ||
+    { cat "$sanitizer_log" >&2; echo "the sanitizer build or tests failed" >&2; exit 1; }
   grep "^phase: " "$sanitizer_log" >&2
-  phase_done "sanitizer build, the rest after ctest"
-  scripts/sanitize_and_fuzz.sh
+  grep -v "^phase: " "$sanitizer_log" | grep "passed under" || true
+  phase_done "sanitizer build and tests, the rest after ctest"
+  scripts/sanitize_and_fuzz.sh --fuzz_only
 fi
