@@ -830,12 +830,14 @@ TEST(CalibratePipelineTest, ShortTiltedSequenceWithTheDefaultsAgainstTruth) {
 }
 
 // LiDAR stamps 80 ms off the IMU clock with the coarse tau search switched
-// off: tau cannot reach the truth within its bounds. The executable writes
-// the result, says SUSPECT with the bound as the reason, and exits 3.
+// off (8 s of the sequence are enough): tau cannot reach the truth within its
+// bounds. The executable writes the result, says SUSPECT with the bound as
+// the reason, and exits 3.
 TEST(CalibratePipelineTest, TimeOffsetBeyondItsBoundIsSuspectWithExitCode3) {
   TempDir dir;
   ASSERT_TRUE(PrepareSequence("short_flat_vlp16.txtpb",
-                              {{"time_offset_s: 0.0125", "time_offset_s: 0.08"}},
+                              {{"time_offset_s: 0.0125", "time_offset_s: 0.08"},
+                               {"duration_s: 16", "duration_s: 8"}},
                               /*gravity=*/false, dir));
   std::string params_text(DefaultParamsText());
   const std::string search = "time_offset_search_step_s: 0.001";
