@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "common/geometry/angles.h"
 #include "stages/decode/point_cloud_conversion.h"
 
 namespace {
@@ -46,7 +47,7 @@ std::vector<uint8_t> MakeCloudBytes(std::mt19937* rng, double no_return) {
   for (int f = 0; f < kFirings; ++f) {
     for (int r = 0; r < kRings; ++r, p += kPointStep) {
       const float azimuth = 2.0f * static_cast<float>(M_PI) * f / kFirings;
-      const float elevation = static_cast<float>((-15.0 + 2.0 * r) * M_PI / 180.0);
+      const float elevation = static_cast<float>(tiltcal::geometry::DegToRad(-15.0 + 2.0 * r));
       float d = range(*rng);
       const double u = unit(*rng);
       if (u < no_return) {

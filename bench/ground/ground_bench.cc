@@ -25,6 +25,7 @@
 #include <string>
 #include <vector>
 
+#include "common/geometry/angles.h"
 #include "common/imu/gyro_integrator.h"
 #include "common/imu/imu_reading.h"
 #include "common/io/params.h"
@@ -108,7 +109,7 @@ Scan VlpLikeSubsample(const Scan& kitti) {
   int kept = 0;
   for (int i = 0; i < kitti.x_size(); ++i) {
     const double r = std::hypot(kitti.x(i), kitti.y(i));
-    const double el = std::atan2(kitti.z(i), r) * 180.0 / M_PI;
+    const double el = tiltcal::geometry::RadToDeg(std::atan2(kitti.z(i), r));
     const double nearest = std::round((el + 15.0) / 2.0) * 2.0 - 15.0;
     if (nearest < -15.0 || nearest > 15.0 || std::fabs(el - nearest) > 0.25) continue;
     if (kept++ % 2 != 0) continue;

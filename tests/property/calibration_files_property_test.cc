@@ -30,6 +30,7 @@
 #include <string>
 #include <vector>
 
+#include "common/geometry/angles.h"
 #include "common/io/atomic_file.h"
 #include "common/io/eigen_proto.h"
 #include "common/io/text_proto.h"
@@ -41,7 +42,7 @@ namespace tiltcal {
 namespace {
 
 constexpr int kCases = 40;
-constexpr double kDegPerRad = 180.0 / M_PI;
+using geometry::kDegPerRad;
 // The defaults of the programs under test (stages/*/default_params.txtpb).
 constexpr double kMinGravityNorm = 9.7, kMaxGravityNorm = 9.9;
 constexpr double kMaxGravityAngleDeg = 0.3;
@@ -429,7 +430,7 @@ void CheckGravityReference(const std::vector<GeneratedSequence>& sequences,
     EXPECT_TRUE(g.allFinite()) << output;
     EXPECT_GE(g.norm(), kMinGravityNorm) << output;
     EXPECT_LE(g.norm(), kMaxGravityNorm) << output;
-    const double angle_deg = std::atan2(g.cross(g_f).norm(), g.dot(g_f)) * kDegPerRad;
+    const double angle_deg = geometry::AngleBetweenDeg(g, g_f);
     EXPECT_LE(angle_deg, kMaxGravityAngleDeg + 1e-9) << output;
   }
   EXPECT_FALSE(HasNonFiniteWord(output)) << output;

@@ -4,6 +4,8 @@
 #include <limits>
 #include <random>
 
+#include "common/geometry/angles.h"
+
 namespace tiltcal::testing {
 
 namespace {
@@ -66,7 +68,7 @@ proto::Scan CastScan(const SyntheticScene& scene, const SyntheticLidar& lidar,
     const double dt = lidar.sweep_s * (fraction - 0.5);
     const Eigen::Matrix3d r_gl = pose.g_from_lidar * Exp(pose.omega_lidar_radps * dt);
     for (size_t ring = 0; ring < lidar.elevations_deg.size(); ++ring) {
-      const double el = lidar.elevations_deg[ring] * M_PI / 180.0;
+      const double el = geometry::DegToRad(lidar.elevations_deg[ring]);
       const Eigen::Vector3d u_l(std::cos(el) * std::cos(azimuth), std::cos(el) * std::sin(azimuth),
                                 std::sin(el));
       const double t = Hit(scene, pose.position_g, r_gl * u_l);
@@ -89,10 +91,6 @@ Eigen::Vector3d TrueNormal(const SyntheticPose& pose) {
 }
 
 double TrueHeight(const SyntheticPose& pose) { return pose.position_g.z(); }
-
-double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  return std::atan2(a.cross(b).norm(), a.dot(b)) * 180.0 / M_PI;
-}
 
 Eigen::Matrix3d RollPitchYaw(double roll, double pitch, double yaw) {
   return (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *

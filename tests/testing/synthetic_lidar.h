@@ -50,9 +50,6 @@ proto::Scan CastScan(const SyntheticScene& scene, const SyntheticLidar& lidar,
 Eigen::Vector3d TrueNormal(const SyntheticPose& pose);
 double TrueHeight(const SyntheticPose& pose);
 
-// Angle between two unit vectors, degrees.
-double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b);
-
 // Rotation from roll, pitch, yaw (rad): Rz(yaw) Ry(pitch) Rx(roll).
 Eigen::Matrix3d RollPitchYaw(double roll, double pitch, double yaw);
 

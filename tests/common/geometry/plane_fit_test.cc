@@ -9,6 +9,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
+#include "common/geometry/angles.h"
 #include "tests/testing/random_vector.h"
 
 namespace tiltcal::geometry {
@@ -180,8 +181,8 @@ TEST(PlaneFit, RobustFitIgnoresOutliers) {
   const PlaneFit robust =
       FitPlaneRobust(c.x.data(), c.y.data(), c.z.data(), c.size(), options, &inlier);
   ASSERT_TRUE(robust.ok);
-  const double robust_err = std::acos(std::min(1.0, robust.normal.dot(n))) * 180.0 / M_PI;
-  const double plain_err = std::acos(std::min(1.0, plain.normal.dot(n))) * 180.0 / M_PI;
+  const double robust_err = RadToDeg(std::acos(std::min(1.0, robust.normal.dot(n))));
+  const double plain_err = RadToDeg(std::acos(std::min(1.0, plain.normal.dot(n))));
   EXPECT_LT(robust_err, 0.1);
   EXPECT_GT(plain_err, robust_err);
   EXPECT_NEAR(robust.offset, 0.9, 0.005);
@@ -219,7 +220,7 @@ TEST(PlaneFit, RefinementFromAHypothesisStaysOnItsSurface) {
   const PlaneFit fit = FitPlaneRobustFrom(c.x.data(), c.y.data(), c.z.data(), c.size(),
                                           hypothesis, 0.9, options, &inlier);
   ASSERT_TRUE(fit.ok);
-  EXPECT_LT(std::acos(std::min(1.0, fit.normal.z())) * 180.0 / M_PI, 0.05);
+  EXPECT_LT(RadToDeg(std::acos(std::min(1.0, fit.normal.z()))), 0.05);
   EXPECT_NEAR(fit.offset, 0.9, 0.002);
   EXPECT_EQ(fit.num_points, 3000);
   // Scoring: the road hypothesis has more support than the sidewalk one.

@@ -6,16 +6,15 @@
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
+#include "common/geometry/angles.h"
 #include "common/geometry/euler_angles.h"
 #include "common/geometry/so3.h"
 
 namespace tiltcal::geometry {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
-
 Eigen::Matrix3d RotZ(double deg) {
-  return Eigen::AngleAxisd(deg * kDeg, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  return Eigen::AngleAxisd(deg * kRadPerDeg, Eigen::Vector3d::UnitZ()).toRotationMatrix();
 }
 
 TEST(RotationStatistics, MeanAcrossPlusMinus180DegreesIsNotZero) {
@@ -24,22 +23,23 @@ TEST(RotationStatistics, MeanAcrossPlusMinus180DegreesIsNotZero) {
   ASSERT_TRUE(stats.converged);
   EXPECT_LT(LogMatrix(stats.mean.transpose() * RotZ(180)).norm(), 1e-9);
   // Deviations ±1 deg about z: σ_z = sqrt((1 + 1) / (2 - 1)) deg.
-  EXPECT_NEAR(stats.sigma.z() / kDeg, std::sqrt(2.0), 1e-9);
+  EXPECT_NEAR(stats.sigma.z() / kRadPerDeg, std::sqrt(2.0), 1e-9);
   EXPECT_NEAR(stats.sigma.x(), 0.0, 1e-12);
   EXPECT_NEAR(stats.sigma.y(), 0.0, 1e-12);
-  EXPECT_NEAR(std::abs(Euler123FromRotation(stats.mean).z()) / kDeg, 180.0, 1e-9);
+  EXPECT_NEAR(std::abs(Euler123FromRotation(stats.mean).z()) / kRadPerDeg, 180.0, 1e-9);
 }
 
 TEST(RotationStatistics, HandComputedSingleAxisCase) {
   // 10, 20, 30 deg about x: mean 20 deg, sample σ = 10 deg, covariance 100 deg².
   std::vector<Eigen::Matrix3d> rotations;
   for (double deg : {10.0, 20.0, 30.0}) {
-    rotations.push_back(Eigen::AngleAxisd(deg * kDeg, Eigen::Vector3d::UnitX()).toRotationMatrix());
+    rotations.push_back(
+        Eigen::AngleAxisd(deg * kRadPerDeg, Eigen::Vector3d::UnitX()).toRotationMatrix());
   }
   const auto stats = ComputeRotationStatistics(rotations);
-  EXPECT_NEAR(Euler123FromRotation(stats.mean).x() / kDeg, 20.0, 1e-9);
-  EXPECT_NEAR(stats.sigma.x() / kDeg, 10.0, 1e-9);
-  EXPECT_NEAR(stats.covariance(0, 0) / (kDeg * kDeg), 100.0, 1e-7);
+  EXPECT_NEAR(Euler123FromRotation(stats.mean).x() / kRadPerDeg, 20.0, 1e-9);
+  EXPECT_NEAR(stats.sigma.x() / kRadPerDeg, 10.0, 1e-9);
+  EXPECT_NEAR(stats.covariance(0, 0) / (kRadPerDeg * kRadPerDeg), 100.0, 1e-7);
 }
 
 TEST(RotationStatistics, MeanZeroesTheSumOfDeviationsAndIsAMinimum) {
@@ -83,7 +83,7 @@ TEST(VectorStatistics, SampleStandardDeviation) {
 
 TEST(EulerAngles, Euler123RoundTripAndHuskyPreset) {
   // Husky rig: IMU upside down relative to the LiDAR, Euler [180, 0, -90] deg.
-  const Eigen::Matrix3d husky = RotationFromEuler123({180 * kDeg, 0, -90 * kDeg});
+  const Eigen::Matrix3d husky = RotationFromEuler123({180 * kRadPerDeg, 0, -90 * kRadPerDeg});
   EXPECT_TRUE((husky * Eigen::Vector3d::UnitZ()).isApprox(-Eigen::Vector3d::UnitZ()));
   EXPECT_TRUE((husky * Eigen::Vector3d::UnitX()).isApprox(-Eigen::Vector3d::UnitY(), 1e-12));
   std::mt19937 rng(3);

@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include "common/geometry/angles.h"
+
 namespace tiltcal::imu {
 namespace {
 
@@ -82,8 +84,8 @@ TEST_P(AlignAngularSpeedsTest, RecoversOffsetAndScale) {
 INSTANTIATE_TEST_SUITE_P(
     OffsetsAndUnits, AlignAngularSpeedsTest,
     ::testing::Values(Case{0.0125, 1.0, 1.0}, Case{0.080, 1.0, 1.0}, Case{-0.3, 1.0, 1.0},
-                      Case{2.0, 1.0, 10.0}, Case{0.080, 57.29577951308232, 1.0},
-                      Case{-7.3, 57.29577951308232, 20.0}));
+                      Case{2.0, 1.0, 10.0}, Case{0.080, geometry::kDegPerRad, 1.0},
+                      Case{-7.3, geometry::kDegPerRad, 20.0}));
 
 TEST(AlignAngularSpeeds, OffsetBeyondTheWindowEndsAtTheBoundOrAWeakPeak) {
   std::vector<TimedValue> gyro, reference;

@@ -1,5 +1,6 @@
 // Oracle tests (analytic ZYX kinematics, simulated bias and noise) of the IMU
 // initialisation the calibrator uses (common/imu).
+#include "common/geometry/angles.h"
 #include "common/imu/gyro_integrator.h"
 #include "common/imu/imu_initialisation.h"
 #include "common/imu/imu_reading.h"
@@ -11,7 +12,6 @@
 
 #include <gtest/gtest.h>
 #include "tests/common/imu/imu_test_options.h"
-#include "tests/testing/angles.h"
 #include "tests/testing/random_vector.h"
 
 namespace tiltcal::calibrate {
@@ -27,7 +27,8 @@ using imu::StaticDetectionOptions;
 using imu::StaticInterval;
 using imu::ValidateImuReadings;
 
-using tiltcal::testing::kDegToRad;
+using geometry::AngleBetweenDeg;
+using geometry::kRadPerDeg;
 
 // Ground truth attitude C_wb(t) = Rz(yaw) Ry(pitch) Rx(roll) with smooth
 // angles, and its body rate from the ZYX kinematics (independent of the
@@ -65,12 +66,8 @@ struct EulerMotion {
   }
 };
 
-double AngleBetweenDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  return std::atan2(a.cross(b).norm(), a.dot(b)) / kDegToRad;
-}
-
 double RotationErrorDeg(const Eigen::Quaterniond& a, const Eigen::Matrix3d& b) {
-  return Eigen::AngleAxisd(a.toRotationMatrix().transpose() * b).angle() / kDegToRad;
+  return Eigen::AngleAxisd(a.toRotationMatrix().transpose() * b).angle() / kRadPerDeg;
 }
 
 // IMU samples of `motion` (world gravity g_w = (0, 0, -9.81), no translation
@@ -153,8 +150,8 @@ TEST(CalibrateImuInitialisationTest, StaticStartGivesBiasAndGravityWithinNoise) 
   EulerMotion m;
   m.start_s = 3.0;  // static for 3 s, then turning and rocking
   m.yaw0 = 0.4;
-  m.pitch0 = -3.0 * kDegToRad;  // tilted rest attitude
-  m.roll0 = 5.0 * kDegToRad;
+  m.pitch0 = -3.0 * kRadPerDeg;  // tilted rest attitude
+  m.roll0 = 5.0 * kRadPerDeg;
   m.yaw_amp = 0.8;
   m.yaw_w = 1.5;
   m.pitch_amp = 0.05;
@@ -188,8 +185,8 @@ TEST(CalibrateImuInitialisationTest, StaticStartGivesBiasAndGravityWithinNoise) 
 TEST(CalibrateImuInitialisationTest, DetectsNoStaticStartWhenMovingAndFallsBack) {
   EulerMotion m;
   m.start_s = -1.0;  // already moving at the first sample
-  m.pitch0 = 2.0 * kDegToRad;
-  m.roll0 = -4.0 * kDegToRad;
+  m.pitch0 = 2.0 * kRadPerDeg;
+  m.roll0 = -4.0 * kRadPerDeg;
   m.yaw_amp = 0.6;
   m.yaw_w = 1.3;
   m.pitch_amp = 0.04;

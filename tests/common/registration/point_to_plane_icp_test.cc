@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include "common/geometry/angles.h"
 #include "common/geometry/so3.h"
 #include "tests/common/registration/registration_test_options.h"
 #include "tests/common/registration/synthetic_scene.h"
@@ -98,7 +99,7 @@ TEST(PointToPlaneIcpTest, NoisyScanLandsWithinTheNoise) {
       AlignPointToPlane(scene.source, scene.map, initial, options);
   ASSERT_TRUE(result.registered);
   EXPECT_LT((result.map_from_source.translation() - scene.truth.translation()).norm(), 0.01);
-  EXPECT_LT(AngleBetween(result.map_from_source, scene.truth), 0.1 * M_PI / 180.0);
+  EXPECT_LT(AngleBetween(result.map_from_source, scene.truth), geometry::DegToRad(0.1));
   EXPECT_NEAR(result.inlier_rms_m, 0.014, 0.008);  // two planes' noise of 1 cm
 }
 

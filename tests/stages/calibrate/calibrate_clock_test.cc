@@ -9,6 +9,7 @@
 
 #include <Eigen/Geometry>
 
+#include "common/geometry/angles.h"
 #include "common/io/eigen_proto.h"
 #include "common/io/text_proto.h"
 #include "tests/stages/calibrate/short_sequence_fixture.h"
@@ -34,7 +35,7 @@ TEST_F(CalibrateClockTest, ClockOffsetOfTwoSecondsIsRecovered) {
   const Eigen::Vector3d dt = est.translation - tru.translation;
   const double planar_cm = (dt - dt.dot(up_b) * up_b).norm() * 100.0;
   const double rot_deg = Eigen::AngleAxisd(est.rotation.conjugate() * tru.rotation).angle() *
-                         kDegPerRad;
+                         geometry::kDegPerRad;
   const double tau_ms = (result.time_offset_s() - tau_truth) * 1e3;
   std::printf("tau %.1f s: coarse %.4f s (r %.3f, second %.3f, scale %.3f), %d scans dropped; "
               "errors: rotation %.4f deg, planar translation %.3f cm, tau %.3f ms\n",

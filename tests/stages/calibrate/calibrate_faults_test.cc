@@ -15,6 +15,7 @@
 
 #include <Eigen/Geometry>
 
+#include "common/geometry/angles.h"
 #include "common/io/eigen_proto.h"
 #include "common/io/record_stream.h"
 #include "common/io/text_proto.h"
@@ -30,7 +31,7 @@ namespace {
 using CalibrateFaultsTest = ShortSequenceTest;
 
 TEST_F(CalibrateFaultsTest, GyroInDegreesPerSecondIsAnErrorNamingTheRatioAndTheRigField) {
-  for (imu::ImuReading& r : inputs_.imu) r.angular_velocity_radps *= kDegPerRad;
+  for (imu::ImuReading& r : inputs_.imu) r.angular_velocity_radps *= geometry::kDegPerRad;
   proto::CalibrationResult result;
   std::string log;
   const Status status = Run(&result, &log);
@@ -42,7 +43,7 @@ TEST_F(CalibrateFaultsTest, GyroInDegreesPerSecondIsAnErrorNamingTheRatioAndTheR
   EXPECT_NE(status.message().find("times faster than the LiDAR"), std::string::npos)
       << status.message();
   const double ratio = std::stod(status.message().substr(status.message().find("turns ") + 6));
-  EXPECT_NEAR(ratio, kDegPerRad, 0.1 * kDegPerRad) << status.message();
+  EXPECT_NEAR(ratio, geometry::kDegPerRad, 0.1 * geometry::kDegPerRad) << status.message();
 }
 
 TEST_F(CalibrateFaultsTest, RigYawOffBy90DegreesIsRefusedWithTheAngle) {
@@ -84,7 +85,7 @@ TEST_F(CalibrateFaultsTest, UndeclaredUpsideDownImuIsRefusedWithTheAxisAngle) {
 // acceleration check); on 40 s sequences within 0.5 deg.
 double RotationFromTruthDeg(const Eigen::Quaterniond& q, const proto::SimulationTruth& truth) {
   const Eigen::Quaterniond t = ToEigen(truth.imu_from_lidar()).rotation;
-  return Eigen::AngleAxisd(q * t.conjugate()).angle() * 180.0 / M_PI;
+  return geometry::RadToDeg(Eigen::AngleAxisd(q * t.conjugate()).angle());
 }
 
 TEST_F(CalibrateFaultsTest, WrongRigRotationsAndNoGuessAreCorrectedFromTheMotion) {

@@ -20,6 +20,7 @@
 
 #include <Eigen/Geometry>
 
+#include "common/geometry/angles.h"
 #include "common/geometry/so3.h"
 #include "common/geometry/translation_prior.h"
 #include "common/io/atomic_file.h"
@@ -328,10 +329,9 @@ TEST(ProblemBuilderTest, ReexpressionMakesTheFirstPoseTheIdentity) {
 
 TEST(CovarianceReportTest, SigmasDirectionsAndWeakNames) {
   Matrix7d cov = Matrix7d::Zero();
-  const double deg = M_PI / 180.0;
-  cov(0, 0) = std::pow(0.01 * deg, 2);
-  cov(1, 1) = std::pow(0.02 * deg, 2);
-  cov(2, 2) = std::pow(0.2 * deg, 2);   // weak
+  cov(0, 0) = std::pow(0.01 * geometry::kRadPerDeg, 2);
+  cov(1, 1) = std::pow(0.02 * geometry::kRadPerDeg, 2);
+  cov(2, 2) = std::pow(0.2 * geometry::kRadPerDeg, 2);   // weak
   cov(3, 3) = std::pow(0.001, 2);
   cov(4, 4) = std::pow(0.002, 2);
   cov(5, 5) = std::pow(0.05, 2);        // weak: along z
@@ -557,7 +557,7 @@ TEST(CovarianceReportTest, PrincipalAxisOfAYawingMotion) {
 // ---- End to end on a short simulated flat sequence ----
 
 double AngleDeg(const Eigen::Quaterniond& a, const Eigen::Quaterniond& b) {
-  return Eigen::AngleAxisd(a.conjugate() * b).angle() * 180.0 / M_PI;
+  return geometry::RadToDeg(Eigen::AngleAxisd(a.conjugate() * b).angle());
 }
 
 // Simulates `scenario` (tests/stages/calibrate/<name>, with the text
@@ -668,15 +668,15 @@ TEST(CalibratePipelineTest, ShortFlatSequenceAgainstTruth) {
   const double rot_deg = AngleDeg(est.rotation, tru.rotation);
   const double rig_rot_deg = AngleDeg(measured.rotation, tru.rotation);
   const double tau_ms = std::abs(result.time_offset_s() - truth.time_offset_s()) * 1e3;
-  const double gravity_deg = std::acos(std::clamp(
+  const double gravity_deg = geometry::RadToDeg(std::acos(std::clamp(
       ToEigen(result.gravity_in_world()).normalized().dot(
-          ToEigen(truth.gravity_in_world()).normalized()), -1.0, 1.0)) * 180.0 / M_PI;
+          ToEigen(truth.gravity_in_world()).normalized()), -1.0, 1.0)));
   // Rotation error split into the angle about up (yaw, about the motion's
   // rotation axis) and the tilt (about horizontal axes).
   const Eigen::AngleAxisd err(est.rotation * tru.rotation.conjugate());
   const Eigen::Vector3d phi = err.angle() * err.axis();
-  const double yaw_deg = std::abs(phi.dot(up_b)) * 180.0 / M_PI;
-  const double tilt_deg = (phi - phi.dot(up_b) * up_b).norm() * 180.0 / M_PI;
+  const double yaw_deg = geometry::RadToDeg(std::abs(phi.dot(up_b)));
+  const double tilt_deg = geometry::RadToDeg((phi - phi.dot(up_b) * up_b).norm());
   std::printf("LiDAR + IMU: rotation error %.4f deg (tilt %.4f, yaw %.4f; rig %.3f), planar "
               "translation error %.3f cm, vertical %.3f cm, tau error %.3f ms, gravity %.4f deg\n",
               rot_deg, tilt_deg, yaw_deg, rig_rot_deg, planar_cm, dt.dot(up_b) * 100.0, tau_ms,

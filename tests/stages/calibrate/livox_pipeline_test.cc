@@ -19,6 +19,7 @@
 
 #include <Eigen/Geometry>
 
+#include "common/geometry/angles.h"
 #include "common/io/eigen_proto.h"
 #include "common/io/record_stream.h"
 #include "common/io/text_proto.h"
@@ -33,10 +34,6 @@ namespace tiltcal {
 namespace {
 
 using testing::ToolPath;
-
-double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  return std::atan2(a.cross(b).norm(), a.dot(b)) * 180.0 / M_PI;
-}
 
 // Runs the commands in turn; false (and a failure recorded) when one fails.
 bool RunAll(const std::vector<std::string>& commands) {
@@ -120,8 +117,9 @@ void ExpectScansAndGroundMatchTruth(const testing::TempDir& dir, const char* lab
     ++valid;
     const proto::TruthScan& t = truth.scans(static_cast<int>(k));
     ASSERT_EQ(planes[k].stamp_ns(), t.stamp_ns());
-    worst_normal_deg = std::max(worst_normal_deg, AngleDeg(ToEigen(planes[k].normal_in_lidar()),
-                                                           ToEigen(t.ground_normal_in_lidar())));
+    worst_normal_deg =
+        std::max(worst_normal_deg, geometry::AngleBetweenDeg(ToEigen(planes[k].normal_in_lidar()),
+                                                             ToEigen(t.ground_normal_in_lidar())));
     worst_height_cm =
         std::max(worst_height_cm, std::abs(planes[k].height_m() - t.ground_height_m()) * 100);
   }
@@ -173,8 +171,8 @@ TEST(LivoxPipelineTest, Mid360SequenceGroundAndCalibrationAgainstTruth) {
   const double planar_cm = (dt - dt.dot(up_b) * up_b).norm() * 100.0;
   const Eigen::AngleAxisd err(est.rotation * tru.rotation.conjugate());
   const Eigen::Vector3d phi = err.angle() * err.axis();
-  const double yaw_deg = std::abs(phi.dot(up_b)) * 180.0 / M_PI;
-  const double tilt_deg = (phi - phi.dot(up_b) * up_b).norm() * 180.0 / M_PI;
+  const double yaw_deg = geometry::RadToDeg(std::abs(phi.dot(up_b)));
+  const double tilt_deg = geometry::RadToDeg((phi - phi.dot(up_b) * up_b).norm());
   const double tau_ms = std::abs(result.time_offset_s() - truth.time_offset_s()) * 1e3;
   std::printf("Mid-360 calibration: tilt %.4f deg, yaw %.4f deg, planar %.3f cm, vertical "
               "%.3f cm, tau %.3f ms, verdict %s\n",

@@ -23,8 +23,6 @@
 
 namespace tiltcal::calibrate {
 
-inline constexpr double kDegPerRad = 180.0 / M_PI;
-
 // LiDAR + IMU only.
 inline proto::CalibrateParams LidarImuParams() {
   return testing::DefaultCalibrateParamsWith(R"pb(

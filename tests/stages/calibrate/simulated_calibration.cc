@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 
+#include "common/geometry/angles.h"
 #include "common/io/eigen_proto.h"
 
 namespace tiltcal::calibrate {
@@ -46,7 +47,7 @@ CalibrationRun RunCalibrate(const SimulatedInputs& inputs, const proto::Calibrat
   const Rigid3d estimate = ToEigen(run.result.imu_from_lidar());
   const Rigid3d truth = ToEigen(inputs.truth.imu_from_lidar());
   run.rotation_deg =
-      Eigen::AngleAxisd(estimate.rotation * truth.rotation.conjugate()).angle() * 180.0 / M_PI;
+      geometry::RadToDeg(Eigen::AngleAxisd(estimate.rotation * truth.rotation.conjugate()).angle());
   run.translation_m = estimate.translation - truth.translation;
   run.tau_ms = (run.result.time_offset_s() - inputs.truth.time_offset_s()) * 1e3;
   run.max_rotation_sigma_deg = ToEigen(run.result.rotation_sigma_deg()).maxCoeff();

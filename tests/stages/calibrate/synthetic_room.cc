@@ -3,6 +3,8 @@
 #include <cmath>
 #include <limits>
 
+#include "common/geometry/angles.h"
+
 namespace tiltcal::calibrate::testing {
 namespace {
 
@@ -194,10 +196,9 @@ SimulatedScan ScanScene(const Scene& scene, const Eigen::Isometry3d& world_from_
   for (int c = 0; c < pattern.num_columns; ++c) {
     const double azimuth = 2.0 * M_PI * c / pattern.num_columns;
     for (int b = 0; b < pattern.num_beams; ++b) {
-      const double elevation =
-          (pattern.min_elevation_deg +
-           (pattern.max_elevation_deg - pattern.min_elevation_deg) * b / std::max(pattern.num_beams - 1, 1)) *
-          M_PI / 180.0;
+      const double elevation = geometry::DegToRad(
+          pattern.min_elevation_deg +
+          (pattern.max_elevation_deg - pattern.min_elevation_deg) * b / std::max(pattern.num_beams - 1, 1));
       const Eigen::Vector3d dir_l(std::cos(elevation) * std::cos(azimuth), std::cos(elevation) * std::sin(azimuth),
                                   std::sin(elevation));
       const Hit hit = CastRay(scene, origin, r * dir_l);

@@ -12,6 +12,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Geometry>
 
+#include "common/geometry/angles.h"
 #include "common/geometry/so3.h"
 #include "common/io/atomic_file.h"
 #include "common/io/eigen_proto.h"
@@ -23,7 +24,7 @@
 namespace tiltcal::dataset {
 namespace {
 
-constexpr double kDegPerRad = 180.0 / M_PI;
+using geometry::kDegPerRad;
 
 proto::DatasetCalibrationParams Params(const std::string& overrides = "") {
   return testing::DefaultParamsWith<proto::DatasetCalibrationParams>(

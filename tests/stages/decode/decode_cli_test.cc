@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include "common/geometry/angles.h"
 #include "common/io/record_stream.h"
 #include "tests/bag/ros1/bag_test_util.h"
 #include "tests/stages/decode/vehicle_bag.h"
@@ -338,7 +339,7 @@ TEST_F(DecodeCli, MissingBag) {
 testing::VehicleBagOptions InGAndDegrees() {
   testing::VehicleBagOptions options;
   options.accel_scale = 1.0 / 9.80665;
-  options.gyro_scale = 180.0 / M_PI;
+  options.gyro_scale = geometry::kDegPerRad;
   return options;
 }
 

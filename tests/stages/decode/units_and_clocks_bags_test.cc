@@ -12,6 +12,7 @@
 
 #include <gtest/gtest.h>
 
+#include "common/geometry/angles.h"
 #include "common/io/record_stream.h"
 #include "common/io/text_proto.h"
 #include "stages/decode/decode.h"
@@ -25,8 +26,6 @@
 
 namespace tiltcal {
 namespace {
-
-constexpr double kDegreesPerRadian = 180.0 / M_PI;
 
 class UnitsAndClocks : public ::testing::Test {
  protected:
@@ -86,7 +85,7 @@ TEST_F(UnitsAndClocks, ImuInGAndDegreesGivesTheSameStreamAsSi) {
   testing::VehicleBagOptions si;
   testing::VehicleBagOptions g_deg;
   g_deg.accel_scale = 1.0 / 9.80665;
-  g_deg.gyro_scale = kDegreesPerRadian;
+  g_deg.gyro_scale = geometry::kDegPerRad;
   const std::string si_out = OutDir("si");
   const std::string g_out = OutDir("g_deg");
   DecodeSummary si_summary, g_summary;
@@ -98,7 +97,7 @@ TEST_F(UnitsAndClocks, ImuInGAndDegreesGivesTheSameStreamAsSi) {
   EXPECT_EQ(si_summary.accel_to_si, 1.0);
   EXPECT_EQ(si_summary.gyro_to_si, 1.0);
   EXPECT_EQ(g_summary.accel_to_si, 9.80665);
-  EXPECT_EQ(g_summary.gyro_to_si, M_PI / 180.0);
+  EXPECT_EQ(g_summary.gyro_to_si, geometry::kRadPerDeg);
   const std::string si_notes = Notes(si_summary);
   const std::string g_notes = Notes(g_summary);
   EXPECT_NE(si_notes.find("accelerometer in m/s², detected: median |f| 9.8089"), std::string::npos)
@@ -170,14 +169,14 @@ TEST_F(UnitsAndClocks, SiValuesAreWrittenAsPublished) {
 TEST_F(UnitsAndClocks, UnitsStatedByTheRigAndConsistent) {
   testing::VehicleBagOptions g_deg;
   g_deg.accel_scale = 1.0 / 9.80665;
-  g_deg.gyro_scale = kDegreesPerRadian;
+  g_deg.gyro_scale = geometry::kDegPerRad;
   DecodeSummary summary;
   const Status status = Decode(Bag("g_deg.bag", g_deg),
                                Rig("imu_accel_unit: G imu_gyro_unit: DEGPS"), OutDir("out"),
                                &summary);
   ASSERT_TRUE(status.ok()) << status.message();
   EXPECT_EQ(summary.accel_to_si, 9.80665);
-  EXPECT_EQ(summary.gyro_to_si, M_PI / 180.0);
+  EXPECT_EQ(summary.gyro_to_si, geometry::kRadPerDeg);
   const std::string notes = Notes(summary);
   EXPECT_NE(notes.find("accelerometer in g, stated by the rig (imu_accel_unit: G) and "
                        "consistent with median |f| 1.000"),
@@ -211,7 +210,7 @@ TEST_F(UnitsAndClocks, RigStatingTheWrongAccelerometerUnitIsAnError) {
 
 TEST_F(UnitsAndClocks, RigStatingRadiansForADegreeGyroIsAnError) {
   testing::VehicleBagOptions deg;
-  deg.gyro_scale = kDegreesPerRadian;
+  deg.gyro_scale = geometry::kDegPerRad;
   const std::string bag = Bag("deg.bag", deg);
   const std::string rig = Rig("imu_gyro_unit: RADPS");
   const std::string out = OutDir("out");
@@ -232,7 +231,7 @@ TEST_F(UnitsAndClocks, DegreesStatedForASlowGyroIsAccepted) {
   const Status status =
       Decode(Bag("si.bag", {}), Rig("imu_gyro_unit: DEGPS"), OutDir("out"), &summary);
   ASSERT_TRUE(status.ok()) << status.message();
-  EXPECT_EQ(summary.gyro_to_si, M_PI / 180.0);
+  EXPECT_EQ(summary.gyro_to_si, geometry::kRadPerDeg);
 }
 
 TEST_F(UnitsAndClocks, AccelerometerFittingNeitherUnitIsAnError) {

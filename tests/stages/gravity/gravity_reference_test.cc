@@ -10,6 +10,7 @@
 
 #include <Eigen/Geometry>
 
+#include "common/geometry/angles.h"
 #include "common/io/eigen_proto.h"
 #include "common/io/text_proto.h"
 #include "stages/gravity/default_params_text.h"
@@ -19,7 +20,8 @@
 namespace tiltcal::gravity {
 namespace {
 
-constexpr double kDegPerRad = 180.0 / M_PI;
+using geometry::AngleBetweenDeg;
+using geometry::kDegPerRad;
 
 proto::GravityParams Params(const std::string& overrides = "") {
   return testing::DefaultParamsWith<proto::GravityParams>(DefaultParamsText(), overrides);
@@ -42,10 +44,6 @@ FlatCalibration Level(const std::string& path, const Eigen::Vector3d& axis, doub
   return c;
 }
 
-double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  return std::atan2(a.cross(b).norm(), a.dot(b)) * kDegPerRad;
-}
-
 TEST(GravityReference, MeanDirectionWithMeanNormAndTheLargestAngle) {
   const Eigen::Vector3d x = Eigen::Vector3d::UnitX();
   const std::vector<FlatCalibration> calibrations = {
@@ -55,7 +53,7 @@ TEST(GravityReference, MeanDirectionWithMeanNormAndTheLargestAngle) {
   ASSERT_TRUE(out.has_gravity_flat());
   const Eigen::Vector3d g_f = ToEigen(out.gravity_flat_in_imu());
   // ±0.05 deg about x cancel: the mean direction is g0's.
-  EXPECT_LT(AngleDeg(g_f, Eigen::Vector3d(0.05, -0.02, -1.0)), 1e-9);
+  EXPECT_LT(AngleBetweenDeg(g_f, Eigen::Vector3d(0.05, -0.02, -1.0)), 1e-9);
   EXPECT_NEAR(g_f.norm(), 9.81, 1e-12);
   ASSERT_EQ(out.flat_calibrations_size(), 3);
   EXPECT_NEAR(out.flat_calibrations(0).angle_from_combined_deg(), 0.05, 1e-9);
@@ -73,8 +71,8 @@ TEST(GravityReference, UnusableCalibrationsAreLeftOutAndNamed) {
   calibrations[3].result.set_verdict(proto::CalibrationResult::SUSPECT);
   proto::GravityReference out;
   ASSERT_TRUE(CombineFlatCalibrations(calibrations, Params().flat_calibrations(), &out).ok());
-  EXPECT_LT(AngleDeg(ToEigen(out.gravity_flat_in_imu()),
-                     ToEigen(calibrations[0].result.gravity_in_world())),
+  EXPECT_LT(AngleBetweenDeg(ToEigen(out.gravity_flat_in_imu()),
+                            ToEigen(calibrations[0].result.gravity_in_world())),
             1e-9);
   EXPECT_EQ(out.gravity_flat_source(), "flat calibrations (1 of 4)");
   EXPECT_TRUE(out.flat_calibrations(0).used());

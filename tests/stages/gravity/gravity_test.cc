@@ -9,6 +9,7 @@
 
 #include <filesystem>
 
+#include "common/geometry/angles.h"
 #include "common/io/eigen_proto.h"
 #include "common/io/record_stream.h"
 #include "common/io/text_proto.h"
@@ -21,7 +22,7 @@
 namespace tiltcal::gravity {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
+using geometry::kRadPerDeg;
 const Eigen::Vector3d kGravityWorld(0, 0, -9.81);
 
 // The shipped defaults (stages/gravity/default_params.txtpb, compiled in).
@@ -41,7 +42,8 @@ struct Scenario {
   GravityInputs inputs;
 
   explicit Scenario(double tilt_deg) {
-    const Eigen::Quaterniond tilt(Eigen::AngleAxisd(tilt_deg * kDeg, Eigen::Vector3d::UnitX()));
+    const Eigen::Quaterniond tilt(
+        Eigen::AngleAxisd(tilt_deg * kRadPerDeg, Eigen::Vector3d::UnitX()));
     const Eigen::Vector3d yaw_axis_in_imu = c_vb.conjugate() * Eigen::Vector3d::UnitZ();
     auto omega = [&](double t) -> Eigen::Vector3d {
       const bool moving = t >= 2.0 && t < 8.0;
@@ -81,7 +83,7 @@ TEST(Gravity, LevelSequenceGivesFlatGravityFromStaticWindows) {
   const double error_deg =
       std::acos(ToEigen(out.gravity_flat_in_imu()).normalized().dot(
           scenario.FlatGravityInImu().normalized())) /
-      kDeg;
+      kRadPerDeg;
   EXPECT_LT(error_deg, 0.05);
   ASSERT_EQ(out.inclination_size(), 110);
   for (const auto& sample : out.inclination()) {
@@ -122,7 +124,7 @@ TEST(Gravity, VibratingImuKeepsItsStaticWindowsGyroBiasAndFlatGravity) {
   const double error_deg =
       std::acos(ToEigen(out.gravity_flat_in_imu()).normalized().dot(
           scenario.FlatGravityInImu().normalized())) /
-      kDeg;
+      kRadPerDeg;
   EXPECT_LT(error_deg, 0.05);
 }
 
@@ -130,7 +132,7 @@ TEST(Gravity, FlatCalibrationIsPreferredAndDisagreementReported) {
   Scenario scenario(0.0);
   proto::CalibrationResult calibration;
   const Eigen::Vector3d tilted_by_1deg =
-      Eigen::AngleAxisd(1.0 * kDeg, Eigen::Vector3d::UnitY()) * scenario.FlatGravityInImu();
+      Eigen::AngleAxisd(1.0 * kRadPerDeg, Eigen::Vector3d::UnitY()) * scenario.FlatGravityInImu();
   *calibration.mutable_gravity_in_world() = ToProto(tilted_by_1deg);
   scenario.inputs.flat_calibration = &calibration;
   proto::GravityReference out;

@@ -3,6 +3,7 @@
 // truth at the stamp, the raw one must not.
 #include "stages/ground/deskew.h"
 
+#include "common/geometry/angles.h"
 #include "common/imu/gyro_integrator.h"
 #include "common/imu/imu_reading.h"
 
@@ -18,7 +19,7 @@
 namespace tiltcal::ground {
 namespace {
 
-using testing::AngleDeg;
+using geometry::AngleBetweenDeg;
 using testing::CastScan;
 using testing::DefaultGroundParams;
 using testing::GroundParamsWith;
@@ -91,8 +92,8 @@ TEST(Deskewer, DeskewedPlaneMatchesTheTruthAtTheStamp) {
   ASSERT_TRUE(plane.valid()) << plane.reject_detail();
   EXPECT_TRUE(plane.deskewed());
   EXPECT_TRUE(scan.deskewed());
-  const double err = AngleDeg(NormalOf(plane), testing::TrueNormal(c.pose));
-  const double raw_err = AngleDeg(NormalOf(raw_plane), testing::TrueNormal(c.pose));
+  const double err = AngleBetweenDeg(NormalOf(plane), testing::TrueNormal(c.pose));
+  const double raw_err = AngleBetweenDeg(NormalOf(raw_plane), testing::TrueNormal(c.pose));
   std::printf("normal error deskewed %.4f deg, raw %.4f deg\n", err, raw_err);
   EXPECT_LT(err, 0.1);
   EXPECT_GT(raw_err, 3.0 * err);

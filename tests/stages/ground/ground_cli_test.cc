@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include "common/geometry/angles.h"
 #include "common/io/atomic_file.h"
 #include "common/io/eigen_proto.h"
 #include "common/io/provenance.h"
@@ -23,7 +24,7 @@
 namespace tiltcal {
 namespace {
 
-using testing::AngleDeg;
+using geometry::AngleBetweenDeg;
 using testing::NormalOf;
 using testing::RollPitchYaw;
 using testing::SyntheticPose;
@@ -131,7 +132,7 @@ TEST(GroundCli, PlanesMatchTheTruthAndDeskewedScansAreWritten) {
     EXPECT_TRUE(testing::NoNan(p));
     EXPECT_EQ(p.stamp_ns(), kFirstStampNs + k * 100000000LL);
     EXPECT_NEAR(p.height_prior_m(), 0.9, 0.01);  // 0.5 m + 0.4 m lever arm
-    EXPECT_LT(AngleDeg(NormalOf(p), testing::TrueNormal(data.poses[k])), 0.1) << k;
+    EXPECT_LT(AngleBetweenDeg(NormalOf(p), testing::TrueNormal(data.poses[k])), 0.1) << k;
     EXPECT_NEAR(p.height_m(), 0.9, 0.005) << k;
   }
   std::vector<proto::Scan> deskewed;

@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include "common/geometry/angles.h"
 #include "common/io/atomic_file.h"
 #include "common/io/record_stream.h"
 #include "common/io/text_proto.h"
@@ -54,7 +55,7 @@ TEST_P(KittiGround, PlaneMatchesTheReference) {
   ASSERT_TRUE(plane.valid()) << plane.reject_detail();
   EXPECT_TRUE(testing::NoNan(plane));
   const Eigen::Vector3d reference = Eigen::Vector3d(-0.001, 0.034, 0.9994).normalized();
-  const double angle = testing::AngleDeg(testing::NormalOf(plane), reference);
+  const double angle = geometry::AngleBetweenDeg(testing::NormalOf(plane), reference);
   std::printf("%s: %u points, %u ground, %u inliers within %.2f m, n = (%.4f, %.4f, %.4f), "
               "d = %.4f m, %.3f deg from the reference, rms %.4f m\n",
               GetParam(), plane.num_points(), plane.num_ground_points(), plane.num_inliers(),
@@ -117,7 +118,7 @@ TEST(KittiGroundCli, ExecutableFitsTheReferencePlane) {
   for (const proto::GroundPlane& plane : planes) {
     EXPECT_TRUE(plane.valid()) << plane.reject_detail();
     EXPECT_FALSE(plane.deskewed());
-    EXPECT_LT(testing::AngleDeg(testing::NormalOf(plane), reference), 0.5);
+    EXPECT_LT(geometry::AngleBetweenDeg(testing::NormalOf(plane), reference), 0.5);
     EXPECT_GE(plane.height_m(), 1.72);
     EXPECT_LE(plane.height_m(), 1.78);
   }

@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include "common/geometry/angles.h"
 #include "common/io/eigen_proto.h"
 #include "tests/stages/ground/ground_test_util.h"
 #include "tests/testing/synthetic_lidar.h"
@@ -17,7 +18,7 @@
 namespace tiltcal::ground {
 namespace {
 
-using testing::AngleDeg;
+using geometry::AngleBetweenDeg;
 using testing::CastScan;
 using testing::DefaultGroundParams;
 using testing::NoNan;
@@ -56,8 +57,8 @@ SequenceErrors RunSequence(double roll_deg, double pitch_deg, double height_m, i
     SyntheticPose pose;
     const double s = static_cast<double>(k) / num_scans;
     pose.position_g = Eigen::Vector3d(0.5 * k, 0.0, height_m + 0.02 * std::sin(7.0 * s));
-    pose.g_from_lidar = RollPitchYaw(roll_deg * M_PI / 180.0 * std::cos(3.0 * s),
-                                     pitch_deg * M_PI / 180.0 * std::sin(2.0 * s + 0.5),
+    pose.g_from_lidar = RollPitchYaw(geometry::DegToRad(roll_deg) * std::cos(3.0 * s),
+                                     geometry::DegToRad(pitch_deg) * std::sin(2.0 * s + 0.5),
                                      0.3 * std::sin(5.0 * s));
     const SyntheticScene scene = StreetScene(100 + k);
     proto::Scan scan = CastScan(scene, lidar, pose, 1000000000LL + k * 100000000LL, 7 + k);
@@ -76,7 +77,7 @@ SequenceErrors RunSequence(double roll_deg, double pitch_deg, double height_m, i
       continue;
     }
     ++errors.valid;
-    errors.normal_deg.push_back(AngleDeg(NormalOf(plane), TrueNormal(poses[k])));
+    errors.normal_deg.push_back(AngleBetweenDeg(NormalOf(plane), TrueNormal(poses[k])));
     errors.height_m.push_back(std::fabs(plane.height_m() - TrueHeight(poses[k])));
   }
   return errors;
@@ -123,7 +124,7 @@ TEST(ScanProcessor, UpsideDownLidarWithRigUpDirection) {
   proto::Scan scan = CastScan(StreetScene(3), SyntheticLidar::Vlp16(), pose, 1, 3);
   const proto::GroundPlane plane = processor.Process(&scan);
   ASSERT_TRUE(plane.valid()) << plane.reject_detail();
-  EXPECT_LT(AngleDeg(NormalOf(plane), TrueNormal(pose)), 0.2);
+  EXPECT_LT(AngleBetweenDeg(NormalOf(plane), TrueNormal(pose)), 0.2);
   EXPECT_LT(NormalOf(plane).z(), -0.9);
   EXPECT_NEAR(plane.height_m(), 1.2, 0.01);
 }
@@ -183,7 +184,7 @@ TEST(ScanProcessor, RaisedSidewalkDoesNotTiltTheRoadPlane) {
   proto::Scan scan = CastScan(scene, SyntheticLidar::Vlp16(), pose, 1, 12);
   const proto::GroundPlane plane = processor.Process(&scan);
   ASSERT_TRUE(plane.valid()) << plane.reject_detail();
-  EXPECT_LT(AngleDeg(NormalOf(plane), TrueNormal(pose)), 0.1);
+  EXPECT_LT(AngleBetweenDeg(NormalOf(plane), TrueNormal(pose)), 0.1);
   EXPECT_NEAR(plane.height_m(), 0.85, 0.005);
 }
 
@@ -214,7 +215,7 @@ TEST(ScanProcessor, CeilingIsNotGroundWhenTheFloorIsVisible) {
   const proto::GroundPlane plane = processor.Process(&scan);
   ASSERT_TRUE(plane.valid()) << plane.reject_detail();
   EXPECT_NEAR(plane.height_m(), 0.8, 0.005);
-  EXPECT_LT(AngleDeg(NormalOf(plane), TrueNormal(pose)), 0.2);
+  EXPECT_LT(AngleBetweenDeg(NormalOf(plane), TrueNormal(pose)), 0.2);
   // No ceiling point is labelled ground.
   for (int i = 0; i < scan.x_size(); ++i) {
     if (scan.z(i) > 1.0) {
@@ -306,7 +307,7 @@ TEST(TiltJumpGate, RejectsTheOutlierOnly) {
   std::vector<proto::GroundPlane> planes(9);
   for (int i = 0; i < 9; ++i) {
     planes[i].set_valid(true);
-    const double tilt = (i == 4 ? 6.0 : 0.1 * i) * M_PI / 180.0;
+    const double tilt = geometry::DegToRad(i == 4 ? 6.0 : 0.1 * i);
     planes[i].mutable_normal_in_lidar()->set_y(std::sin(tilt));
     planes[i].mutable_normal_in_lidar()->set_z(std::cos(tilt));
   }

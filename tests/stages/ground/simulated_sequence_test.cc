@@ -12,6 +12,7 @@
 
 #include <gtest/gtest.h>
 
+#include "common/geometry/angles.h"
 #include "common/io/eigen_proto.h"
 #include "common/io/record_stream.h"
 #include "common/io/text_proto.h"
@@ -90,7 +91,7 @@ void RunSequence(double roll_deg, double pitch_deg, const char* name) {
     }
     ++valid;
     const Eigen::Vector3d n_true = ToEigen(it->second->ground_normal_in_lidar());
-    normal_deg.push_back(testing::AngleDeg(testing::NormalOf(p), n_true));
+    normal_deg.push_back(geometry::AngleBetweenDeg(testing::NormalOf(p), n_true));
     height_m.push_back(std::fabs(p.height_m() - it->second->ground_height_m()));
   }
   const double normal = Median(normal_deg), height = Median(height_m);

@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include "common/geometry/angles.h"
 #include "common/geometry/euler_angles.h"
 #include "common/io/atomic_file.h"
 #include "common/io/eigen_proto.h"
@@ -18,11 +19,9 @@
 namespace tiltcal::report {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
-
 proto::Rigid3 Extrinsic(const Eigen::Vector3d& euler_deg, const Eigen::Vector3d& t_m) {
   Rigid3d t;
-  t.rotation = Eigen::Quaterniond(geometry::RotationFromEuler123(euler_deg * kDeg));
+  t.rotation = Eigen::Quaterniond(geometry::RotationFromEuler123(euler_deg * geometry::kRadPerDeg));
   t.translation = t_m;
   return ToProto(t);
 }

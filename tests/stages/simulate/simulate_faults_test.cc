@@ -15,6 +15,7 @@
 
 #include "bag/ros1/bag_reader.h"
 #include "bag/ros1/messages.h"
+#include "common/geometry/angles.h"
 #include "common/geometry/euler_angles.h"
 #include "common/imu/imu_units.h"
 #include "common/io/atomic_file.h"
@@ -230,12 +231,11 @@ TEST(SimulateFaultsTest, ImuInGAndDegreesPerSecond) {
     double gyro_factor;   // published / SI
     double accel_factor;
   };
-  const double deg_per_rad = 180.0 / M_PI;
   const double per_g = 1.0 / imu::kStandardGravityMps2;
   for (const Case& c : std::vector<Case>{
-           {"faults { imu_accel_unit: G imu_gyro_unit: DEGPS }", deg_per_rad, per_g},
+           {"faults { imu_accel_unit: G imu_gyro_unit: DEGPS }", geometry::kDegPerRad, per_g},
            {"faults { imu_accel_unit: G }", 1.0, per_g},
-           {"faults { imu_gyro_unit: DEGPS }", deg_per_rad, 1.0}}) {
+           {"faults { imu_gyro_unit: DEGPS }", geometry::kDegPerRad, 1.0}}) {
     SCOPED_TRACE(c.overrides);
     const proto::SimulateParams params = ShortScenarioWith("duration_s: 1 " + c.overrides);
     const SimulatedRun run = Simulate(params, dir, "units");
@@ -482,8 +482,8 @@ TEST(SimulateFaultsTest, RigFileWithLargeErrors) {
                                      geometry::RotationFromEuler123Deg(c.lidar_side_deg);
     const Eigen::Matrix3d c_meas = ToRotation(rig.imu_from_lidar());
     EXPECT_LT((c_meas - expected).norm(), 1e-9);
-    EXPECT_NEAR(Eigen::AngleAxisd(c_bl.transpose() * c_meas).angle() * 180 / M_PI, c.angle_deg,
-                1e-6);
+    EXPECT_NEAR(geometry::RadToDeg(Eigen::AngleAxisd(c_bl.transpose() * c_meas).angle()),
+                c.angle_deg, 1e-6);
     const Eigen::Vector3d dr = ToEigen(rig.imu_from_lidar().translation()) -
                                ToEigen(run.truth.imu_from_lidar().translation());
     EXPECT_LT((dr - c.translation_m).norm(), 1e-12);

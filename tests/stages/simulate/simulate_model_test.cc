@@ -10,6 +10,7 @@
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
+#include "common/geometry/angles.h"
 #include "common/geometry/euler_angles.h"
 #include "stages/simulate/lidar_model.h"
 #include "stages/simulate/random.h"
@@ -20,7 +21,7 @@
 namespace tiltcal::simulate {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
+using geometry::kRadPerDeg;
 
 TEST(SimEulerAnglesTest, HuskyRigHasTheImuUpsideDownRelativeToTheLidar) {
   const Eigen::Matrix3d c_bl = geometry::RotationFromEuler123Deg(Eigen::Vector3d(180, 0, -90));
@@ -37,13 +38,13 @@ TrajectoryConfig TiltedConfig(bool vibration) {
   c.static_start_s = 1.0;
   c.ramp_s = 1.5;
   c.heading_rad = 0.3;
-  c.ground_roll_rad = 3 * kDeg;
-  c.ground_pitch_rad = 8 * kDeg;
+  c.ground_roll_rad = 3 * kRadPerDeg;
+  c.ground_pitch_rad = 8 * kRadPerDeg;
   c.imu_height_m = 0.3;
   c.vehicle_from_imu = geometry::RotationFromEuler123Deg(Eigen::Vector3d(180, 0, 0));
   if (vibration) {
-    c.vibration_roll_rad = 0.5 * kDeg;
-    c.vibration_pitch_rad = 0.4 * kDeg;
+    c.vibration_roll_rad = 0.5 * kRadPerDeg;
+    c.vibration_pitch_rad = 0.4 * kRadPerDeg;
     c.vibration_frequency_hz = 3.0;
   }
   return c;
@@ -88,7 +89,8 @@ TEST(SimTrajectoryTest, PlanarMotionOnTheTiltedPlane) {
   const PlanarTrajectory trajectory(config);
   const Eigen::Vector3d n = trajectory.NormalInWorld();
   // The plane normal is tilted by roll 3, pitch 8 deg: acos(cos3 cos8).
-  EXPECT_NEAR(std::acos(n.z()), std::acos(std::cos(3 * kDeg) * std::cos(8 * kDeg)), 1e-12);
+  EXPECT_NEAR(std::acos(n.z()), std::acos(std::cos(3 * kRadPerDeg) * std::cos(8 * kRadPerDeg)),
+              1e-12);
   double min_yaw_rate = 0, max_yaw_rate = 0;
   for (double t = 0; t < 30.0; t += 0.05) {
     const ImuState s = trajectory.Evaluate(t);
@@ -314,8 +316,8 @@ TEST(SimScanSimulatorTest, LivoxFramesAreNonRepetitiveWithinTheFieldOfView) {
           continue;
         }
         ++valid;
-        const double az = std::atan2(p.y, p.x) * 180.0 / M_PI;
-        const double el = std::atan2(p.z, std::hypot(p.x, p.y)) * 180.0 / M_PI;
+        const double az = geometry::RadToDeg(std::atan2(p.y, p.x));
+        const double el = geometry::RadToDeg(std::atan2(p.z, std::hypot(p.x, p.y)));
         if (avia) {
           EXPECT_LE(std::abs(az), 35.2 + 1e-3);
           EXPECT_LE(std::abs(el), 38.6 + 1e-3);

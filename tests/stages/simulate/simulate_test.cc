@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include "bag/ros1/message_encoding.h"
+#include "common/geometry/angles.h"
 #include "common/io/atomic_file.h"
 #include "common/io/params.h"
 #include "common/io/record_stream.h"
@@ -363,8 +364,10 @@ TEST_F(ShortRunTest, GroundPointsFitTheTruePlane) {
     const Eigen::Matrix3d c_bl = ToRotation(truth.imu_from_lidar());
     const Eigen::Vector3d r_bl = ToVector(truth.imu_from_lidar().translation());
     EXPECT_NEAR(d, truth.imu_height_m() + n.dot(c_bl.transpose() * r_bl), 1e-9);
-    EXPECT_NEAR(ts.inclination_deg(), std::acos(std::cos(3 * M_PI / 180) * std::cos(8 * M_PI / 180)) *
-                                          180 / M_PI, 1e-9);
+    EXPECT_NEAR(ts.inclination_deg(),
+                geometry::RadToDeg(std::acos(std::cos(geometry::DegToRad(3)) *
+                                             std::cos(geometry::DegToRad(8)))),
+                1e-9);
   }
 }
 
@@ -452,7 +455,7 @@ TEST(SimulateTest, RigFileHoldsThePerturbedExtrinsic) {
   EXPECT_TRUE(dt.isApprox(ToVector(params.rig_file().translation_error_m()), 1e-12));
   const double angle =
       AngleBetween(ToRotation(rig.imu_from_lidar()), ToRotation(truth.imu_from_lidar()));
-  const Eigen::Vector3d e = ToVector(params.rig_file().rotation_error_deg()) * M_PI / 180;
+  const Eigen::Vector3d e = geometry::DegToRad(ToVector(params.rig_file().rotation_error_deg()));
   EXPECT_NEAR(angle, e.norm(), 0.01 * e.norm());  // small angles: |Euler| ≈ angle
   EXPECT_EQ(rig.imu_height_m(), truth.imu_height_m());
   EXPECT_EQ(rig.imu_topic(), params.imu().topic());

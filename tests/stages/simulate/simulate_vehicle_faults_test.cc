@@ -16,6 +16,7 @@
 
 #include "bag/ros1/bag_reader.h"
 #include "bag/ros1/messages.h"
+#include "common/geometry/angles.h"
 #include "common/io/atomic_file.h"
 #include "common/io/eigen_proto.h"
 #include "common/io/text_proto.h"
@@ -184,10 +185,14 @@ TEST(SimulateVehicleFaultsTest, ImuScaleAndMisalignment) {
   const proto::SimulateParams params = ShortWith(motion + faults);
   const SimRun clean = Simulate(clean_params, dir, "clean");
   const SimRun faulty = Simulate(params, dir, "faulty");
-  const double d = M_PI / 180;
+  using geometry::kRadPerDeg;
   Eigen::Matrix3d k_gyro, k_accel;
-  k_gyro << 1.02, 0, 0, 0.5 * d, 1 - 0.015, 0, -0.8 * d, 1.0 * d, 1.01;
-  k_accel << 1 - 0.01, 0, 0, -1 * d, 1.03, 0, 0.6 * d, 0.4 * d, 1.005;
+  k_gyro << 1.02, 0, 0,
+            0.5 * kRadPerDeg, 1 - 0.015, 0,
+            -0.8 * kRadPerDeg, 1.0 * kRadPerDeg, 1.01;
+  k_accel << 1 - 0.01, 0, 0,
+             -1 * kRadPerDeg, 1.03, 0,
+             0.6 * kRadPerDeg, 0.4 * kRadPerDeg, 1.005;
   EXPECT_LT((MatrixOf(faulty.truth.gyro_intrinsics()) - k_gyro).norm(), 1e-12);
   EXPECT_LT((MatrixOf(faulty.truth.accel_intrinsics()) - k_accel).norm(), 1e-12);
   EXPECT_NEAR(faulty.truth.gyro_intrinsics().scale_ppm().x(), 20000, 1e-6);
@@ -258,9 +263,9 @@ TEST(SimulateVehicleFaultsTest, ImuIntrinsicsDrawnWithinBounds) {
     EXPECT_GT(angles.cwiseAbs().minCoeff(), 0.0);
     Eigen::Matrix3d k = Eigen::Matrix3d::Identity();
     k.diagonal() += scale * 1e-6;
-    k(1, 0) = angles.x() * M_PI / 180;
-    k(2, 0) = angles.y() * M_PI / 180;
-    k(2, 1) = angles.z() * M_PI / 180;
+    k(1, 0) = geometry::DegToRad(angles.x());
+    k(2, 0) = geometry::DegToRad(angles.y());
+    k(2, 1) = geometry::DegToRad(angles.z());
     EXPECT_LT((MatrixOf(*t) - k).norm(), 1e-12);
   }
   EXPECT_NE(ToEigen(other_seed.truth.gyro_intrinsics().scale_ppm()),

@@ -7,6 +7,7 @@
 
 #include <Eigen/Geometry>
 
+#include "common/geometry/angles.h"
 #include "common/io/eigen_proto.h"
 #include "stages/verify/default_params_text.h"
 #include "tests/testing/params_text.h"
@@ -14,7 +15,7 @@
 namespace tiltcal::verify {
 namespace {
 
-constexpr double kRadPerDeg = M_PI / 180.0;
+using geometry::kRadPerDeg;
 
 proto::VerifyParams Params(const std::string& overrides = "") {
   return testing::DefaultParamsWith<proto::VerifyParams>(DefaultParamsText(), overrides);

@@ -6,14 +6,14 @@
 
 #include <gtest/gtest.h>
 
+#include "common/geometry/angles.h"
 #include "tests/stages/calibrate/calibrate_params_text.h"
-#include "tests/testing/angles.h"
 #include "tests/testing/random_vector.h"
 
 namespace tiltcal::calibrate {
 namespace {
 
-using tiltcal::testing::kDegToRad;
+using geometry::kRadPerDeg;
 
 // The program's hand-eye settings: at least 15 pairs, excited from 0.02 rad,
 // pairs disagreeing by more than 1 deg down-weighted.
@@ -28,15 +28,15 @@ Eigen::Quaterniond Exp(const Eigen::Vector3d& phi) {
 }
 
 double AngleDeg(const Eigen::Quaterniond& a, const Eigen::Quaterniond& b) {
-  return Eigen::AngleAxisd((a.conjugate() * b).normalized()).angle() / kDegToRad;
+  return Eigen::AngleAxisd((a.conjugate() * b).normalized()).angle() / kRadPerDeg;
 }
 
 // A rig-like extrinsic: LiDAR mounted upside down and turned (the paper's
 // Husky "measured" value is roll 180, yaw -90), plus a few degrees.
 Eigen::Quaterniond TrueExtrinsic() {
-  return Eigen::Quaterniond(Eigen::AngleAxisd(-88.0 * kDegToRad, Eigen::Vector3d::UnitZ()) *
-                            Eigen::AngleAxisd(2.5 * kDegToRad, Eigen::Vector3d::UnitY()) *
-                            Eigen::AngleAxisd(178.0 * kDegToRad, Eigen::Vector3d::UnitX()));
+  return Eigen::Quaterniond(Eigen::AngleAxisd(-88.0 * kRadPerDeg, Eigen::Vector3d::UnitZ()) *
+                            Eigen::AngleAxisd(2.5 * kRadPerDeg, Eigen::Vector3d::UnitY()) *
+                            Eigen::AngleAxisd(178.0 * kRadPerDeg, Eigen::Vector3d::UnitX()));
 }
 
 // Pairs whose IMU rotation vectors are drawn with per-axis RMS angles
@@ -51,7 +51,7 @@ std::vector<RotationPair> MakePairs(const Eigen::Quaterniond& c_bl, const Eigen:
     const Eigen::Vector3d phi = axis_rms_rad.cwiseProduct(tiltcal::testing::RandomVector3(n, rng));
     const Eigen::Quaterniond c_b = Exp(phi);
     const Eigen::Quaterniond c_l = c_bl.conjugate() * c_b * c_bl;
-    const double s = noise_deg * kDegToRad;
+    const double s = noise_deg * kRadPerDeg;
     RotationPair p;
     p.imu_delta = c_b * Exp(s * tiltcal::testing::RandomVector3(n, rng));
     p.lidar_delta = c_l * Exp(s * tiltcal::testing::RandomVector3(n, rng));
@@ -99,7 +99,7 @@ TEST(HandEyeRotationTest, ReportsDegeneracyForPlanarMotion) {
   EXPECT_LT(r.rotation_spread_rad(1), 0.01);
   // The caller keeps the measured value.
   const Eigen::Quaterniond measured =
-      c_bl * Exp(Eigen::Vector3d(1.0, -2.0, 0.5) * kDegToRad);
+      c_bl * Exp(Eigen::Vector3d(1.0, -2.0, 0.5) * kRadPerDeg);
   EXPECT_LT(AngleDeg(ChooseInitialRotation(measured, r), measured), 1e-9);
 }
 

@@ -8,9 +8,9 @@
 
 #include <gtest/gtest.h>
 
+#include "common/geometry/angles.h"
 #include "tests/stages/calibrate/calibrate_params_text.h"
 #include "tests/stages/calibrate/synthetic_room.h"
-#include "tests/testing/angles.h"
 
 namespace tiltcal::calibrate {
 namespace {
@@ -20,7 +20,7 @@ using testing::MakeDefaultScene;
 using testing::Scene;
 using testing::ScanScene;
 
-using tiltcal::testing::kDegToRad;
+using geometry::kRadPerDeg;
 
 // True LiDAR pose in the scene frame w at time t: driving along the room at
 // 1.2 m/s with yaw swings and small roll / pitch / bounce.
@@ -34,7 +34,7 @@ Eigen::Isometry3d TruePose(double t) {
   return pose;
 }
 
-double RotationDeg(const Eigen::Matrix3d& r) { return Eigen::AngleAxisd(r).angle() / kDegToRad; }
+double RotationDeg(const Eigen::Matrix3d& r) { return Eigen::AngleAxisd(r).angle() / kRadPerDeg; }
 
 struct OdometryErrors {
   double worst_translation_m = 0.0;      // of T_{l0 lk}
@@ -82,7 +82,7 @@ OdometryErrors RunOdometry(const proto::CalibrateParams& params, bool with_prior
     std::optional<Eigen::Quaterniond> prior;
     if (with_prior) {
       // Gyro-like prior: the true rotation with a slow drift (0.3 deg/s).
-      const Eigen::Quaterniond drift(Eigen::AngleAxisd(0.3 * kDegToRad * t, Eigen::Vector3d(0.3, -0.5, 0.8).normalized()));
+      const Eigen::Quaterniond drift(Eigen::AngleAxisd(0.3 * kRadPerDeg * t, Eigen::Vector3d(0.3, -0.5, 0.8).normalized()));
       prior = Eigen::Quaterniond(truth[static_cast<std::size_t>(k)].linear()) * drift;
     }
     odometry.AddScan(100.0 + t, scan, prior);

@@ -20,6 +20,7 @@
 
 #include <Eigen/Geometry>
 
+#include "common/geometry/angles.h"
 #include "common/geometry/so3.h"
 #include "common/spline/quaternion_manifold.h"
 #include "stages/calibrate/problem/calibration_state.h"
@@ -29,7 +30,7 @@
 namespace tiltcal::calibrate {
 namespace {
 
-constexpr double kDegToRad = M_PI / 180.0;
+using geometry::kRadPerDeg;
 constexpr int64_t kOriginNs = 1'700'000'000'000'000'000;
 
 Eigen::Matrix3d Rx(double a) { return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitX()).toRotationMatrix(); }
@@ -51,7 +52,7 @@ struct Scenario {
 
   double Yaw(double t) const { return 0.3 * t + 0.6 * std::sin(0.9 * t); }
   Eigen::Vector3d UpInPlane() const {  // gravity-up, frame p
-    return Rx(roll_deg * kDegToRad) * Ry(pitch_deg * kDegToRad) * Eigen::Vector3d::UnitZ();
+    return Rx(roll_deg * kRadPerDeg) * Ry(pitch_deg * kRadPerDeg) * Eigen::Vector3d::UnitZ();
   }
   Eigen::Matrix3d StartFromPlane() const { return (Rz(Yaw(0.0)) * c_vb).transpose(); }  // A = C_pb(0)^T
   // g_f: IMU-frame gravity on level ground (plane normal = up), m/s^2.
@@ -194,7 +195,7 @@ TEST(GroundResidualsTest, TiltedPlaneTrueStateZeroesDistInclUpButNotFlat) {
   const double flat = CostOf(sc, false, Only(true, false, false, false), &summary);
   EXPECT_EQ(summary.num_flat, n);
   const double expected = 0.5 * n * std::pow(2.0 * std::sin(0.5 * sc.SlopeRad()), 2);
-  EXPECT_GT(sc.SlopeRad(), 8.0 * kDegToRad);
+  EXPECT_GT(sc.SlopeRad(), 8.0 * kRadPerDeg);
   EXPECT_NEAR(flat, expected, 1e-9 * expected);
 }
 

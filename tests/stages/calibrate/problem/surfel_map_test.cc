@@ -10,10 +10,10 @@
 
 #include <gtest/gtest.h>
 
+#include "common/geometry/angles.h"
 #include "stages/calibrate/problem/point_priority.h"
 #include "tests/stages/calibrate/calibrate_params_text.h"
 #include "tests/stages/calibrate/synthetic_room.h"
-#include "tests/testing/angles.h"
 
 namespace tiltcal::calibrate {
 namespace {
@@ -24,11 +24,11 @@ using testing::Scene;
 using testing::ScanScene;
 using testing::SimulatedScan;
 
-using tiltcal::testing::kDegToRad;
+using geometry::kRadPerDeg;
 
 double NormalAngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   // Sign-free: a plane's normal is defined up to sign.
-  return std::atan2(a.cross(b).norm(), std::abs(a.dot(b))) / kDegToRad;
+  return std::atan2(a.cross(b).norm(), std::abs(a.dot(b))) / kRadPerDeg;
 }
 
 // LiDAR poses in the scene frame w along the room, with yaw and some tilt.
@@ -143,7 +143,7 @@ TEST_F(SurfelMapRoomTest, SurfelsLieOnTheTruePlanesWithMatchingNormals) {
     worst_normal_deg = std::max(worst_normal_deg, best_angle);
     errors_deg.push_back(best_angle);
     EXPECT_LT(best_angle, 3.0) << "surface " << id << " at " << centroid_w.transpose() << " sigma "
-                               << s.normal_sigma_rad / kDegToRad << " deg, n " << s.num_points;
+                               << s.normal_sigma_rad / kRadPerDeg << " deg, n " << s.num_points;
     // Plane equation in a is consistent: n^T c + d = 0 and |n| = 1.
     EXPECT_NEAR(s.normal.norm(), 1.0, 1e-12);
     worst_offset_m = std::max(worst_offset_m, std::abs(s.normal.dot(s.centroid) + s.offset_m));
@@ -371,7 +371,7 @@ TEST(SurfelMapTest, GateRejectsCornersCurvesLinesAndThickClouds) {
   proto::SurfelMapParams loose = options;
   loose.set_max_planarity(1.0);  // isolate the thickness gate on this voxel
   loose.set_sample_points(0);    // no outlier check
-  loose.set_max_normal_sigma_deg(1.0 * 180.0 / M_PI);
+  loose.set_max_normal_sigma_deg(geometry::RadToDeg(1.0));
   map.AddPointsInWorld(thick);
   // Voxel (10,0,0): too few points.
   map.AddPointsInWorld({Eigen::Vector3d(5.1, 0.1, 0.1), Eigen::Vector3d(5.2, 0.3, 0.1), Eigen::Vector3d(5.3, 0.1, 0.2)});

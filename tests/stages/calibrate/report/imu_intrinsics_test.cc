@@ -15,6 +15,7 @@
 #include <ceres/solver.h>
 #include <gtest/gtest.h>
 
+#include "common/geometry/angles.h"
 #include "common/geometry/so3.h"
 #include "common/imu/triad_errors.h"
 #include "stages/calibrate/problem/calibration_state.h"
@@ -25,7 +26,7 @@
 namespace tiltcal::calibrate {
 namespace {
 
-constexpr double kDegToRad = M_PI / 180.0;
+using geometry::kRadPerDeg;
 constexpr double kGyroSigma = 1e-3;  // rad/s, the noise and the residuals' sigma
 
 // A consumer gyroscope: measured = T true, T lower triangular (the
@@ -33,9 +34,9 @@ constexpr double kGyroSigma = 1e-3;  // rad/s, the noise and the residuals' sigm
 Eigen::Matrix3d ConsumerGyro() {
   Eigen::Matrix3d t = Eigen::Matrix3d::Identity();
   t.diagonal() += Eigen::Vector3d(3000e-6, -2000e-6, 5000e-6);
-  t(1, 0) = 0.3 * kDegToRad;
-  t(2, 0) = -0.2 * kDegToRad;
-  t(2, 1) = 0.25 * kDegToRad;
+  t(1, 0) = 0.3 * kRadPerDeg;
+  t(2, 0) = -0.2 * kRadPerDeg;
+  t(2, 1) = 0.25 * kRadPerDeg;
   return t;
 }
 
@@ -85,7 +86,7 @@ std::unique_ptr<CalibrationProblem> GyroProblem(TurningSpline* s, bool estimate,
   options.estimate_biases = false;
   options.estimate_imu_intrinsics = estimate;
   options.intrinsics_scale_prior_sigma = params.scale_prior_ppm() * 1e-6;
-  options.intrinsics_misalignment_prior_sigma_rad = params.misalignment_prior_deg() * kDegToRad;
+  options.intrinsics_misalignment_prior_sigma_rad = params.misalignment_prior_deg() * kRadPerDeg;
   auto problem = std::make_unique<CalibrationProblem>(&s->state, GyroNoise(),
                                                       proto::LidarResidualParams(), options);
   problem->AddImuResiduals(s->samples, true, false);
