@@ -33,16 +33,10 @@ TESTS=(decode_bags_test io_test checked_conversion_test imu_test ros1_unit_test
 
 if [ ! -f "$BUILD_DIR/build.ninja" ]; then
   # -O1 and line tables only: half the compile time of -O2 -g, still
-  # symbolised reports. A unity build (each target's sources compiled as one
-  # file) parses the headers once per target, and without a compiler cache
-  # the precompiled headers of the release build (cmake/tiltcal_helpers.cmake)
-  # once per build. Clang's precompiled header holds its absolute paths and
-  # time, so ccache would miss every unit that uses one: with ccache the
-  # sanitizer build goes without.
-  pch=ON
-  [ "${#COMPILER_CACHE[@]}" = 0 ] || pch=OFF
+  # symbolised reports. The precompiled headers of the release build
+  # (cmake/tiltcal_helpers.cmake) and a unity build (each target's sources
+  # compiled as one file) parse the headers once per build and per target.
   cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_UNITY_BUILD=ON \
-    -DTILTCAL_PCH="$pch" \
     -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only -DNDEBUG" \
     -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only -DNDEBUG" \
     -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ "${COMPILER_CACHE[@]}" \
