@@ -1,6 +1,7 @@
 #include "stages/calibrate/calibration_result.h"
 
 #include <cmath>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -194,12 +195,11 @@ MapSharpnessPair MeasureBothMapSharpnesses(const CalibrateInputs& inputs,
   const auto start = Clock::now();
   const Rigid3d rig = ToEigen(inputs.rig.imu_from_lidar());
   const double spacing_s = params.association().deskew_node_spacing_s();
+  MapSharpnessComparison compared = CompareMapSharpness(
+      state, rig.rotation, rig.translation, inputs.scans, params.map(), spacing_s);
   MapSharpnessPair out;
-  out.estimate = MeasureMapSharpness(state, inputs.scans, params.map(), spacing_s);
-  CalibrationState with_rig = state;
-  with_rig.SetImuFromLidarRotation(rig.rotation);
-  with_rig.SetImuFromLidarTranslation(rig.translation);
-  out.rig = MeasureMapSharpness(with_rig, inputs.scans, params.map(), spacing_s);
+  out.estimate = std::move(compared.state);
+  out.rig = std::move(compared.other);
   out.seconds = Seconds(start);
   return out;
 }

@@ -44,20 +44,19 @@ void MeasureMaps(const calibrate::CalibrateInputs& inputs,
                  const calibrate::CalibrationState& state, const Rigid3d& reference,
                  proto::SequenceVerification* out) {
   const double spacing_s = calibrate_params.association().deskew_node_spacing_s();
-  *out->mutable_map_sharpness_estimate() =
-      calibrate::MeasureMapSharpness(state, inputs.scans, calibrate_params.map(), spacing_s);
-  calibrate::CalibrationState with_reference = state;
-  with_reference.SetImuFromLidarRotation(reference.rotation);
-  with_reference.SetImuFromLidarTranslation(reference.translation);
-  *out->mutable_map_sharpness_reference() = calibrate::MeasureMapSharpness(
-      with_reference, inputs.scans, calibrate_params.map(), spacing_s);
+  calibrate::MapSharpnessComparison compared = calibrate::CompareMapSharpness(
+      state, reference.rotation, reference.translation, inputs.scans, calibrate_params.map(),
+      spacing_s);
+  *out->mutable_map_sharpness_estimate() = std::move(compared.state);
+  *out->mutable_map_sharpness_reference() = std::move(compared.other);
   const proto::MapSharpness& e = out->map_sharpness_estimate();
   const proto::MapSharpness& r = out->map_sharpness_reference();
   out->add_reasons(fmt::format(
-      "map: median surfel thickness {:.2f} mm with the estimate ({} planar surfels), {:.2f} mm "
-      "with the reference ({}), ratio reference / estimate {:.3f}",
-      1e3 * e.median_thickness_m(), e.planar_surfels(), 1e3 * r.median_thickness_m(),
-      r.planar_surfels(),
+      "map: over the {} voxels planar in both maps, median surfel thickness {:.2f} mm with the "
+      "estimate ({} planar surfels), {:.2f} mm with the reference ({}), ratio reference / "
+      "estimate {:.3f}",
+      e.common_surfels(), 1e3 * e.median_thickness_m(), e.planar_surfels(),
+      1e3 * r.median_thickness_m(), r.planar_surfels(),
       e.median_thickness_m() > 0.0 ? r.median_thickness_m() / e.median_thickness_m() : 0.0));
 }
 

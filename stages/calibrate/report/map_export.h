@@ -3,7 +3,7 @@
 
 // The before/after maps of a calibration, for a point-cloud viewer: the
 // scans moved to frame a with the final trajectory and tau (each point at its
-// own time, pose nodes every deskew_node_spacing_s, as MeasureMapSharpness
+// own time, pose nodes every deskew_node_spacing_s, as CompareMapSharpness
 // does) and one extrinsic, the rig's or the estimate. A wrong extrinsic
 // shows as doubled or thick walls; their median surfel thickness is
 // CalibrationResult.map_sharpness_rig / map_sharpness_estimate.

@@ -12,17 +12,38 @@
 
 #include <vector>
 
+#include <Eigen/Geometry>
+
 #include "stages/calibrate/problem/calibration_state.h"
 #include "stages/calibrate/problem/lidar_scans.h"
+#include "stages/calibrate/problem/surfel_map.h"
 #include "tiltcal/proto/calibrate_params.pb.h"
 #include "tiltcal/proto/calibration.pb.h"
 
 namespace tiltcal::calibrate {
 
-proto::MapSharpness MeasureMapSharpness(const CalibrationState& state,
-                                        const std::vector<LidarScan>& scans,
-                                        const proto::SurfelMapParams& map_params,
-                                        double deskew_node_spacing_s);
+// Two maps of the same trajectory and tau, one with the state's extrinsic
+// and one with other_imu_from_lidar (C_bl, r_b^{lb}), compared on the same
+// voxels: median_thickness_m of each is taken over the voxels planar in both
+// maps (common_surfels of them; 0 m when none). A blurred map loses its
+// thickest voxels to the planarity gate, so the median over each map's own
+// surfels would favour the blurred one; planar_surfels stays each map's
+// own count.
+struct MapSharpnessComparison {
+  proto::MapSharpness state;
+  proto::MapSharpness other;
+};
+MapSharpnessComparison CompareMapSharpness(const CalibrationState& state,
+                                           const Eigen::Quaterniond& other_rotation,
+                                           const Eigen::Vector3d& other_translation_m,
+                                           const std::vector<LidarScan>& scans,
+                                           const proto::SurfelMapParams& map_params,
+                                           double deskew_node_spacing_s);
+
+// The comparison of two surfel lists of the same voxel grid, each sorted by
+// voxel (x, y, z) as SurfelMap::surfels() is.
+MapSharpnessComparison CompareSurfelThickness(const std::vector<Surfel>& state,
+                                              const std::vector<Surfel>& other);
 
 }  // namespace tiltcal::calibrate
 

@@ -81,10 +81,10 @@ void CheckMap(const proto::CalibrationResult& r, const proto::VerdictParams& par
   if (rig.planar_surfels() == 0 || rig.median_thickness_m() <= 0.0) return;
   const double ratio = est.median_thickness_m() / rig.median_thickness_m();
   const std::string numbers = fmt::format(
-      "median surfel thickness {:.2f} cm with the estimate ({} surfels) vs {:.2f} cm with the "
-      "rig ({} surfels)",
-      est.median_thickness_m() * 100.0, est.planar_surfels(), rig.median_thickness_m() * 100.0,
-      rig.planar_surfels());
+      "over the {} voxels planar in both maps, median surfel thickness {:.2f} cm with the "
+      "estimate vs {:.2f} cm with the rig ({} and {} planar surfels)",
+      est.common_surfels(), est.median_thickness_m() * 100.0, rig.median_thickness_m() * 100.0,
+      est.planar_surfels(), rig.planar_surfels());
   if (ratio > params.max_map_thickness_ratio()) {
     f->suspect.push_back("the LiDAR map is less sharp with the estimate than with the rig: " +
                          numbers);
