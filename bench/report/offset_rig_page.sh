@@ -35,7 +35,8 @@ for seed in 1 2; do
 done
 make -s -f Makefile.pipeline DATASET="$DATASET" BIN="$BIN" -j2 report
 echo
-printf '%-10s %22s %22s %8s %10s\n' sequence "rig: thickness/surfels" "estimate: thick/surf" ratio verdict
+# Thickness over the voxels planar in both maps (common), surfels of each map.
+printf '%-10s %22s %22s %7s %8s %10s\n' sequence "rig: thickness/surfels" "estimate: thick/surf" common ratio verdict
 for seq in offset_1 offset_2; do
   f=$(ls "$DATASET/out/$seq"/calibration*.txtpb | head -1)
   /usr/bin/python3 - "$f" "$seq" <<'PY'
@@ -45,11 +46,12 @@ def block(name):
     m = re.search(name + r" \{([^}]*)\}", text)
     t = float(re.search(r"median_thickness_m: ([-0-9.e]+)", m.group(1)).group(1))
     n = int(re.search(r"planar_surfels: (\d+)", m.group(1)).group(1))
-    return t, n
+    c = int(re.search(r"common_surfels: (\d+)", m.group(1)).group(1))
+    return t, n, c
 rig, est = block("map_sharpness_rig"), block("map_sharpness_estimate")
 verdict = re.search(r"^verdict: (\w+)", text, re.M).group(1)
 print(f"{sys.argv[2]:<10} {1e3*rig[0]:12.2f} mm {rig[1]:5d} {1e3*est[0]:12.2f} mm {est[1]:5d}"
-      f" {est[0]/rig[0]:8.3f} {verdict:>10}")
+      f" {est[2]:7d} {est[0]/rig[0]:8.3f} {verdict:>10}")
 PY
 done
 echo
