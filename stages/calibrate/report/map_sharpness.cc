@@ -7,8 +7,11 @@
 namespace tiltcal::calibrate {
 namespace {
 
-SurfelMap BuildMap(const CalibrationState& state, const std::vector<LidarScan>& scans,
-                   const proto::SurfelMapParams& map_params, double deskew_node_spacing_s) {
+// The planar surfels of the map of every scan with the state (the map's
+// voxels and point samples are freed on return).
+std::vector<Surfel> MapSurfels(const CalibrationState& state, const std::vector<LidarScan>& scans,
+                               const proto::SurfelMapParams& map_params,
+                               double deskew_node_spacing_s) {
   SurfelMap map(map_params);
   ScanPoseTable table;
   std::vector<Eigen::Vector3d> world;
@@ -19,7 +22,7 @@ SurfelMap BuildMap(const CalibrationState& state, const std::vector<LidarScan>& 
     map.AddPointsInWorld(world);
   }
   map.ExtractSurfels();
-  return map;
+  return map.surfels();
 }
 
 // sqrt(l3): the RMS distance of the surfel's points to its plane, m.
@@ -48,9 +51,10 @@ MapSharpnessComparison CompareMapSharpness(const CalibrationState& state,
   CalibrationState with_other = state;
   with_other.SetImuFromLidarRotation(other_rotation);
   with_other.SetImuFromLidarTranslation(other_translation_m);
+  const std::vector<Surfel> surfels =
+      MapSurfels(state, scans, map_params, deskew_node_spacing_s);
   return CompareSurfelThickness(
-      BuildMap(state, scans, map_params, deskew_node_spacing_s).surfels(),
-      BuildMap(with_other, scans, map_params, deskew_node_spacing_s).surfels());
+      surfels, MapSurfels(with_other, scans, map_params, deskew_node_spacing_s));
 }
 
 MapSharpnessComparison CompareSurfelThickness(const std::vector<Surfel>& a,
