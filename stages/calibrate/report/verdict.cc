@@ -78,7 +78,18 @@ void CheckMap(const proto::CalibrationResult& r, const proto::VerdictParams& par
     f->suspect.push_back("the LiDAR map built with the estimate has no planar surfel");
     return;
   }
-  if (rig.planar_surfels() == 0 || rig.median_thickness_m() <= 0.0) return;
+  if (rig.planar_surfels() == 0) return;
+  if (est.common_surfels() == 0) {
+    // No voxel planar in both maps: no thickness to compare, and the map
+    // that kept fewer planar surfels is the smeared one.
+    if (est.planar_surfels() < rig.planar_surfels()) {
+      f->suspect.push_back(fmt::format(
+          "the LiDAR map is less sharp with the estimate than with the rig: no voxel is planar "
+          "in both maps, and the estimate's has {} planar surfels against the rig's {}",
+          est.planar_surfels(), rig.planar_surfels()));
+    }
+    return;
+  }
   const double ratio = est.median_thickness_m() / rig.median_thickness_m();
   const std::string numbers = fmt::format(
       "over the {} voxels planar in both maps, median surfel thickness {:.2f} cm with the "

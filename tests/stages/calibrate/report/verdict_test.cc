@@ -249,6 +249,26 @@ TEST(VerdictTest, MapLessSharpThanWithTheRigIsSuspect) {
   EXPECT_TRUE(SuspectWith(r, "no planar surfel"));
 }
 
+// Maps without a voxel planar in both have no thickness to compare (0 m):
+// the one that kept fewer planar surfels is the smeared one.
+TEST(VerdictTest, MapsWithoutCommonVoxelsCompareTheirPlanarSurfels) {
+  CalibrationResult r = CleanResult();
+  for (proto::MapSharpness* m :
+       {r.mutable_map_sharpness_estimate(), r.mutable_map_sharpness_rig()}) {
+    m->set_common_surfels(0);
+    m->set_median_thickness_m(0.0);
+  }
+  r.mutable_map_sharpness_estimate()->set_planar_surfels(200);
+  EXPECT_TRUE(SuspectWith(r, "no voxel is planar in both maps, and the estimate's has 200 "
+                             "planar surfels against the rig's 880"));
+  // A large move that the map confirms (the rig's map kept fewer) stays OK.
+  r.mutable_map_sharpness_estimate()->set_planar_surfels(900);
+  r.mutable_map_sharpness_rig()->set_planar_surfels(40);
+  r.set_rotation_from_rig_deg(90.0);
+  EXPECT_EQ(Decide(&r), "");
+  EXPECT_EQ(r.verdict(), CalibrationResult::OK);
+}
+
 TEST(VerdictTest, LargeMoveIsSuspectOnlyWithoutASharperMap) {
   CalibrationResult r = CleanResult();
   SetRigid(0.7071, 0.7071, 0.4, 0.02, 0.30, r.mutable_rig_imu_from_lidar());
