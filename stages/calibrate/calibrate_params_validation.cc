@@ -107,6 +107,15 @@ Status ValidateImuVibrationParams(const proto::ImuVibrationParams& params) {
   return Status::Ok();
 }
 
+// 0 (the ground's errors independent) or enough batches for a variance of
+// their means (error_correlation.h).
+Status ValidateObservabilityParams(const proto::ObservabilityParams& params) {
+  const int batches = params.ground_correlation_batches();
+  if (batches == 0 || batches >= 4) return Status::Ok();
+  return Status::Error(fmt::format(
+      "params: observability.ground_correlation_batches = {} must be 0 or at least 4", batches));
+}
+
 Status ValidateCalibrateParams(const proto::CalibrateParams& params) {
   TILTCAL_RETURN_IF_ERROR(ValidateImuNoiseParams(params.imu_noise()));
   TILTCAL_RETURN_IF_ERROR(ValidateLidarScanParams(params.scans()));
@@ -121,6 +130,7 @@ Status ValidateCalibrateParams(const proto::CalibrateParams& params) {
   }
   TILTCAL_RETURN_IF_ERROR(ValidateGroundResidualsParams(params.ground()));
   TILTCAL_RETURN_IF_ERROR(ValidateImuVibrationParams(params.imu_vibration()));
+  TILTCAL_RETURN_IF_ERROR(ValidateObservabilityParams(params.observability()));
   return ValidateVerdictParams(params.verdict());
 }
 

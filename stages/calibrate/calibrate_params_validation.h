@@ -28,6 +28,7 @@ Status ValidateAssociationParams(const proto::AssociationParams& params, const s
 Status ValidateGroundResidualsParams(const proto::GroundResidualsParams& params);
 Status ValidateVerdictParams(const proto::VerdictParams& params);
 Status ValidateImuVibrationParams(const proto::ImuVibrationParams& params);
+Status ValidateObservabilityParams(const proto::ObservabilityParams& params);
 
 Status ValidateCalibrateParams(const proto::CalibrateParams& params);
 

@@ -77,25 +77,26 @@ void ScaleByOneFactor(double sigma0_squared, double clock_rate_prior_sigma,
   for (int j = 0; j < 8; ++j) (*clock_rate_row)[static_cast<size_t>(j)] = full(7, j);
 }
 
-// The variance components per residual type of the default sample's problem
-// into the result, and their weights.
+// The variance components per variance group of the default sample's
+// problem into the result, and their weights.
 Status FillVarianceComponents(const SolvedCalibration& solved, proto::CalibrationResult* result,
-                              ResidualTypeWeights* weights) {
+                              VarianceGroupWeights* weights) {
   std::vector<VarianceComponent> components;
-  TILTCAL_RETURN_IF_ERROR(ComputeResidualTypeComponents(
+  TILTCAL_RETURN_IF_ERROR(ComputeVarianceGroupComponents(
       ReportProblem(solved.loop)->problem(), solved.inputs.imu_decimation != 1,
       solved.params.observability(), static_cast<int>(solved.params.num_threads()),
       &components));
   result->clear_variance_components();
-  for (int t = 0; t < kNumResidualTypes; ++t) {
-    const VarianceComponent& c = components[static_cast<size_t>(t)];
-    (*weights)[static_cast<size_t>(t)] = c.weight;
+  for (int k = 0; k < kNumVarianceGroups; ++k) {
+    const VarianceComponent& c = components[static_cast<size_t>(k)];
+    (*weights)[static_cast<size_t>(k)] = c.weight;
     if (c.rows == 0) continue;
     proto::VarianceComponentReport* r = result->add_variance_components();
-    r->set_type(ResidualTypeName(static_cast<ResidualType>(t)));
+    r->set_type(VarianceGroupName(static_cast<VarianceGroup>(k)));
     r->set_rows(c.rows);
     r->set_redundancy(c.redundancy);
     r->set_variance_factor(c.sigma0_squared);
+    r->set_correlation(c.correlation);
     r->set_weight(c.weight);
   }
   return Status::Ok();
@@ -119,7 +120,7 @@ void FillCovariance(const SolvedCalibration& solved, proto::CalibrationResult* r
   if (observability.compute_covariance()) {
     const bool per_type = observability.scale_by_variance_factor() &&
                           observability.variance_factors() == proto::ObservabilityParams::PER_TYPE;
-    ResidualTypeWeights weights;
+    VarianceGroupWeights weights;
     weights.fill(1.0);
     Status cs = per_type ? FillVarianceComponents(solved, result, &weights) : Status::Ok();
     Matrix7d cov;

@@ -11,6 +11,7 @@
 #include <Eigen/SparseCore>
 
 #include "common/geometry/angles.h"
+#include "stages/calibrate/report/error_correlation.h"
 #include "stages/calibrate/report/marginal_covariance.h"
 #include "stages/calibrate/report/typed_jacobian.h"
 
@@ -109,18 +110,18 @@ Status OrderForMarginal(ceres::Problem* problem, const Group (&groups)[3],
 }
 
 // The Jacobian of every residual (robust loss applied) in the order's
-// columns, each residual type's rows weighted by type_weights (none: 1), and
+// columns, each variance group's rows weighted by group_weights (none: 1), and
 // the marginal covariance of its last `kept` columns.
 Status MarginalOfKept(ceres::Problem* problem, const MarginalOrder& order,
                       const proto::ObservabilityParams& params, int num_threads,
-                      const ResidualTypeWeights* type_weights, Eigen::MatrixXd* marginal) {
+                      const VarianceGroupWeights* group_weights, Eigen::MatrixXd* marginal) {
   TypedJacobian typed;
   const Status evaluated = EvaluateTypedJacobian(problem, order.blocks, num_threads, &typed);
   if (!evaluated.ok()) return Status::Error("covariance: " + evaluated.message());
-  if (type_weights != nullptr) {
+  if (group_weights != nullptr) {
     for (int r = 0; r < typed.jacobian.outerSize(); ++r) {
       const double scale =
-          std::sqrt((*type_weights)[static_cast<size_t>(typed.row_type[static_cast<size_t>(r)])]);
+          std::sqrt((*group_weights)[static_cast<size_t>(typed.row_group[static_cast<size_t>(r)])]);
       for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(typed.jacobian, r); it;
            ++it) {
         it.valueRef() *= scale;
@@ -169,7 +170,7 @@ Status ComputeExtrinsicCovariance(ceres::Problem* problem, CalibrationState* sta
                                   const proto::ObservabilityParams& params, int num_threads,
                                   Matrix7d* covariance, Eigen::MatrixXd* intrinsics_covariance,
                                   std::vector<double>* clock_rate_row,
-                                  const ResidualTypeWeights* type_weights) {
+                                  const VarianceGroupWeights* group_weights) {
   covariance->setZero();
   if (clock_rate_row != nullptr) clock_rate_row->clear();
   // rho, marginalised last when asked for and free.
@@ -192,7 +193,7 @@ Status ComputeExtrinsicCovariance(ceres::Problem* problem, CalibrationState* sta
                                            with_rate ? state->clock_rate : nullptr, &order));
   Eigen::MatrixXd marginal;
   TILTCAL_RETURN_IF_ERROR(
-      MarginalOfKept(problem, order, params, num_threads, type_weights, &marginal));
+      MarginalOfKept(problem, order, params, num_threads, group_weights, &marginal));
   if (intrinsics.size > 0) {
     *intrinsics_covariance = marginal.topLeftCorner(intrinsics.size, intrinsics.size);
   }
@@ -222,9 +223,9 @@ VarianceFactor ComputeVarianceFactor(ceres::Problem* problem) {
   return out;
 }
 
-Status ComputeResidualTypeComponents(ceres::Problem* problem, bool imu_filtered,
-                                     const proto::ObservabilityParams& params, int num_threads,
-                                     std::vector<VarianceComponent>* components) {
+Status ComputeVarianceGroupComponents(ceres::Problem* problem, bool imu_filtered,
+                                      const proto::ObservabilityParams& params, int num_threads,
+                                      std::vector<VarianceComponent>* components) {
   std::vector<double*> blocks;
   problem->GetParameterBlocks(&blocks);
   const auto held = [problem](double* b) { return problem->IsParameterBlockConstant(b); };
@@ -232,14 +233,20 @@ Status ComputeResidualTypeComponents(ceres::Problem* problem, bool imu_filtered,
   TypedJacobian typed;
   const Status evaluated = EvaluateTypedJacobian(problem, blocks, num_threads, &typed);
   if (!evaluated.ok()) return Status::Error("variance components: " + evaluated.message());
-  std::vector<VarianceComponentGroup> groups(kNumResidualTypes);
-  for (int t = 0; t < kNumResidualTypes; ++t) {
-    VarianceComponentGroup& g = groups[static_cast<size_t>(t)];
-    g.square_sum = typed.square_sum[static_cast<size_t>(t)];
-    g.estimated = t != kOther;
-    g.may_shrink = t == kLidar || (!imu_filtered && (t == kGyro || t == kAccel));
+  std::vector<VarianceComponentGroup> groups(kNumVarianceGroups);
+  for (int k = 0; k < kNumVarianceGroups; ++k) {
+    VarianceComponentGroup& g = groups[static_cast<size_t>(k)];
+    const ResidualType type = TypeOfGroup(static_cast<VarianceGroup>(k));
+    g.square_sum = typed.square_sum[static_cast<size_t>(k)];
+    g.estimated = type != kOther;
+    g.may_shrink = type == kLidar || (!imu_filtered && (type == kGyro || type == kAccel));
+    if (type == kGround && params.ground_correlation_batches() > 0) {
+      g.correlation = PooledBatchMeansCorrelation(typed.residuals, typed.row_group,
+                                                  typed.row_in_block, k,
+                                                  params.ground_correlation_batches());
+    }
   }
-  return EstimateVarianceComponents(typed.jacobian, typed.row_type, groups,
+  return EstimateVarianceComponents(typed.jacobian, typed.row_group, groups,
                                     params.min_relative_pivot(), components);
 }
 

@@ -67,15 +67,16 @@ MotionAxis PrincipalRotationAxis(const std::vector<imu::ImuReading>& samples,
 // and its row of the 8x8 covariance is returned there: cov(rho, .) with the
 // 7 above, then var(rho) (rho dimensionless); otherwise it is left empty.
 // The 7x7 is the marginal covariance of the 7 either way.
-// With type_weights, each residual type's information is multiplied by its
-// weight (the variance components' w_k, variance_components.h).
-using ResidualTypeWeights = std::array<double, kNumResidualTypes>;
+// With group_weights, each variance group's information (residual_type.h)
+// is multiplied by its weight (the variance components' w_k,
+// variance_components.h).
+using VarianceGroupWeights = std::array<double, kNumVarianceGroups>;
 Status ComputeExtrinsicCovariance(ceres::Problem* problem, CalibrationState* state,
                                   const proto::ObservabilityParams& params, int num_threads,
                                   Matrix7d* covariance,
                                   Eigen::MatrixXd* intrinsics_covariance = nullptr,
                                   std::vector<double>* clock_rate_row = nullptr,
-                                  const ResidualTypeWeights* type_weights = nullptr);
+                                  const VarianceGroupWeights* group_weights = nullptr);
 
 // A-posteriori variance factor of the weighted least-squares problem at its
 // current parameters: sigma0^2 = 2 F / (m - n), F the cost with the robust
@@ -90,15 +91,20 @@ struct VarianceFactor {
 };
 VarianceFactor ComputeVarianceFactor(ceres::Problem* problem);
 
-// Variance components per residual type (variance_components.h) of a problem
-// at its current parameters, indexed by ResidualType: gyro, accel, lidar and
-// ground estimated, other (priors, bias random walks) held at 1. The ground's
-// may not shrink (its residuals' errors are the ground planes', shared by
-// many residuals: their fit says nothing of the vertical's error), nor, with
-// imu_filtered (imu_vibration.h), the gyro's and accelerometer's.
-Status ComputeResidualTypeComponents(ceres::Problem* problem, bool imu_filtered,
-                                     const proto::ObservabilityParams& params, int num_threads,
-                                     std::vector<VarianceComponent>* components);
+// Variance components per variance group (residual_type.h,
+// variance_components.h) of a problem at its current parameters, indexed by
+// VarianceGroup: gyro, accel, lidar and the four ground residuals estimated,
+// other (priors, bias random walks) held at 1. The ground's may not shrink
+// (their errors are the ground planes', shared by many residuals: their fit
+// says nothing of the vertical's error), nor, with imu_filtered
+// (imu_vibration.h), the gyro's and accelerometer's. The ground's errors
+// stay correlated over the scans of rolling ground or of a rocking
+// suspension: each ground group's tau_k is estimated from its residuals in
+// the scans' order with params.ground_correlation_batches batches
+// (error_correlation.h; 0: taken as independent).
+Status ComputeVarianceGroupComponents(ceres::Problem* problem, bool imu_filtered,
+                                      const proto::ObservabilityParams& params, int num_threads,
+                                      std::vector<VarianceComponent>* components);
 
 // The covariance with the data's information scaled by 1/sigma0^2 and the
 // priors' kept: a prior acts on the extrinsic block only, so the marginal

@@ -14,24 +14,29 @@ Status EvaluateTypedJacobian(ceres::Problem* problem, const std::vector<double*>
   problem->GetResidualBlocks(&options.residual_blocks);
   options.apply_loss_function = true;
   options.num_threads = std::max(1, num_threads);
-  out->row_type.clear();
+  out->row_group.clear();
+  out->row_in_block.clear();
   out->square_sum.fill(0.0);
   for (const ceres::ResidualBlockId id : options.residual_blocks) {
     const ceres::CostFunction* cost_function = problem->GetCostFunctionForResidualBlock(id);
-    const ResidualType type = TypeOf(cost_function);
-    out->row_type.insert(out->row_type.end(),
-                         static_cast<size_t>(cost_function->num_residuals()), type);
+    const VarianceGroup group = VarianceGroupOf(cost_function);
+    const int rows = cost_function->num_residuals();
+    out->row_group.insert(out->row_group.end(), static_cast<size_t>(rows), group);
+    for (int i = 0; i < rows; ++i) out->row_in_block.push_back(i);
     double cost = 0.0;
     if (!problem->EvaluateResidualBlock(id, true, &cost, nullptr, nullptr) ||
         !std::isfinite(cost)) {
       return Status::Error("the residuals could not be evaluated");
     }
-    out->square_sum[type] += 2.0 * cost;
+    out->square_sum[group] += 2.0 * cost;
   }
+  std::vector<double> residuals;
   ceres::CRSMatrix crs;
-  if (!problem->Evaluate(options, nullptr, nullptr, nullptr, &crs)) {
+  if (!problem->Evaluate(options, nullptr, &residuals, nullptr, &crs)) {
     return Status::Error("the residuals could not be evaluated");
   }
+  out->residuals = Eigen::Map<const Eigen::VectorXd>(residuals.data(),
+                                                     static_cast<Eigen::Index>(residuals.size()));
   out->jacobian = Eigen::Map<const Eigen::SparseMatrix<double, Eigen::RowMajor>>(
       crs.num_rows, crs.num_cols, static_cast<Eigen::Index>(crs.values.size()), crs.rows.data(),
       crs.cols.data(), crs.values.data());

@@ -3,15 +3,19 @@
 
 // The Jacobian of every residual block of a calibration problem (robust loss
 // applied, residuals weighted by their sigma) in the columns of the given
-// parameter blocks, with each row's residual type (residual_type.h) and per
-// type the weighted square sum 2F_k (ceres' cost with the robust loss, times
-// 2) at the current parameters.
+// parameter blocks, with each row's variance group (residual_type.h), its
+// residual and its index within its block, and per group the weighted square
+// sum 2F_k (ceres' cost with the robust loss, times 2) at the current
+// parameters. Rows are in the order the problem holds its residual blocks:
+// the order they were added in (the calibration removes none), for the ground
+// residuals the scans' order.
 
 #include <array>
 #include <vector>
 
 #include <ceres/problem.h>
 
+#include <Eigen/Core>
 #include <Eigen/SparseCore>
 
 #include "common/status.h"
@@ -21,8 +25,10 @@ namespace tiltcal::calibrate {
 
 struct TypedJacobian {
   Eigen::SparseMatrix<double, Eigen::RowMajor> jacobian;
-  std::vector<int> row_type;  // ResidualType of each row
-  std::array<double, kNumResidualTypes> square_sum{};
+  std::vector<int> row_group;        // VarianceGroup of each row
+  std::vector<int> row_in_block;     // 0 .. the block's num_residuals - 1
+  Eigen::VectorXd residuals;         // weighted, robust loss applied
+  std::array<double, kNumVarianceGroups> square_sum{};
 };
 
 Status EvaluateTypedJacobian(ceres::Problem* problem, const std::vector<double*>& parameter_blocks,

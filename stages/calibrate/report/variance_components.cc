@@ -46,7 +46,9 @@ Status EstimateVarianceComponents(const Eigen::SparseMatrix<double, Eigen::RowMa
     c.redundancy = static_cast<double>(c.rows) - inverse.cwiseProduct(normal[k]).sum();
     if (!groups[k].estimated || !(c.redundancy > 0.0) || !(groups[k].square_sum > 0.0)) continue;
     c.sigma0_squared = groups[k].square_sum / c.redundancy;
-    c.weight = 1.0 / (groups[k].may_shrink ? c.sigma0_squared : std::max(1.0, c.sigma0_squared));
+    c.correlation = std::max(1.0, groups[k].correlation);
+    const double inflation = c.sigma0_squared * c.correlation;
+    c.weight = 1.0 / (groups[k].may_shrink ? inflation : std::max(1.0, inflation));
   }
   return Status::Ok();
 }

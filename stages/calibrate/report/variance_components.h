@@ -23,7 +23,12 @@
 // (priors, random walks: not measurements of noise). A group that may not
 // shrink has w_k = 1 / max(s_k, 1): its residuals are not white or its errors
 // not independent, so a fit below their model sigma says nothing of their
-// noise. tr(H^{-1} J_k^T J_k) needs H^{-1} only on H's pattern
+// noise. A group whose errors stay correlated along the sequence
+// (error_correlation.h: tau_k, the variance of their mean against that of
+// independent errors) has its information divided by tau_k as well:
+//   w_k = 1 / (s_k max(1, tau_k)),  or 1 / max(1, s_k max(1, tau_k))
+// for a group that may not shrink (tau_k below 1, errors that cancel, is
+// not credited). tr(H^{-1} J_k^T J_k) needs H^{-1} only on H's pattern
 // (selected_inverse.h).
 
 #include <cstdint>
@@ -39,12 +44,14 @@ struct VarianceComponentGroup {
   double square_sum = 0.0;  // e_k^T e_k
   bool estimated = true;
   bool may_shrink = true;
+  double correlation = 1.0;  // tau_k
 };
 
 struct VarianceComponent {
   int64_t rows = 0;
   double redundancy = 0.0;      // r_k
   double sigma0_squared = 1.0;  // s_k
+  double correlation = 1.0;     // max(1, tau_k) as applied
   double weight = 1.0;          // w_k the covariance uses
 };
 

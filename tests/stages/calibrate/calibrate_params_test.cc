@@ -196,5 +196,19 @@ TEST(CalibrateParamsTest, VoxelIcpNeedsItsSettingsOnlyWhenChosen) {
   EXPECT_TRUE(ValidateAgainstSchema(params).ok());
 }
 
+TEST(CalibrateParamsTest, GroundCorrelationNeedsEnoughBatchesOrNone) {
+  proto::CalibrateParams params = tiltcal::testing::DefaultCalibrateParamsWith();
+  EXPECT_EQ(params.observability().ground_correlation_batches(), 20);
+  params.mutable_observability()->set_ground_correlation_batches(3);
+  const Status status = ValidateCalibrateParams(params);
+  ASSERT_FALSE(status.ok());
+  EXPECT_EQ(status.message(),
+            "params: observability.ground_correlation_batches = 3 must be 0 or at least 4");
+  params.mutable_observability()->set_ground_correlation_batches(0);
+  EXPECT_TRUE(ValidateCalibrateParams(params).ok());
+  params.mutable_observability()->set_ground_correlation_batches(4);
+  EXPECT_TRUE(ValidateCalibrateParams(params).ok());
+}
+
 }  // namespace
 }  // namespace tiltcal::calibrate

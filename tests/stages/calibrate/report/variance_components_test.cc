@@ -114,5 +114,33 @@ TEST(VarianceComponentsTest, HeldAndNonShrinkingGroups) {
       EstimateVarianceComponents(p.a.sparseView(0.0, 0.0), bad, p.groups, 1e-14, &c).ok());
 }
 
+// A group whose errors stay correlated has its information divided by tau
+// as well; tau below 1 is not credited, and one that may not shrink keeps a
+// weight of at most 1.
+TEST(VarianceComponentsTest, CorrelatedErrorsDivideTheWeight) {
+  TwoGroupProblem p = MakeProblem(1000, 100, 0.5, 2.0, 4);
+  p.groups[0].correlation = 6.0;
+  p.groups[1].correlation = 0.3;
+  std::vector<VarianceComponent> c;
+  ASSERT_TRUE(
+      EstimateVarianceComponents(p.a.sparseView(0.0, 0.0), p.row_group, p.groups, 1e-14, &c).ok());
+  EXPECT_DOUBLE_EQ(c[0].correlation, 6.0);
+  EXPECT_DOUBLE_EQ(c[0].weight, 1.0 / (6.0 * c[0].sigma0_squared));
+  EXPECT_DOUBLE_EQ(c[1].correlation, 1.0);
+  EXPECT_DOUBLE_EQ(c[1].weight, 1.0 / c[1].sigma0_squared);
+  // s_0 ~ 0.25: s tau ~ 1.5 above 1 divides a group that may not shrink;
+  // tau 2 (s tau ~ 0.5) leaves it at 1.
+  p.groups[0].may_shrink = false;
+  ASSERT_TRUE(
+      EstimateVarianceComponents(p.a.sparseView(0.0, 0.0), p.row_group, p.groups, 1e-14, &c).ok());
+  ASSERT_GT(6.0 * c[0].sigma0_squared, 1.0);
+  EXPECT_DOUBLE_EQ(c[0].weight, 1.0 / (6.0 * c[0].sigma0_squared));
+  p.groups[0].correlation = 2.0;
+  ASSERT_TRUE(
+      EstimateVarianceComponents(p.a.sparseView(0.0, 0.0), p.row_group, p.groups, 1e-14, &c).ok());
+  ASSERT_LT(2.0 * c[0].sigma0_squared, 1.0);
+  EXPECT_DOUBLE_EQ(c[0].weight, 1.0);
+}
+
 }  // namespace
 }  // namespace tiltcal::calibrate
