@@ -312,6 +312,7 @@ Status CalibrateSequence(const proto::CalibrateParams& params, CalibrateInputs* 
                                              solve.mutable_imu_noise(), &vibration)
                               .WithContext(inputs->imu_source));
   inputs->imu_decimation = vibration.decimation();
+  inputs->imu_low_pass_correlation = LowPassCorrelation(vibration);
   const std::string vibration_note = DescribeImuVibration(vibration);
   if (!vibration_note.empty()) Log(log, vibration_note);
   TILTCAL_RETURN_IF_ERROR(Calibrate(*inputs, solve, result, final_state, log));

@@ -65,6 +65,9 @@ struct CalibrateInputs {
   // The IMU readings were thinned to every imu_decimation-th sample
   // (imu_vibration.h); 1 when not.
   int imu_decimation = 1;
+  // How much their residuals understate their noise at low frequencies
+  // (LowPassCorrelation, imu_vibration.h); 1 when not filtered.
+  double imu_low_pass_correlation = 1.0;
   // tiltcal_decode's clock-drift note in imu.binpb's provenance ("" without).
   std::string clock_drift;
 };

@@ -110,10 +110,10 @@ Status ValidateImuVibrationParams(const proto::ImuVibrationParams& params) {
 // 0 (the ground's errors independent) or enough batches for a variance of
 // their means (error_correlation.h).
 Status ValidateObservabilityParams(const proto::ObservabilityParams& params) {
-  const int batches = params.ground_correlation_batches();
+  const int batches = params.correlation_batches();
   if (batches == 0 || batches >= 4) return Status::Ok();
   return Status::Error(fmt::format(
-      "params: observability.ground_correlation_batches = {} must be 0 or at least 4", batches));
+      "params: observability.correlation_batches = {} must be 0 or at least 4", batches));
 }
 
 Status ValidateCalibrateParams(const proto::CalibrateParams& params) {

@@ -11,6 +11,7 @@
 #include "stages/calibrate/problem/problem_builder.h"
 #include "stages/calibrate/progress.h"
 #include "stages/calibrate/report/covariance_report.h"
+#include "stages/calibrate/report/imu_static_noise.h"
 #include "stages/calibrate/report/map_sharpness.h"
 #include "stages/calibrate/report/residual_statistics.h"
 
@@ -81,9 +82,19 @@ void ScaleByOneFactor(double sigma0_squared, double clock_rate_prior_sigma,
 // problem into the result, and their weights.
 Status FillVarianceComponents(const SolvedCalibration& solved, proto::CalibrationResult* result,
                               VarianceGroupWeights* weights) {
+  ImuResidualNoise imu;
+  imu.low_pass_correlation = solved.inputs.imu_low_pass_correlation;
+  if (imu.low_pass_correlation > 1.0 && solved.init.imu.from_static_start) {
+    const ImuStaticNoise at_rest = MeasureImuStaticNoise(
+        solved.inputs.imu, solved.init.imu.averaging_begin_s, solved.init.imu.averaging_end_s,
+        solved.params.imu_noise().gyro_sigma_radps(), solved.params.imu_noise().accel_sigma_mps2(),
+        imu.low_pass_correlation);
+    imu.gyro_floor = at_rest.gyro_factor;
+    imu.accel_floor = at_rest.accel_factor;
+  }
   std::vector<VarianceComponent> components;
   TILTCAL_RETURN_IF_ERROR(ComputeVarianceGroupComponents(
-      ReportProblem(solved.loop)->problem(), solved.inputs.imu_decimation != 1,
+      ReportProblem(solved.loop)->problem(), imu,
       solved.params.observability(), static_cast<int>(solved.params.num_threads()),
       &components));
   result->clear_variance_components();
@@ -97,6 +108,7 @@ Status FillVarianceComponents(const SolvedCalibration& solved, proto::Calibratio
     r->set_redundancy(c.redundancy);
     r->set_variance_factor(c.sigma0_squared);
     r->set_correlation(c.correlation);
+    r->set_floor(c.floor);
     r->set_weight(c.weight);
   }
   return Status::Ok();

@@ -223,7 +223,7 @@ VarianceFactor ComputeVarianceFactor(ceres::Problem* problem) {
   return out;
 }
 
-Status ComputeVarianceGroupComponents(ceres::Problem* problem, bool imu_filtered,
+Status ComputeVarianceGroupComponents(ceres::Problem* problem, const ImuResidualNoise& imu,
                                       const proto::ObservabilityParams& params, int num_threads,
                                       std::vector<VarianceComponent>* components) {
   std::vector<double*> blocks;
@@ -239,11 +239,17 @@ Status ComputeVarianceGroupComponents(ceres::Problem* problem, bool imu_filtered
     const ResidualType type = TypeOfGroup(static_cast<VarianceGroup>(k));
     g.square_sum = typed.square_sum[static_cast<size_t>(k)];
     g.estimated = type != kOther;
-    g.may_shrink = type == kLidar || (!imu_filtered && (type == kGyro || type == kAccel));
-    if (type == kGround && params.ground_correlation_batches() > 0) {
+    const bool low_passed_imu =
+        (type == kGyro || type == kAccel) && imu.low_pass_correlation > 1.0;
+    if ((type == kGround || low_passed_imu) && params.correlation_batches() > 0) {
       g.correlation = PooledBatchMeansCorrelation(typed.residuals, typed.row_group,
-                                                  typed.row_in_block, k,
-                                                  params.ground_correlation_batches());
+                                                  typed.row_component, k,
+                                                  params.correlation_batches());
+    }
+    if (type == kGround) g.floor = 1.0;
+    if (low_passed_imu) {
+      g.correlation = std::max(g.correlation, imu.low_pass_correlation);
+      g.floor = type == kGyro ? imu.gyro_floor : imu.accel_floor;
     }
   }
   return EstimateVarianceComponents(typed.jacobian, typed.row_group, groups,

@@ -91,18 +91,29 @@ struct VarianceFactor {
 };
 VarianceFactor ComputeVarianceFactor(ceres::Problem* problem);
 
+// What the IMU residuals' variance components need beyond their fit: for
+// readings low-passed and thinned (imu_vibration.h), the correlation the
+// filter gives them (LowPassCorrelation) and the floors of s_k tau_k, their
+// noise measured at rest (imu_static_noise.h; 0: none). Raw readings: 1, 0.
+struct ImuResidualNoise {
+  double low_pass_correlation = 1.0;
+  double gyro_floor = 0.0;
+  double accel_floor = 0.0;
+};
+
 // Variance components per variance group (residual_type.h,
 // variance_components.h) of a problem at its current parameters, indexed by
 // VarianceGroup: gyro, accel, lidar and the four ground residuals estimated,
-// other (priors, bias random walks) held at 1. The ground's may not shrink
-// (their errors are the ground planes', shared by many residuals: their fit
-// says nothing of the vertical's error), nor, with imu_filtered
-// (imu_vibration.h), the gyro's and accelerometer's. The ground's errors
-// stay correlated over the scans of rolling ground or of a rocking
-// suspension: each ground group's tau_k is estimated from its residuals in
-// the scans' order with params.ground_correlation_batches batches
-// (error_correlation.h; 0: taken as independent).
-Status ComputeVarianceGroupComponents(ceres::Problem* problem, bool imu_filtered,
+// other (priors, bias random walks) held at 1. The ground's have a floor of
+// 1 (their errors are the ground planes', shared by many residuals: their
+// fit says nothing of the vertical's error). Errors that stay correlated
+// along the sequence divide the information by their tau
+// (error_correlation.h, with params.correlation_batches batches; 0: none
+// estimated): each ground group's, from its residuals in the scans' order
+// (rolling ground, a rocking suspension), and, for low-passed readings
+// (imu.low_pass_correlation > 1), the gyro's and accelerometer's, at least
+// imu.low_pass_correlation, with imu's floors.
+Status ComputeVarianceGroupComponents(ceres::Problem* problem, const ImuResidualNoise& imu,
                                       const proto::ObservabilityParams& params, int num_threads,
                                       std::vector<VarianceComponent>* components);
 

@@ -33,12 +33,12 @@ BatchMeansVariances BatchMeans(const std::vector<double>& series, int num_batche
 
 double PooledBatchMeansCorrelation(const Eigen::VectorXd& residuals,
                                    const std::vector<int>& row_group,
-                                   const std::vector<int>& row_in_block, int group,
+                                   const std::vector<int>& row_component, int group,
                                    int num_batches) {
   std::map<int, std::vector<double>> series;
   for (size_t r = 0; r < row_group.size(); ++r) {
     if (row_group[r] != group) continue;
-    series[row_in_block[r]].push_back(residuals[static_cast<Eigen::Index>(r)]);
+    series[row_component[r]].push_back(residuals[static_cast<Eigen::Index>(r)]);
   }
   double batch_means = 0.0;
   double values = 0.0;

@@ -65,6 +65,12 @@ Status HandleImuVibration(const proto::ImuVibrationParams& params,
   return Status::Ok();
 }
 
+double LowPassCorrelation(const proto::ImuVibrationReport& report) {
+  if (!report.filtered() || !(report.cutoff_hz() > 0.0) || report.decimation() < 1) return 1.0;
+  return std::max(1.0, report.sample_rate_hz() / (2.0 * report.cutoff_hz() *
+                                                  static_cast<double>(report.decimation())));
+}
+
 std::string DescribeImuVibration(const proto::ImuVibrationReport& r) {
   if (!r.found() && !r.filtered()) return "";
   auto peak = [](double hz) { return hz > 0.0 ? fmt::format(", peak {:.1f} Hz", hz) : std::string(); };

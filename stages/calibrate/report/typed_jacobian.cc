@@ -5,6 +5,8 @@
 
 #include <ceres/crs_matrix.h>
 
+#include "stages/calibrate/residuals/stacked_cost_function.h"
+
 namespace tiltcal::calibrate {
 
 Status EvaluateTypedJacobian(ceres::Problem* problem, const std::vector<double*>& parameter_blocks,
@@ -15,14 +17,16 @@ Status EvaluateTypedJacobian(ceres::Problem* problem, const std::vector<double*>
   options.apply_loss_function = true;
   options.num_threads = std::max(1, num_threads);
   out->row_group.clear();
-  out->row_in_block.clear();
+  out->row_component.clear();
   out->square_sum.fill(0.0);
   for (const ceres::ResidualBlockId id : options.residual_blocks) {
     const ceres::CostFunction* cost_function = problem->GetCostFunctionForResidualBlock(id);
     const VarianceGroup group = VarianceGroupOf(cost_function);
     const int rows = cost_function->num_residuals();
     out->row_group.insert(out->row_group.end(), static_cast<size_t>(rows), group);
-    for (int i = 0; i < rows; ++i) out->row_in_block.push_back(i);
+    const auto* stacked = dynamic_cast<const StackedCostFunction*>(cost_function);
+    const int measurement_rows = stacked != nullptr ? stacked->row(0).num_residuals() : rows;
+    for (int i = 0; i < rows; ++i) out->row_component.push_back(i % measurement_rows);
     double cost = 0.0;
     if (!problem->EvaluateResidualBlock(id, true, &cost, nullptr, nullptr) ||
         !std::isfinite(cost)) {

@@ -4,7 +4,7 @@
 // The Jacobian of every residual block of a calibration problem (robust loss
 // applied, residuals weighted by their sigma) in the columns of the given
 // parameter blocks, with each row's variance group (residual_type.h), its
-// residual and its index within its block, and per group the weighted square
+// residual and its component, and per group the weighted square
 // sum 2F_k (ceres' cost with the robust loss, times 2) at the current
 // parameters. Rows are in the order the problem holds its residual blocks:
 // the order they were added in (the calibration removes none), for the ground
@@ -26,7 +26,10 @@ namespace tiltcal::calibrate {
 struct TypedJacobian {
   Eigen::SparseMatrix<double, Eigen::RowMajor> jacobian;
   std::vector<int> row_group;        // VarianceGroup of each row
-  std::vector<int> row_in_block;     // 0 .. the block's num_residuals - 1
+  // The row's index within its measurement: 0..2 for a gyro, accel, flat or
+  // up residual (a stacked block's rows in turn), 0 for a dist, incl or
+  // LiDAR residual.
+  std::vector<int> row_component;
   Eigen::VectorXd residuals;         // weighted, robust loss applied
   std::array<double, kNumVarianceGroups> square_sum{};
 };

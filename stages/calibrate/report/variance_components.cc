@@ -47,8 +47,9 @@ Status EstimateVarianceComponents(const Eigen::SparseMatrix<double, Eigen::RowMa
     if (!groups[k].estimated || !(c.redundancy > 0.0) || !(groups[k].square_sum > 0.0)) continue;
     c.sigma0_squared = groups[k].square_sum / c.redundancy;
     c.correlation = std::max(1.0, groups[k].correlation);
+    c.floor = groups[k].floor;
     const double inflation = c.sigma0_squared * c.correlation;
-    c.weight = 1.0 / (groups[k].may_shrink ? inflation : std::max(1.0, inflation));
+    c.weight = 1.0 / std::max(groups[k].floor, inflation);
   }
   return Status::Ok();
 }

@@ -20,15 +20,17 @@
 // solved: the estimate is unbiased when the model's sigmas are in the right
 // ratio, and a noisier group leaks into the others' residuals through the
 // parameters they share otherwise. A group not estimated keeps s_k = w_k = 1
-// (priors, random walks: not measurements of noise). A group that may not
-// shrink has w_k = 1 / max(s_k, 1): its residuals are not white or its errors
-// not independent, so a fit below their model sigma says nothing of their
-// noise. A group whose errors stay correlated along the sequence
-// (error_correlation.h: tau_k, the variance of their mean against that of
-// independent errors) has its information divided by tau_k as well:
-//   w_k = 1 / (s_k max(1, tau_k)),  or 1 / max(1, s_k max(1, tau_k))
-// for a group that may not shrink (tau_k below 1, errors that cancel, is
-// not credited). tr(H^{-1} J_k^T J_k) needs H^{-1} only on H's pattern
+// (priors, random walks: not measurements of noise). A group whose errors
+// stay correlated along the sequence (error_correlation.h: tau_k, the
+// variance of their mean against that of independent errors) has its
+// information divided by tau_k as well, and a group whose fit can fall below
+// its noise has a floor f_k under the product:
+//   w_k = 1 / max(f_k, s_k max(1, tau_k))
+// (tau_k below 1, errors that cancel, is not credited). f_k = 1 for residuals
+// whose errors are shared, so that their fit says nothing of their noise
+// (the ground's); for a low-passed IMU, whose in-band noise the spline
+// absorbs, its noise measured at rest (imu_static_noise.h); 0 otherwise.
+// tr(H^{-1} J_k^T J_k) needs H^{-1} only on H's pattern
 // (selected_inverse.h).
 
 #include <cstdint>
@@ -43,8 +45,8 @@ namespace tiltcal::calibrate {
 struct VarianceComponentGroup {
   double square_sum = 0.0;  // e_k^T e_k
   bool estimated = true;
-  bool may_shrink = true;
   double correlation = 1.0;  // tau_k
+  double floor = 0.0;        // f_k
 };
 
 struct VarianceComponent {
@@ -52,6 +54,7 @@ struct VarianceComponent {
   double redundancy = 0.0;      // r_k
   double sigma0_squared = 1.0;  // s_k
   double correlation = 1.0;     // max(1, tau_k) as applied
+  double floor = 0.0;           // f_k
   double weight = 1.0;          // w_k the covariance uses
 };
 

@@ -198,15 +198,15 @@ TEST(CalibrateParamsTest, VoxelIcpNeedsItsSettingsOnlyWhenChosen) {
 
 TEST(CalibrateParamsTest, GroundCorrelationNeedsEnoughBatchesOrNone) {
   proto::CalibrateParams params = tiltcal::testing::DefaultCalibrateParamsWith();
-  EXPECT_EQ(params.observability().ground_correlation_batches(), 20);
-  params.mutable_observability()->set_ground_correlation_batches(3);
+  EXPECT_EQ(params.observability().correlation_batches(), 20);
+  params.mutable_observability()->set_correlation_batches(3);
   const Status status = ValidateCalibrateParams(params);
   ASSERT_FALSE(status.ok());
   EXPECT_EQ(status.message(),
-            "params: observability.ground_correlation_batches = 3 must be 0 or at least 4");
-  params.mutable_observability()->set_ground_correlation_batches(0);
+            "params: observability.correlation_batches = 3 must be 0 or at least 4");
+  params.mutable_observability()->set_correlation_batches(0);
   EXPECT_TRUE(ValidateCalibrateParams(params).ok());
-  params.mutable_observability()->set_ground_correlation_batches(4);
+  params.mutable_observability()->set_correlation_batches(4);
   EXPECT_TRUE(ValidateCalibrateParams(params).ok());
 }
 

@@ -452,12 +452,12 @@ void MakeDistanceProblem(double rho, unsigned seed, DistanceProblem* p) {
 
 TEST(CovarianceReportTest, GroundHeightErrorsCorrelatedAlongTheScansDivideTheirWeight) {
   proto::CalibrateParams params = testing::DefaultCalibrateParamsWith();
-  ASSERT_EQ(params.observability().ground_correlation_batches(), 20);
+  ASSERT_EQ(params.observability().correlation_batches(), 20);
   std::vector<VarianceComponent> c;
   DistanceProblem correlated;
   MakeDistanceProblem(0.85, 3, &correlated);
   ASSERT_TRUE(
-      ComputeVarianceGroupComponents(&correlated.problem, false, params.observability(), 1, &c)
+      ComputeVarianceGroupComponents(&correlated.problem, ImuResidualNoise(), params.observability(), 1, &c)
           .ok());
   ASSERT_EQ(c.size(), static_cast<size_t>(kNumVarianceGroups));
   const VarianceComponent& dist = c[kGroundDistGroup];
@@ -471,19 +471,19 @@ TEST(CovarianceReportTest, GroundHeightErrorsCorrelatedAlongTheScansDivideTheirW
   EXPECT_EQ(c[kGroundFlatGroup].rows, 0);
 
   // Taken as independent: the ground may not shrink, weight 1.
-  params.mutable_observability()->set_ground_correlation_batches(0);
+  params.mutable_observability()->set_correlation_batches(0);
   ASSERT_TRUE(
-      ComputeVarianceGroupComponents(&correlated.problem, false, params.observability(), 1, &c)
+      ComputeVarianceGroupComponents(&correlated.problem, ImuResidualNoise(), params.observability(), 1, &c)
           .ok());
   EXPECT_DOUBLE_EQ(c[kGroundDistGroup].correlation, 1.0);
   EXPECT_DOUBLE_EQ(c[kGroundDistGroup].weight, 1.0);
 
   // Independent errors: tau about 1, s tau below 1, weight 1.
-  params.mutable_observability()->set_ground_correlation_batches(20);
+  params.mutable_observability()->set_correlation_batches(20);
   DistanceProblem independent;
   MakeDistanceProblem(0.0, 3, &independent);
   ASSERT_TRUE(
-      ComputeVarianceGroupComponents(&independent.problem, false, params.observability(), 1, &c)
+      ComputeVarianceGroupComponents(&independent.problem, ImuResidualNoise(), params.observability(), 1, &c)
           .ok());
   EXPECT_LT(c[kGroundDistGroup].correlation, 2.0);
   EXPECT_DOUBLE_EQ(c[kGroundDistGroup].weight, 1.0);

@@ -73,29 +73,29 @@ TEST(ErrorCorrelationTest, PoolsTheComponentsOfOneGroupOnly) {
   std::normal_distribution<double> normal;
   std::vector<double> residuals;
   std::vector<int> row_group;
-  std::vector<int> row_in_block;
+  std::vector<int> row_component;
   for (int b = 0; b < blocks; ++b) {
     for (int c = 0; c < 3; ++c) {
       residuals.push_back(components[static_cast<size_t>(c)][static_cast<size_t>(b)]);
       row_group.push_back(3);
-      row_in_block.push_back(c);
+      row_component.push_back(c);
     }
     residuals.push_back(normal(rng));
     row_group.push_back(1);
-    row_in_block.push_back(0);
+    row_component.push_back(0);
   }
   const Eigen::VectorXd r =
       Eigen::Map<const Eigen::VectorXd>(residuals.data(), static_cast<Eigen::Index>(residuals.size()));
-  const double pooled = PooledBatchMeansCorrelation(r, row_group, row_in_block, 3, 20);
+  const double pooled = PooledBatchMeansCorrelation(r, row_group, row_component, 3, 20);
   double separate = 0.0;
   for (int c = 0; c < 3; ++c) separate += BatchMeans(components[static_cast<size_t>(c)], 20).batch_means;
   double variances = 0.0;
   for (int c = 0; c < 3; ++c) variances += BatchMeans(components[static_cast<size_t>(c)], 20).values;
   EXPECT_DOUBLE_EQ(pooled, separate / variances);
   EXPECT_NEAR(pooled, 9.0, 9.0 * 0.3);
-  EXPECT_NEAR(PooledBatchMeansCorrelation(r, row_group, row_in_block, 1, 20), 1.0, 0.6);
+  EXPECT_NEAR(PooledBatchMeansCorrelation(r, row_group, row_component, 1, 20), 1.0, 0.6);
   // A group with no rows: 1.
-  EXPECT_EQ(PooledBatchMeansCorrelation(r, row_group, row_in_block, 4, 20), 1.0);
+  EXPECT_EQ(PooledBatchMeansCorrelation(r, row_group, row_component, 4, 20), 1.0);
 }
 
 }  // namespace

@@ -94,11 +94,11 @@ TEST(VarianceComponentsTest, RedundanciesEqualTheDenseOnes) {
   EXPECT_NEAR(c[1].sigma0_squared, p.groups[1].square_sum / c[1].redundancy, 1e-12);
 }
 
-// A group held (not estimated) keeps weight 1; one that may not shrink keeps
+// A group held (not estimated) keeps weight 1; one with a floor of 1 keeps
 // its estimate but a weight of at most 1.
 TEST(VarianceComponentsTest, HeldAndNonShrinkingGroups) {
   TwoGroupProblem p = MakeProblem(1000, 100, 0.5, 2.0, 4);
-  p.groups[0].may_shrink = false;
+  p.groups[0].floor = 1.0;
   p.groups[1].estimated = false;
   std::vector<VarianceComponent> c;
   ASSERT_TRUE(
@@ -115,8 +115,7 @@ TEST(VarianceComponentsTest, HeldAndNonShrinkingGroups) {
 }
 
 // A group whose errors stay correlated has its information divided by tau
-// as well; tau below 1 is not credited, and one that may not shrink keeps a
-// weight of at most 1.
+// as well; tau below 1 is not credited, and a floor bounds s tau from below.
 TEST(VarianceComponentsTest, CorrelatedErrorsDivideTheWeight) {
   TwoGroupProblem p = MakeProblem(1000, 100, 0.5, 2.0, 4);
   p.groups[0].correlation = 6.0;
@@ -128,9 +127,9 @@ TEST(VarianceComponentsTest, CorrelatedErrorsDivideTheWeight) {
   EXPECT_DOUBLE_EQ(c[0].weight, 1.0 / (6.0 * c[0].sigma0_squared));
   EXPECT_DOUBLE_EQ(c[1].correlation, 1.0);
   EXPECT_DOUBLE_EQ(c[1].weight, 1.0 / c[1].sigma0_squared);
-  // s_0 ~ 0.25: s tau ~ 1.5 above 1 divides a group that may not shrink;
-  // tau 2 (s tau ~ 0.5) leaves it at 1.
-  p.groups[0].may_shrink = false;
+  // s_0 ~ 0.25: s tau ~ 1.5 above a floor of 1 divides the group; tau 2
+  // (s tau ~ 0.5) leaves it at the floor, as does a floor of 0.8.
+  p.groups[0].floor = 1.0;
   ASSERT_TRUE(
       EstimateVarianceComponents(p.a.sparseView(0.0, 0.0), p.row_group, p.groups, 1e-14, &c).ok());
   ASSERT_GT(6.0 * c[0].sigma0_squared, 1.0);
@@ -140,6 +139,10 @@ TEST(VarianceComponentsTest, CorrelatedErrorsDivideTheWeight) {
       EstimateVarianceComponents(p.a.sparseView(0.0, 0.0), p.row_group, p.groups, 1e-14, &c).ok());
   ASSERT_LT(2.0 * c[0].sigma0_squared, 1.0);
   EXPECT_DOUBLE_EQ(c[0].weight, 1.0);
+  p.groups[0].floor = 0.8;
+  ASSERT_TRUE(
+      EstimateVarianceComponents(p.a.sparseView(0.0, 0.0), p.row_group, p.groups, 1e-14, &c).ok());
+  EXPECT_DOUBLE_EQ(c[0].weight, 1.0 / 0.8);
 }
 
 }  // namespace
