@@ -107,7 +107,7 @@ Status ValidateImuVibrationParams(const proto::ImuVibrationParams& params) {
   return Status::Ok();
 }
 
-// 0 (the ground's errors independent) or enough batches for a variance of
+// 0 (errors taken as independent) or enough batches for a variance of
 // their means (error_correlation.h).
 Status ValidateObservabilityParams(const proto::ObservabilityParams& params) {
   const int batches = params.correlation_batches();

@@ -75,9 +75,10 @@ class SimulatedBag {
   proto::SimulationTruth truth_;
 };
 
+// Simulated once per test process; destroyed (its folder removed) at exit.
 const SimulatedBag& Simulated() {
-  static const SimulatedBag* bag = new SimulatedBag();
-  return *bag;
+  static const SimulatedBag bag;
+  return bag;
 }
 
 // How a copy of the simulated bag differs from it.
