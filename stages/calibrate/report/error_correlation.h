@@ -37,9 +37,9 @@ BatchMeansVariances BatchMeans(const std::vector<double>& series, int num_batche
 
 // tau^ pooled over the series of one group's rows: the rows with
 // row_group == group, each component (row_component, typed_jacobian.h) a
-// series of its own (a 3-row residual gives three), in the rows' order. tau^ = the sum of
-// the numerators over the sum of the denominators; 1 when there is no
-// variance to compare (too few rows, all residuals equal).
+// series of its own (a 3-row residual gives three), in the rows' order.
+// tau^ = the sum of the numerators over the sum of the denominators; 1 when
+// there is no variance to compare (too few rows, all residuals equal).
 double PooledBatchMeansCorrelation(const Eigen::VectorXd& residuals,
                                    const std::vector<int>& row_group,
                                    const std::vector<int>& row_component, int group,

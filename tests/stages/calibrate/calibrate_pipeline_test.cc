@@ -456,9 +456,9 @@ TEST(CovarianceReportTest, GroundHeightErrorsCorrelatedAlongTheScansDivideTheirW
   std::vector<VarianceComponent> c;
   DistanceProblem correlated;
   MakeDistanceProblem(0.85, 3, &correlated);
-  ASSERT_TRUE(
-      ComputeVarianceGroupComponents(&correlated.problem, ImuResidualNoise(), params.observability(), 1, &c)
-          .ok());
+  ASSERT_TRUE(ComputeVarianceGroupComponents(&correlated.problem, ImuResidualNoise(),
+                                             params.observability(), 1, &c)
+                  .ok());
   ASSERT_EQ(c.size(), static_cast<size_t>(kNumVarianceGroups));
   const VarianceComponent& dist = c[kGroundDistGroup];
   EXPECT_EQ(dist.rows, 400);
@@ -472,9 +472,9 @@ TEST(CovarianceReportTest, GroundHeightErrorsCorrelatedAlongTheScansDivideTheirW
 
   // Taken as independent: the ground may not shrink, weight 1.
   params.mutable_observability()->set_correlation_batches(0);
-  ASSERT_TRUE(
-      ComputeVarianceGroupComponents(&correlated.problem, ImuResidualNoise(), params.observability(), 1, &c)
-          .ok());
+  ASSERT_TRUE(ComputeVarianceGroupComponents(&correlated.problem, ImuResidualNoise(),
+                                             params.observability(), 1, &c)
+                  .ok());
   EXPECT_DOUBLE_EQ(c[kGroundDistGroup].correlation, 1.0);
   EXPECT_DOUBLE_EQ(c[kGroundDistGroup].weight, 1.0);
 
@@ -482,9 +482,9 @@ TEST(CovarianceReportTest, GroundHeightErrorsCorrelatedAlongTheScansDivideTheirW
   params.mutable_observability()->set_correlation_batches(20);
   DistanceProblem independent;
   MakeDistanceProblem(0.0, 3, &independent);
-  ASSERT_TRUE(
-      ComputeVarianceGroupComponents(&independent.problem, ImuResidualNoise(), params.observability(), 1, &c)
-          .ok());
+  ASSERT_TRUE(ComputeVarianceGroupComponents(&independent.problem, ImuResidualNoise(),
+                                             params.observability(), 1, &c)
+                  .ok());
   EXPECT_LT(c[kGroundDistGroup].correlation, 2.0);
   EXPECT_DOUBLE_EQ(c[kGroundDistGroup].weight, 1.0);
 }

@@ -2,15 +2,14 @@
 // independent errors, (1 + rho) / (1 - rho) for an AR(1) series, pooled over
 // the components of a group's blocks and blind to the other groups' rows.
 
-#include <cmath>
-#include <random>
-#include <vector>
+#include "stages/calibrate/report/error_correlation.h"
 
 #include <gtest/gtest.h>
 
 #include <Eigen/Core>
-
-#include "stages/calibrate/report/error_correlation.h"
+#include <cmath>
+#include <random>
+#include <vector>
 
 namespace tiltcal::calibrate {
 namespace {
@@ -84,13 +83,15 @@ TEST(ErrorCorrelationTest, PoolsTheComponentsOfOneGroupOnly) {
     row_group.push_back(1);
     row_component.push_back(0);
   }
-  const Eigen::VectorXd r =
-      Eigen::Map<const Eigen::VectorXd>(residuals.data(), static_cast<Eigen::Index>(residuals.size()));
+  const Eigen::VectorXd r = Eigen::Map<const Eigen::VectorXd>(
+      residuals.data(), static_cast<Eigen::Index>(residuals.size()));
   const double pooled = PooledBatchMeansCorrelation(r, row_group, row_component, 3, 20);
   double separate = 0.0;
-  for (int c = 0; c < 3; ++c) separate += BatchMeans(components[static_cast<size_t>(c)], 20).batch_means;
+  for (int c = 0; c < 3; ++c)
+    separate += BatchMeans(components[static_cast<size_t>(c)], 20).batch_means;
   double variances = 0.0;
-  for (int c = 0; c < 3; ++c) variances += BatchMeans(components[static_cast<size_t>(c)], 20).values;
+  for (int c = 0; c < 3; ++c)
+    variances += BatchMeans(components[static_cast<size_t>(c)], 20).values;
   EXPECT_DOUBLE_EQ(pooled, separate / variances);
   EXPECT_NEAR(pooled, 9.0, 9.0 * 0.3);
   EXPECT_NEAR(PooledBatchMeansCorrelation(r, row_group, row_component, 1, 20), 1.0, 0.6);
