@@ -84,13 +84,22 @@ Status FillVarianceComponents(const SolvedCalibration& solved, proto::Calibratio
                               VarianceGroupWeights* weights) {
   ImuResidualNoise imu;
   imu.low_pass_correlation = solved.inputs.imu_low_pass_correlation;
-  if (imu.low_pass_correlation > 1.0 && solved.init.imu.from_static_start) {
-    const ImuStaticNoise at_rest = MeasureImuStaticNoise(
-        solved.inputs.imu, solved.init.imu.averaging_begin_s, solved.init.imu.averaging_end_s,
-        solved.params.imu_noise().gyro_sigma_radps(), solved.params.imu_noise().accel_sigma_mps2(),
-        imu.low_pass_correlation);
-    imu.gyro_floor = at_rest.gyro_factor;
-    imu.accel_floor = at_rest.accel_factor;
+  if (imu.low_pass_correlation > 1.0) {
+    // Low-passed readings whose noise was not measured at rest (no static
+    // start) keep the model's sigma as their floor: their residuals
+    // understate it.
+    imu.gyro_floor = 1.0;
+    imu.accel_floor = 1.0;
+    if (solved.init.imu.from_static_start) {
+      const ImuStaticNoise at_rest = MeasureImuStaticNoise(
+          solved.inputs.imu, solved.init.imu.averaging_begin_s, solved.init.imu.averaging_end_s,
+          solved.params.imu_noise().gyro_sigma_radps(),
+          solved.params.imu_noise().accel_sigma_mps2(), imu.low_pass_correlation);
+      if (at_rest.samples >= kMinStaticNoiseSamples) {
+        imu.gyro_floor = at_rest.gyro_factor;
+        imu.accel_floor = at_rest.accel_factor;
+      }
+    }
   }
   std::vector<VarianceComponent> components;
   TILTCAL_RETURN_IF_ERROR(ComputeVarianceGroupComponents(

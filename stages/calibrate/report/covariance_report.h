@@ -94,7 +94,8 @@ VarianceFactor ComputeVarianceFactor(ceres::Problem* problem);
 // What the IMU residuals' variance components need beyond their fit: for
 // readings low-passed and thinned (imu_vibration.h), the correlation the
 // filter gives them (LowPassCorrelation) and the floors of s_k tau_k, their
-// noise measured at rest (imu_static_noise.h; 0: none). Raw readings: 1, 0.
+// noise measured at rest (imu_static_noise.h; 1 when not measured). Raw
+// readings: 1 and no floor (0).
 struct ImuResidualNoise {
   double low_pass_correlation = 1.0;
   double gyro_floor = 0.0;
