@@ -2,10 +2,16 @@
 # Configures and builds tiltcal into build/ (Release, Ninja), through ccache
 # when it is installed (compiler_cache.sh). Binaries land in build/bin/.
 # Extra arguments go to cmake, e.g. -DTILTCAL_SANITIZE=address.
+# SETUP_BUILD_ONLY=1 installs only the build dependencies (setup.sh
+# --build_only; scripts/test.sh installs the test ones beside the build).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source scripts/phase_time.sh
-scripts/setup.sh
+if [ "${SETUP_BUILD_ONLY:-0}" = 1 ]; then
+  scripts/setup.sh --build_only
+else
+  scripts/setup.sh
+fi
 phase_done setup
 BUILD_DIR=${BUILD_DIR:-build}
 source scripts/compiler_cache.sh

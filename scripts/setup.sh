@@ -3,29 +3,41 @@
 # then the test oracles of tests/package.json (npm ci into tests/node_modules).
 # Idempotent: does nothing when everything is present. Needs root (or sudo)
 # for the Debian packages.
-#   setup.sh              build and test dependencies
-#   setup.sh --cluster    and Slurm + munge, for the one-node cluster of
-#                         scripts/slurm_local_cluster.sh (test pipeline.slurm)
+#   setup.sh               build and test dependencies
+#   setup.sh --build_only  only what the Release build needs (compilers,
+#                          libraries, GoogleTest); scripts/test.sh installs
+#                          the rest beside the build
+#   setup.sh --cluster     and Slurm + munge, for the one-node cluster of
+#                          scripts/slurm_local_cluster.sh (test pipeline.slurm)
 set -euo pipefail
 
 CLUSTER=0
+BUILD_ONLY=0
 for arg in "$@"; do
   case "$arg" in
     --cluster) CLUSTER=1 ;;
-    *) echo "usage: setup.sh [--cluster]" >&2; exit 2 ;;
+    --build_only) BUILD_ONLY=1 ;;
+    *) echo "usage: setup.sh [--build_only] [--cluster]" >&2; exit 2 ;;
   esac
 done
 
+# What cmake and the Release build (tests and benchmarks included) need.
 PACKAGES=(
   build-essential cmake ninja-build lld pkg-config git
   libeigen3-dev libceres-dev libgoogle-glog-dev
   libpcl-dev libnanoflann-dev libprotobuf-dev protobuf-compiler
   liblz4-dev lz4 libbz2-dev libfmt-dev libsqlite3-dev libzstd-dev zlib1g-dev libpng-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  python3-rosbag python3-sensor-msgs python3-tf2 python3-numpy python3-matplotlib python3-yaml
-  chromium
-  clang libclang-rt-14-dev
 )
+if [ "$BUILD_ONLY" = 0 ]; then
+  # What only the tests run: the ROS 1 oracles, the browser of the report
+  # page's tests, and clang with its sanitizer runtimes.
+  PACKAGES+=(
+    python3-rosbag python3-sensor-msgs python3-tf2 python3-numpy python3-matplotlib python3-yaml
+    chromium
+    clang libclang-rt-14-dev
+  )
+fi
 # Slurm's controller, node daemon and client commands, and munge (its
 # authentication). Their services are not started here:
 # scripts/slurm_local_cluster.sh runs the daemons itself.
@@ -47,7 +59,10 @@ if [ ${#missing[@]} -ne 0 ]; then
   echo "setup: installing ${#missing[@]} Debian packages: ${missing[*]}" >&2
   export DEBIAN_FRONTEND=noninteractive
   $SUDO apt-get update -qq
-  $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+  # dpkg without an fsync per file: a fresh machine unpacks about 560
+  # packages, and a machine that crashes meanwhile reinstalls them anyway.
+  $SUDO apt-get install -y -qq --no-install-recommends -o Dpkg::Options::=--force-unsafe-io \
+    "${missing[@]}" >/dev/null
   echo "setup: Debian packages done" >&2
 fi
 
@@ -58,6 +73,8 @@ fi
 # node_modules/.tiltcal-lock.sha256). A node_modules that is a symlink (a git
 # worktree sharing another checkout's) is replaced by the worktree's own
 # install instead of being emptied through the link.
+# The build needs none of them.
+[ "$BUILD_ONLY" = 1 ] && exit 0
 TESTS_DIR="$(cd "$(dirname "${BASH_SOURCE[0]}")/../tests" && pwd)"
 if ! command -v npm >/dev/null; then
   echo "setup: no npm (Node 20): the ROS 2 bag tests will be skipped" >&2
