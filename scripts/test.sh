@@ -14,14 +14,16 @@ phase_done "setup of the build dependencies"
 # After it, in the same background job, the parsers under ASan + UBSan and
 # a few seconds of fuzzing each (scripts/sanitize_and_fuzz.sh);
 # SKIP_SANITIZERS=1 leaves them out. Their clang build and their tests run
-# beside the release build and ctest at a lower priority, on the cores
-# those leave idle (a link, the last long tests); their phase times follow
-# ctest's (their whole output when they fail), then the fuzzing runs.
+# beside the release build and ctest; their phase times follow ctest's
+# (their whole output when they fail), then the fuzzing runs.
 sanitizers=1
 [ "${SKIP_SANITIZERS:-0}" != 1 ] || sanitizers=0
 background_log=$(mktemp)
 test_setup_done=$(mktemp -u)  # made when the test dependencies are in
-# Its own process group, so that an early exit stops the whole job.
+# Its own process group, so that an early exit stops the whole job. Where
+# the kernel groups each session for scheduling (autogroups), the job's
+# nice counts only within it, and it shares the cores evenly with the build;
+# it has then long finished when ctest ends.
 setsid nice -n 10 bash -c 'source scripts/phase_time.sh
   scripts/setup.sh --cluster
   phase_done "setup of the test dependencies (background)"
@@ -39,6 +41,7 @@ background_failed() {
 # benchmarks (bench/, run by hand, never by a test) left out.
 SETUP_BUILD_ONLY=1 scripts/build.sh -DTILTCAL_WERROR=ON -DTILTCAL_BUILD_TESTS=ON \
   -DTILTCAL_BUILD_BENCHMARKS=OFF
+source scripts/phase_time.sh  # the clock restarts after build.sh's own phases
 while [ ! -e "$test_setup_done" ]; do
   if ! kill -0 "$background" 2> /dev/null; then
     [ -e "$test_setup_done" ] || background_failed "the setup of the test dependencies failed"
