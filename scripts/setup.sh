@@ -59,8 +59,10 @@ if [ ${#missing[@]} -ne 0 ]; then
   echo "setup: installing ${#missing[@]} Debian packages: ${missing[*]}" >&2
   export DEBIAN_FRONTEND=noninteractive
   $SUDO apt-get update -qq
-  # dpkg without an fsync per file: a fresh machine unpacks about 560
-  # packages, and a machine that crashes meanwhile reinstalls them anyway.
+  # dpkg without an fsync per unpacked file (its own database is still
+  # synced), as in Debian's container images: a fresh machine unpacks about
+  # 560 packages. A crash in the middle can leave some files empty;
+  # apt-get install --reinstall mends them.
   $SUDO apt-get install -y -qq --no-install-recommends -o Dpkg::Options::=--force-unsafe-io \
     "${missing[@]}" >/dev/null
   echo "setup: Debian packages done" >&2
@@ -72,8 +74,8 @@ fi
 # lock file differs from the one of the last install (its sha256 is kept in
 # node_modules/.tiltcal-lock.sha256). A node_modules that is a symlink (a git
 # worktree sharing another checkout's) is replaced by the worktree's own
-# install instead of being emptied through the link.
-# The build needs none of them.
+# install instead of being emptied through the link. The build needs none of
+# them.
 [ "$BUILD_ONLY" = 1 ] && exit 0
 TESTS_DIR="$(cd "$(dirname "${BASH_SOURCE[0]}")/../tests" && pwd)"
 if ! command -v npm >/dev/null; then
