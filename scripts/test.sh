@@ -24,7 +24,8 @@ test_setup_done=$(mktemp -u)  # made when the test dependencies are in
 # the kernel groups each session for scheduling (autogroups), the job's
 # nice counts only within it, and it shares the cores evenly with the build;
 # it has then long finished when ctest ends.
-setsid nice -n 10 bash -c 'source scripts/phase_time.sh
+setsid nice -n 10 bash -c 'set -euo pipefail
+  source scripts/phase_time.sh
   scripts/setup.sh --cluster
   phase_done "setup of the test dependencies (background)"
   touch "$1"
