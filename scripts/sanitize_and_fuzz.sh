@@ -45,7 +45,8 @@ if [ ! -f "$BUILD_DIR/build.ninja" ]; then
 fi
 cmake --build "$BUILD_DIR" -j "$(nproc)" --target "${FUZZERS[@]}" "${TESTS[@]}" tiltcal_decode \
   tiltcal_inspect
-phase_done "sanitizer configure + build"
+# After --no_fuzz the build has nothing to do: no phase line for it.
+[ "$MODE" = --fuzz_only ] || phase_done "sanitizer configure + build"
 
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
