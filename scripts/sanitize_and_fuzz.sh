@@ -2,22 +2,27 @@
 # The parsers under the sanitizers (fuzz/README.md, docs/reliability.md): builds, with
 # clang, ASan + UBSan (float-cast-overflow included, stop at the first
 # finding) and libFuzzer coverage, only what the I/O, bag and decode tests
-# and the fuzz harnesses need; runs those tests; then runs each harness for
-# FUZZ_SECONDS (default 5) from its committed seed corpus (fuzz/corpus/).
+# and the fuzz harnesses need (a TILTCAL_PARSERS_ONLY build: no Ceres, no
+# PCL); runs those tests; then runs each harness for FUZZ_SECONDS
+# (default 5) from its committed seed corpus (fuzz/corpus/).
 # Tests and harnesses run JOBS (default: the number of cores) at a time; each
 # harness still gets its FUZZ_SECONDS. New inputs go to a temporary
 # directory; a crash leaves its input as crash-* in $BUILD_DIR/fuzz-artifacts/
-# and fails the script. With --no_fuzz it builds, runs the tests and stops;
-# with --fuzz_only it builds (nothing to do after --no_fuzz) and fuzzes
-# (scripts/test.sh runs the first beside the release build and its tests,
-# the second after them).
-#   scripts/sanitize_and_fuzz.sh [--no_fuzz | --fuzz_only]
+# and fails the script. One step alone: --build_only, --tests_only or
+# --fuzz_only (the last two build first, which has nothing to do after
+# --build_only). scripts/test.sh builds while the release build's packages
+# install, runs the tests beside the release build and ctest, and fuzzes
+# after them.
+#   scripts/sanitize_and_fuzz.sh [--build_only | --tests_only | --fuzz_only]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 MODE=${1:-}
 case $MODE in
-  "" | --no_fuzz | --fuzz_only) ;;
-  *) echo "usage: scripts/sanitize_and_fuzz.sh [--no_fuzz | --fuzz_only]" >&2; exit 2 ;;
+  "" | --build_only | --tests_only | --fuzz_only) ;;
+  *)
+    echo "usage: scripts/sanitize_and_fuzz.sh [--build_only | --tests_only | --fuzz_only]" >&2
+    exit 2
+    ;;
 esac
 source scripts/phase_time.sh
 source scripts/compiler_cache.sh
@@ -41,12 +46,14 @@ if [ ! -f "$BUILD_DIR/build.ninja" ]; then
     -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only -DNDEBUG" \
     -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ "${COMPILER_CACHE[@]}" \
     -DTILTCAL_SANITIZE=address,undefined -DTILTCAL_FUZZ=ON -DTILTCAL_BUILD_BENCHMARKS=OFF \
-    >/dev/null
+    -DTILTCAL_PARSERS_ONLY=ON >/dev/null
 fi
 cmake --build "$BUILD_DIR" -j "$(nproc)" --target "${FUZZERS[@]}" "${TESTS[@]}" tiltcal_decode \
   tiltcal_inspect
-# After --no_fuzz the build has nothing to do: no phase line for it.
-[ "$MODE" = --fuzz_only ] || phase_done "sanitizer configure + build"
+case $MODE in
+  "" | --build_only) phase_done "sanitizer configure + build" ;;
+esac
+[ "$MODE" = --build_only ] && exit 0
 
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
@@ -78,7 +85,7 @@ if [ "$MODE" != --fuzz_only ]; then
   done
   phase_done "sanitizer tests"
 fi
-[ "$MODE" = --no_fuzz ] && exit 0
+[ "$MODE" = --tests_only ] && exit 0
 
 artifacts=$BUILD_DIR/fuzz-artifacts
 mkdir -p "$artifacts"

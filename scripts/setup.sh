@@ -3,41 +3,54 @@
 # then the test oracles of tests/package.json (npm ci into tests/node_modules).
 # Idempotent: does nothing when everything is present. Needs root (or sudo)
 # for the Debian packages.
-#   setup.sh               build and test dependencies
-#   setup.sh --build_only  only what the Release build needs (compilers,
-#                          libraries, GoogleTest); scripts/test.sh installs
-#                          the rest beside the build
-#   setup.sh --cluster     and Slurm + munge, for the one-node cluster of
-#                          scripts/slurm_local_cluster.sh (test pipeline.slurm)
+#   setup.sh                build and test dependencies
+#   setup.sh --build_only   only what the Release build needs (compilers,
+#                           libraries, GoogleTest)
+#   setup.sh --parsers_only only what the sanitizer build of the parsers
+#                           needs (clang, protobuf, the compression
+#                           libraries; no Ceres, no PCL): scripts/test.sh
+#                           compiles it while the rest installs
+#   setup.sh --cluster      and Slurm + munge, for the one-node cluster of
+#                           scripts/slurm_local_cluster.sh (test pipeline.slurm)
 set -euo pipefail
 
 CLUSTER=0
-BUILD_ONLY=0
+ONLY=
 for arg in "$@"; do
   case "$arg" in
     --cluster) CLUSTER=1 ;;
-    --build_only) BUILD_ONLY=1 ;;
-    *) echo "usage: setup.sh [--build_only] [--cluster]" >&2; exit 2 ;;
+    --build_only | --parsers_only) ONLY=$arg ;;
+    *) echo "usage: setup.sh [--build_only | --parsers_only] [--cluster]" >&2; exit 2 ;;
   esac
 done
 
-# What cmake and the Release build (tests and benchmarks included) need.
-PACKAGES=(
+# What the parsers and their tests need to build (TILTCAL_PARSERS_ONLY).
+PARSER_PACKAGES=(
   build-essential cmake ninja-build lld pkg-config git
-  libeigen3-dev libceres-dev libgoogle-glog-dev
-  libpcl-dev libnanoflann-dev libprotobuf-dev protobuf-compiler
+  libeigen3-dev libprotobuf-dev protobuf-compiler
   liblz4-dev lz4 libbz2-dev libfmt-dev libsqlite3-dev libzstd-dev zlib1g-dev libpng-dev
-  libgtest-dev libgmock-dev libbenchmark-dev
+  libgtest-dev libgmock-dev
 )
-if [ "$BUILD_ONLY" = 0 ]; then
-  # What only the tests run: the ROS 1 oracles, the browser of the report
-  # page's tests, and clang with its sanitizer runtimes.
-  PACKAGES+=(
-    python3-rosbag python3-sensor-msgs python3-tf2 python3-numpy python3-matplotlib python3-yaml
-    chromium
-    clang libclang-rt-14-dev
-  )
-fi
+# The rest of what cmake and the Release build (tests and benchmarks
+# included) need: the calibrator's libraries. PCL brings most of the
+# packages (VTK, Qt, Boost).
+CALIBRATOR_PACKAGES=(libceres-dev libgoogle-glog-dev libpcl-dev libnanoflann-dev libbenchmark-dev)
+# clang with its sanitizer runtimes (scripts/sanitize_and_fuzz.sh).
+CLANG_PACKAGES=(clang libclang-rt-14-dev)
+# What only the tests run: the ROS 1 oracles and the browser of the report
+# page's tests.
+TEST_PACKAGES=(
+  python3-rosbag python3-sensor-msgs python3-tf2 python3-numpy python3-matplotlib python3-yaml
+  chromium
+)
+case $ONLY in
+  --parsers_only) PACKAGES=("${PARSER_PACKAGES[@]}" "${CLANG_PACKAGES[@]}") ;;
+  --build_only) PACKAGES=("${PARSER_PACKAGES[@]}" "${CALIBRATOR_PACKAGES[@]}") ;;
+  *)
+    PACKAGES=("${PARSER_PACKAGES[@]}" "${CALIBRATOR_PACKAGES[@]}" "${CLANG_PACKAGES[@]}"
+              "${TEST_PACKAGES[@]}")
+    ;;
+esac
 # Slurm's controller, node daemon and client commands, and munge (its
 # authentication). Their services are not started here:
 # scripts/slurm_local_cluster.sh runs the daemons itself.
@@ -76,7 +89,7 @@ fi
 # worktree sharing another checkout's) is replaced by the worktree's own
 # install instead of being emptied through the link. The build needs none of
 # them.
-[ "$BUILD_ONLY" = 1 ] && exit 0
+[ -n "$ONLY" ] && exit 0
 TESTS_DIR="$(cd "$(dirname "${BASH_SOURCE[0]}")/../tests" && pwd)"
 if ! command -v npm >/dev/null; then
   echo "setup: no npm (Node 20): the ROS 2 bag tests will be skipped" >&2

@@ -5,39 +5,52 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source scripts/phase_time.sh
-# What the build needs first. The rest (the test oracles, the browser,
-# clang, and Slurm and munge so that the one-node cluster test
-# pipeline.slurm runs rather than skips) installs in the background while
-# the release build compiles; ctest waits for it.
-scripts/setup.sh --build_only
-phase_done "setup of the build dependencies"
-# After it, in the same background job, the parsers under ASan + UBSan and
-# a few seconds of fuzzing each (scripts/sanitize_and_fuzz.sh);
-# SKIP_SANITIZERS=1 leaves them out. Their clang build and their tests run
-# beside the release build and ctest; their phase times follow ctest's
-# (their whole output when they fail), then the fuzzing runs.
+# The packages arrive in three parts, so that both cores compile while the
+# rest installs (dpkg unpacks on one core). First, in the foreground, what
+# the sanitizer build of the parsers needs (clang, protobuf, the
+# compression libraries: a few packages); that build starts at once in a
+# background job (scripts/sanitize_and_fuzz.sh, the parsers under ASan +
+# UBSan; SKIP_SANITIZERS=1 leaves it out). Then, in the foreground, the
+# rest of what the release build needs (Ceres, PCL: most of the packages),
+# and the release build. When both the build's packages and the sanitizer
+# build are done, the background job installs what only the tests need
+# (the oracles, the browser, and Slurm and munge so that the one-node
+# cluster test pipeline.slurm runs rather than skips) and runs the
+# sanitizer tests; ctest waits for those packages. The fuzzing runs after
+# ctest.
+scripts/setup.sh --parsers_only
+phase_done "setup of the parsers' build dependencies"
 sanitizers=1
 [ "${SKIP_SANITIZERS:-0}" != 1 ] || sanitizers=0
 background_log=$(mktemp)
-test_setup_done=$(mktemp -u)  # made when the test dependencies are in
+build_setup_done=$(mktemp -u)  # made when the release build's packages are in
+test_setup_done=$(mktemp -u)   # made when the test dependencies are in
 # Its own process group, so that an early exit stops the whole job. Where
 # the kernel groups each session for scheduling (autogroups), the job's
-# nice counts only within it, and it shares the cores evenly with the build;
-# it has then long finished when ctest ends.
+# nice counts only within it, and it shares the cores evenly with the
+# foreground (the install, then the build); it has long finished when ctest
+# ends. One apt at a time: it installs after the foreground's install.
 setsid nice -n 10 bash -c 'set -euo pipefail
+  [ "$3" = 0 ] || scripts/sanitize_and_fuzz.sh --build_only
   source scripts/phase_time.sh
+  while [ ! -e "$1" ]; do sleep 1; done
+  phase_done "wait for the release build'"'"'s packages (background)"
   scripts/setup.sh --cluster
   phase_done "setup of the test dependencies (background)"
-  touch "$1"
-  [ "$2" = 0 ] || exec scripts/sanitize_and_fuzz.sh --no_fuzz' \
-  background "$test_setup_done" "$sanitizers" > "$background_log" 2>&1 &
+  touch "$2"
+  [ "$3" = 0 ] || exec scripts/sanitize_and_fuzz.sh --tests_only' \
+  background "$build_setup_done" "$test_setup_done" "$sanitizers" > "$background_log" 2>&1 &
 background=$!
-trap 'kill -- -"$background" 2> /dev/null || true; rm -f "$background_log" "$test_setup_done"' EXIT
+trap 'kill -- -"$background" 2> /dev/null || true
+      rm -f "$background_log" "$build_setup_done" "$test_setup_done"' EXIT
 background_failed() {
   cat "$background_log" >&2
   echo "$1" >&2
   exit 1
 }
+scripts/setup.sh --build_only
+touch "$build_setup_done"
+phase_done "setup of the build dependencies"
 # Tests on, whatever an earlier configure of the build directory chose; the
 # benchmarks (bench/, run by hand, never by a test) left out.
 SETUP_BUILD_ONLY=1 scripts/build.sh -DTILTCAL_WERROR=ON -DTILTCAL_BUILD_TESTS=ON \
@@ -45,7 +58,8 @@ SETUP_BUILD_ONLY=1 scripts/build.sh -DTILTCAL_WERROR=ON -DTILTCAL_BUILD_TESTS=ON
 source scripts/phase_time.sh  # the clock restarts after build.sh's own phases
 while [ ! -e "$test_setup_done" ]; do
   if ! kill -0 "$background" 2> /dev/null; then
-    [ -e "$test_setup_done" ] || background_failed "the setup of the test dependencies failed"
+    [ -e "$test_setup_done" ] ||
+      background_failed "the sanitizer build or the setup of the test dependencies failed"
   fi
   sleep 1
 done
