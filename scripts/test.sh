@@ -12,11 +12,11 @@ source scripts/phase_time.sh
 # background job (scripts/sanitize_and_fuzz.sh, the parsers under ASan +
 # UBSan; SKIP_SANITIZERS=1 leaves it out). Then, in the foreground, the
 # rest of what the release build needs (Ceres, PCL: most of the packages),
-# and the release build. When both the build's packages and the sanitizer
-# build are done, the background job installs what only the tests need
-# (the oracles, the browser, and Slurm and munge so that the one-node
-# cluster test pipeline.slurm runs rather than skips) and runs the
-# sanitizer tests; ctest waits for those packages. The fuzzing runs after
+# and the release build. Once the build's packages are in, the background
+# job installs what only the tests need (the oracles, the browser, and
+# Slurm and munge so that the one-node cluster test pipeline.slurm runs
+# rather than skips); ctest waits for them. When both its build and those
+# packages are done, it runs the sanitizer tests. The fuzzing runs after
 # ctest.
 scripts/setup.sh --parsers_only
 phase_done "setup of the parsers' build dependencies"
@@ -31,14 +31,20 @@ test_setup_done=$(mktemp -u)   # made when the test dependencies are in
 # foreground (the install, then the build); it has long finished when ctest
 # ends. One apt at a time: it installs after the foreground's install.
 setsid nice -n 10 bash -c 'set -euo pipefail
-  [ "$3" = 0 ] || scripts/sanitize_and_fuzz.sh --build_only
+  sanitizer_build=
+  if [ "$3" = 1 ]; then
+    scripts/sanitize_and_fuzz.sh --build_only &
+    sanitizer_build=$!
+  fi
   source scripts/phase_time.sh
   while [ ! -e "$1" ]; do sleep 1; done
   phase_done "wait for the release build'"'"'s packages (background)"
   scripts/setup.sh --cluster
   phase_done "setup of the test dependencies (background)"
   touch "$2"
-  [ "$3" = 0 ] || exec scripts/sanitize_and_fuzz.sh --tests_only' \
+  [ -n "$sanitizer_build" ] || exit 0
+  wait "$sanitizer_build"
+  exec scripts/sanitize_and_fuzz.sh --tests_only' \
   background "$build_setup_done" "$test_setup_done" "$sanitizers" > "$background_log" 2>&1 &
 background=$!
 trap 'kill -- -"$background" 2> /dev/null || true
@@ -58,8 +64,7 @@ SETUP_BUILD_ONLY=1 scripts/build.sh -DTILTCAL_WERROR=ON -DTILTCAL_BUILD_TESTS=ON
 source scripts/phase_time.sh  # the clock restarts after build.sh's own phases
 while [ ! -e "$test_setup_done" ]; do
   if ! kill -0 "$background" 2> /dev/null; then
-    [ -e "$test_setup_done" ] ||
-      background_failed "the sanitizer build or the setup of the test dependencies failed"
+    [ -e "$test_setup_done" ] || background_failed "the setup of the test dependencies failed"
   fi
   sleep 1
 done
