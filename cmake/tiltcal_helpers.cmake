@@ -48,7 +48,9 @@ endfunction()
 # library with the same options, and reused by every target (REUSE_FROM).
 # GCC uses a precompiled header only when it was made with the same options
 # and macros, and otherwise reads the header as text: a target that cannot
-# share one (tiltcal_registration, compiled with -fopenmp) makes its own.
+# share one (tiltcal_registration, compiled with -fopenmp; the odometry,
+# with PCL's -fPIC) goes without (NO_PCH); for its one or two files, making
+# its own would cost more than it saves.
 # Clang (the sanitizer build) stops with an error on such a mismatch instead,
 # so a target whose options differ fails there loudly, never silently slower.
 function(tiltcal_pch_enabled out)
@@ -59,7 +61,7 @@ function(tiltcal_pch_enabled out)
   endif()
 endfunction()
 
-# tiltcal_use_pch(TARGET LIBRARY|TEST|OWN)
+# tiltcal_use_pch(TARGET LIBRARY|TEST)
 function(tiltcal_use_pch target kind)
   tiltcal_pch_enabled(enabled)
   if(NOT enabled)
@@ -68,10 +70,6 @@ function(tiltcal_use_pch target kind)
   # A precompiled header that GCC cannot use is a warning (not an error
   # under TILTCAL_WERROR): the build is right, only slower.
   target_compile_options(${target} PRIVATE -Winvalid-pch -Wno-error=invalid-pch)
-  if(kind STREQUAL "OWN")
-    target_precompile_headers(${target} PRIVATE ${PROJECT_SOURCE_DIR}/cmake/pch.h)
-    return()
-  endif()
   set(owner tiltcal_pch)
   set(header ${PROJECT_SOURCE_DIR}/cmake/pch.h)
   set(deps tiltcal_proto Eigen3::Eigen fmt::fmt)
@@ -90,36 +88,33 @@ function(tiltcal_use_pch target kind)
   target_precompile_headers(${target} REUSE_FROM ${owner})
 endfunction()
 
-# tiltcal_add_library(NAME SRCS ... DEPS ... [OWN_PCH])
+# tiltcal_add_library(NAME SRCS ... DEPS ... [NO_PCH])
 # A unity build with TILTCAL_UNITY_BUILD (default): the sources are compiled
 # in batches of 8 as one file each, so the headers and templates they share
 # are compiled once per batch. Names at file scope, anonymous namespaces
 # included, must then differ between the files of one library.
-# OWN_PCH: the target makes its own precompiled header (for options that
-# change what the headers define or how they compile, as -fopenmp does, or
-# PCL's -fPIC).
+# NO_PCH: no precompiled header (for options that change what the headers
+# define or how they compile, as -fopenmp does, or PCL's -fPIC).
 function(tiltcal_add_library)
-  cmake_parse_arguments(ARG "OWN_PCH" "NAME" "SRCS;DEPS" ${ARGN})
+  cmake_parse_arguments(ARG "NO_PCH" "NAME" "SRCS;DEPS" ${ARGN})
   add_library(${ARG_NAME} STATIC ${ARG_SRCS})
   set_target_properties(${ARG_NAME} PROPERTIES UNITY_BUILD ${TILTCAL_UNITY_BUILD})
   target_include_directories(${ARG_NAME} PUBLIC ${PROJECT_SOURCE_DIR} ${PROJECT_BINARY_DIR}/generated)
   target_link_libraries(${ARG_NAME} PUBLIC ${ARG_DEPS})
   tiltcal_set_target_options(${ARG_NAME})
-  if(ARG_OWN_PCH)
-    tiltcal_use_pch(${ARG_NAME} OWN)
-  else()
+  if(NOT ARG_NO_PCH)
     tiltcal_use_pch(${ARG_NAME} LIBRARY)
   endif()
 endfunction()
 
-# tiltcal_add_stage(NAME decode SRCS lib sources... DEPS ... [OWN_PCH])
+# tiltcal_add_stage(NAME decode SRCS lib sources... DEPS ...)
 # Builds tiltcal_<NAME>_lib from SRCS and the executable tiltcal_<NAME> from
 # main.cc of the current directory, landing in build/bin/. A stage with a
 # default_params.txtpb gets it compiled in as tiltcal::<NAME>::DefaultParamsText()
 # ("stages/<NAME>/default_params_text.h"), so that the file stays the one
 # place where the defaults are written.
 function(tiltcal_add_stage)
-  cmake_parse_arguments(ARG "OWN_PCH" "NAME" "SRCS;DEPS" ${ARGN})
+  cmake_parse_arguments(ARG "" "NAME" "SRCS;DEPS" ${ARGN})
   set(defaults_file ${CMAKE_CURRENT_SOURCE_DIR}/default_params.txtpb)
   if(EXISTS ${defaults_file})
     set_property(DIRECTORY APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS ${defaults_file})
@@ -132,11 +127,7 @@ function(tiltcal_add_stage)
                    ${generated}/default_params_text.cc @ONLY)
     list(APPEND ARG_SRCS ${generated}/default_params_text.cc)
   endif()
-  set(own_pch)
-  if(ARG_OWN_PCH)
-    set(own_pch OWN_PCH)
-  endif()
-  tiltcal_add_library(NAME tiltcal_${ARG_NAME}_lib SRCS ${ARG_SRCS} DEPS ${ARG_DEPS} ${own_pch})
+  tiltcal_add_library(NAME tiltcal_${ARG_NAME}_lib SRCS ${ARG_SRCS} DEPS ${ARG_DEPS})
   add_executable(tiltcal_${ARG_NAME} main.cc)
   target_link_libraries(tiltcal_${ARG_NAME} PRIVATE tiltcal_${ARG_NAME}_lib)
   tiltcal_set_target_options(tiltcal_${ARG_NAME})
