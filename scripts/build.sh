@@ -2,17 +2,15 @@
 # Configures and builds tiltcal into build/ (Release, Ninja), through ccache
 # when it is installed (compiler_cache.sh). Binaries land in build/bin/.
 # Extra arguments go to cmake, e.g. -DTILTCAL_SANITIZE=address.
-# SETUP_BUILD_ONLY=1 installs only the build dependencies (setup.sh
-# --build_only; scripts/test.sh installs the test ones beside the build).
+# SKIP_SETUP=1 leaves out scripts/setup.sh (scripts/test.sh installs the
+# packages itself, in parts, before and beside the build).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source scripts/phase_time.sh
-if [ "${SETUP_BUILD_ONLY:-0}" = 1 ]; then
-  scripts/setup.sh --build_only
-else
+if [ "${SKIP_SETUP:-0}" != 1 ]; then
   scripts/setup.sh
+  phase_done setup
 fi
-phase_done setup
 BUILD_DIR=${BUILD_DIR:-build}
 source scripts/compiler_cache.sh
 if [ ! -f "$BUILD_DIR/build.ninja" ] || [ $# -gt 0 ]; then

@@ -59,7 +59,7 @@ touch "$build_setup_done"
 phase_done "setup of the build dependencies"
 # Tests on, whatever an earlier configure of the build directory chose; the
 # benchmarks (bench/, run by hand, never by a test) left out.
-SETUP_BUILD_ONLY=1 scripts/build.sh -DTILTCAL_WERROR=ON -DTILTCAL_BUILD_TESTS=ON \
+SKIP_SETUP=1 scripts/build.sh -DTILTCAL_WERROR=ON -DTILTCAL_BUILD_TESTS=ON \
   -DTILTCAL_BUILD_BENCHMARKS=OFF
 source scripts/phase_time.sh  # the clock restarts after build.sh's own phases
 while [ ! -e "$test_setup_done" ]; do
