@@ -31,10 +31,24 @@ PARSER_PACKAGES=(
   liblz4-dev lz4 libbz2-dev libfmt-dev libsqlite3-dev libzstd-dev zlib1g-dev libpng-dev
   libgtest-dev libgmock-dev
 )
+# The PCL libraries the calibrator and its tests link, and what PCL's CMake
+# package looks for (FLANN, five Boost libraries). Not libpcl-dev: it
+# depends on all of PCL, VTK, Qt and Boost (about 330 packages more, 90 s
+# of install on 2 cores); scripts/unpack_pcl_dev.sh unpacks its headers
+# and CMake package into /opt/tiltcal/libpcl-dev instead, unless it is
+# installed. The headers must match these libraries' version, Debian
+# bookworm's PCL 1.13.
+PCL_PACKAGES=(
+  libpcl-common1.13 libpcl-kdtree1.13 libpcl-octree1.13 libpcl-search1.13
+  libpcl-sample-consensus1.13 libpcl-filters1.13 libpcl-features1.13 libpcl-registration1.13
+  libpcl-io1.13 libflann-dev
+  libboost-system-dev libboost-filesystem-dev libboost-date-time-dev libboost-iostreams-dev
+  libboost-serialization-dev
+)
 # The rest of what cmake and the Release build (tests and benchmarks
-# included) need: the calibrator's libraries. PCL brings most of the
-# packages (VTK, Qt, Boost).
-CALIBRATOR_PACKAGES=(libceres-dev libgoogle-glog-dev libpcl-dev libnanoflann-dev libbenchmark-dev)
+# included) need: the calibrator's libraries.
+CALIBRATOR_PACKAGES=(libceres-dev libgoogle-glog-dev "${PCL_PACKAGES[@]}" libnanoflann-dev
+                     libbenchmark-dev)
 # clang with its sanitizer runtimes (scripts/sanitize_and_fuzz.sh).
 CLANG_PACKAGES=(clang libclang-rt-14-dev)
 # What only the tests run: the ROS 1 oracles and the browser of the report
@@ -66,19 +80,24 @@ missing=()
 for package in "${PACKAGES[@]}"; do
   grep -qxF "$package" <<< "$installed" || missing+=("$package")
 done
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
 if [ ${#missing[@]} -ne 0 ]; then
-  SUDO=""
-  if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
   echo "setup: installing ${#missing[@]} Debian packages: ${missing[*]}" >&2
   export DEBIAN_FRONTEND=noninteractive
   $SUDO apt-get update -qq
   # dpkg without an fsync per unpacked file (its own database is still
   # synced), as in Debian's container images: a fresh machine unpacks about
-  # 560 packages. A crash in the middle can leave some files empty;
+  # 230 packages. A crash in the middle can leave some files empty;
   # apt-get install --reinstall mends them.
   $SUDO apt-get install -y -qq --no-install-recommends -o Dpkg::Options::=--force-unsafe-io \
     "${missing[@]}" >/dev/null
   echo "setup: Debian packages done" >&2
+fi
+# PCL's headers and CMake package, without libpcl-dev's dependencies.
+if [ "$ONLY" != --parsers_only ] && ! dpkg-query -W -f='${db:Status-Abbrev}' libpcl-dev 2>/dev/null |
+     grep -q '^ii'; then
+  $SUDO "$(dirname "${BASH_SOURCE[0]}")/unpack_pcl_dev.sh"
 fi
 
 # The npm packages of the ROS 2 test oracles (tests/oracle/write_ros2_bags.mjs),
