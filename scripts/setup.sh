@@ -53,9 +53,12 @@ CALIBRATOR_PACKAGES=(libceres-dev libgoogle-glog-dev "${PCL_PACKAGES[@]}" libnan
 CLANG_PACKAGES=(clang libclang-rt-14-dev)
 # What only the tests run: the ROS 1 oracles and the browser of the report
 # page's tests.
+# python3-munkres answers matplotlib's python3-fonttools, which depends on
+# "python3-scipy | python3-munkres": apt would otherwise take SciPy (and
+# Pythran, 9 packages, 67 MB, a long byte-compile) that nothing here uses.
 TEST_PACKAGES=(
   python3-rosbag python3-sensor-msgs python3-tf2 python3-numpy python3-matplotlib python3-yaml
-  chromium
+  python3-munkres chromium
 )
 case $ONLY in
   --parsers_only) PACKAGES=("${PARSER_PACKAGES[@]}" "${CLANG_PACKAGES[@]}") ;;
