@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Installs every build and test dependency of tiltcal from Debian packages,
+# Installs every build and test dependency of tiltcal from Debian packages
+# (PCL's headers from libpcl-dev unpacked, not installed: see PCL_PACKAGES),
 # then the test oracles of tests/package.json (npm ci into tests/node_modules).
 # Idempotent: does nothing when everything is present. Needs root (or sudo)
 # for the Debian packages.

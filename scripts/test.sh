@@ -11,7 +11,7 @@ source scripts/phase_time.sh
 # compression libraries: a few packages); that build starts at once in a
 # background job (scripts/sanitize_and_fuzz.sh, the parsers under ASan +
 # UBSan; SKIP_SANITIZERS=1 leaves it out). Then, in the foreground, the
-# rest of what the release build needs (Ceres, PCL: most of the packages),
+# rest of what the release build needs (Ceres, PCL: about 100 packages),
 # and the release build. Once the build's packages are in, the background
 # job installs what only the tests need (the oracles, the browser, and
 # Slurm and munge so that the one-node cluster test pipeline.slurm runs

@@ -3,13 +3,12 @@
 #include <fmt/format.h>
 
 #include <Eigen/Core>
-#include <Eigen/Eigenvalues>
-#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 
 #include "common/geometry/translation_prior.h"
 #include "common/io/eigen_proto.h"
+#include "common/linear_algebra/dense_decompositions.h"
 
 namespace tiltcal::calibration {
 namespace {
@@ -62,11 +61,11 @@ std::string CheckCovariance(const proto::CalibrationResult& r, int n,
         asymmetry, params.max_covariance_asymmetry());
   }
   // Scaled to a largest entry of 1 so that no eigenvalue under- or overflows.
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(0.5 * (p + p.transpose()) / largest,
-                                                           Eigen::EigenvaluesOnly);
-  if (eig.info() != Eigen::Success) return "covariance: eigenvalues not computed";
-  const double smallest_scaled = eig.eigenvalues().minCoeff();
-  const double largest_scaled = eig.eigenvalues().maxCoeff();
+  const linear_algebra::SymmetricEigen eig = linear_algebra::DecomposeSymmetric(
+      0.5 * (p + p.transpose()) / largest, linear_algebra::EigenvectorsToo::kNo);
+  if (!eig.converged) return "covariance: eigenvalues not computed";
+  const double smallest_scaled = eig.values.minCoeff();
+  const double largest_scaled = eig.values.maxCoeff();
   if (!(smallest_scaled > 0.0)) {
     return fmt::format(
         "covariance ({}x{} block) is not positive definite (eigenvalues {:.3g} to "
@@ -96,16 +95,15 @@ std::string CheckCovariance(const proto::CalibrationResult& r, int n,
 // information, is positive semidefinite up to rounding.
 std::string CheckPriorWithinCovariance(const proto::CalibrationResult& r, int n) {
   const Eigen::MatrixXd p = Eigen::Map<const RowMajor7d>(r.covariance().data()).topLeftCorner(n, n);
-  const Eigen::MatrixXd information = p.inverse();
+  const Eigen::MatrixXd information = linear_algebra::Inverse(p);
   Eigen::MatrixXd prior = Eigen::MatrixXd::Zero(n, n);
   prior.block<3, 3>(3, 3) = geometry::TranslationPriorInformation(
       r.translation_prior_sigma_m(), ToEigen(r.translation_prior_axis_b()));
   const Eigen::MatrixXd data = information - prior;
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(0.5 * (data + data.transpose()),
-                                                           Eigen::EigenvaluesOnly);
+  const linear_algebra::SymmetricEigen eig = linear_algebra::DecomposeSymmetric(
+      0.5 * (data + data.transpose()), linear_algebra::EigenvectorsToo::kNo);
   const double scale = information.cwiseAbs().maxCoeff();
-  if (eig.info() != Eigen::Success ||
-      !(eig.eigenvalues().minCoeff() >= -kInformationRounding * scale)) {
+  if (!eig.converged || !(eig.values.minCoeff() >= -kInformationRounding * scale)) {
     return fmt::format(
         "covariance holds less information than its own translation prior "
         "(translation_prior_sigma_m {} along ({}, {}, {}))",

@@ -3,10 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include <Eigen/Cholesky>
-#include <Eigen/Eigenvalues>
-
 #include "common/geometry/so3.h"
+#include "common/linear_algebra/dense_decompositions.h"
 
 namespace tiltcal::geometry {
 namespace {
@@ -46,7 +44,7 @@ FusedExtrinsic FuseExtrinsics(const std::vector<ExtrinsicEstimate>& estimates,
   Eigen::MatrixXd net_prior =
       prior.information.size() == n * n ? prior.information : Eigen::MatrixXd::Zero(n, n);
   for (const ExtrinsicEstimate& e : estimates) {
-    information.push_back(e.covariance.inverse());
+    information.push_back(linear_algebra::Inverse(e.covariance));
     if (e.prior_information.size() == n * n) net_prior -= e.prior_information;
   }
   const ExtrinsicEstimate prior_estimate = PriorAsEstimate(prior);
@@ -70,7 +68,7 @@ FusedExtrinsic FuseExtrinsics(const std::vector<ExtrinsicEstimate>& estimates,
       h += j.transpose() * net_prior * j;
       g += j.transpose() * net_prior * e;
     }
-    const Eigen::VectorXd step = -h.ldlt().solve(g);
+    const Eigen::VectorXd step = -linear_algebra::SolveByLdlt(h, g);
     out.rotation = BoxPlus(out.rotation, step.head<3>()).normalized();
     out.rest += step.tail(n - 3);
     if (step.norm() < 1e-12) {
@@ -79,7 +77,7 @@ FusedExtrinsic FuseExtrinsics(const std::vector<ExtrinsicEstimate>& estimates,
     }
   }
   out.iterations = std::min(out.iterations, max_iterations);
-  out.covariance = h.inverse();
+  out.covariance = linear_algebra::Inverse(h);
   return out;
 }
 
@@ -89,12 +87,13 @@ ExtrinsicConsistency TestConsistency(const ExtrinsicEstimate& estimate,
   c.difference = ExtrinsicError(estimate, fused.rotation, fused.rest);
   const Eigen::MatrixXd d = estimate_in_fused ? Eigen::MatrixXd(estimate.covariance - fused.covariance)
                                               : Eigen::MatrixXd(estimate.covariance + fused.covariance);
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(0.5 * (d + d.transpose()));
-  const double floor = 1e-9 * std::max(eig.eigenvalues().cwiseAbs().maxCoeff(), 1e-300);
-  for (int k = 0; k < eig.eigenvalues().size(); ++k) {
-    if (eig.eigenvalues()[k] <= floor) continue;
-    const double projection = eig.eigenvectors().col(k).dot(c.difference);
-    c.chi2 += projection * projection / eig.eigenvalues()[k];
+  const linear_algebra::SymmetricEigen eig =
+      linear_algebra::DecomposeSymmetric(0.5 * (d + d.transpose()));
+  const double floor = 1e-9 * std::max(eig.values.cwiseAbs().maxCoeff(), 1e-300);
+  for (int k = 0; k < eig.values.size(); ++k) {
+    if (eig.values[k] <= floor) continue;
+    const double projection = eig.vectors.col(k).dot(c.difference);
+    c.chi2 += projection * projection / eig.values[k];
     ++c.dof;
   }
   for (int j = 0; j < c.difference.size(); ++j) {

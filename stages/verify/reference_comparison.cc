@@ -10,8 +10,6 @@
 #include <fmt/format.h>
 
 #include <Eigen/Core>
-#include <Eigen/Eigenvalues>
-#include <Eigen/LU>
 
 #include "common/calibration/calibration_checks.h"
 #include "common/calibration/extrinsic_estimate.h"
@@ -19,6 +17,7 @@
 #include "common/geometry/extrinsic_fusion.h"
 #include "common/geometry/so3.h"
 #include "common/io/eigen_proto.h"
+#include "common/linear_algebra/dense_decompositions.h"
 
 namespace tiltcal::verify {
 namespace {
@@ -53,10 +52,10 @@ Eigen::MatrixXd Symmetric(const Eigen::MatrixXd& m) { return 0.5 * (m + m.transp
 
 // Eigen-decomposition with the eigenvalues below the floor (relative to the
 // largest) set to zero; the count of the rest in *rank.
-Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> Decompose(const Eigen::MatrixXd& m,
-                                                         Eigen::VectorXd* values, int* rank) {
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(Symmetric(m));
-  *values = eig.eigenvalues();
+linear_algebra::SymmetricEigen Decompose(const Eigen::MatrixXd& m, Eigen::VectorXd* values,
+                                         int* rank) {
+  linear_algebra::SymmetricEigen eig = linear_algebra::DecomposeSymmetric(Symmetric(m));
+  *values = eig.values;
   const double largest = std::max(values->maxCoeff(), 0.0);
   *rank = 0;
   for (int i = 0; i < values->size(); ++i) {
@@ -77,7 +76,7 @@ Eigen::MatrixXd PseudoInverse(const Eigen::MatrixXd& m) {
   for (int i = 0; i < values.size(); ++i) {
     if (values[i] > 0.0) inverse[i] = 1.0 / values[i];
   }
-  return eig.eigenvectors() * inverse.asDiagonal() * eig.eigenvectors().transpose();
+  return eig.vectors * inverse.asDiagonal() * eig.vectors.transpose();
 }
 
 // " b (x, y, z)" of a unit vector; an axis (signed_direction false: an
@@ -147,14 +146,13 @@ bool Compare(const geometry::ExtrinsicEstimate& est, const geometry::ExtrinsicEs
   d.tail(n - 3) = est.rest - ref.rest;
   c->d = to_b * d;
   // The data's information: the solve's prior removed, rounding below zero clipped.
-  const auto data = Decompose(est.covariance.inverse() - est.prior_information, &c->values,
-                              &c->rank);
-  const Eigen::MatrixXd lambda_l =
-      data.eigenvectors() * c->values.asDiagonal() * data.eigenvectors().transpose();
+  const auto data = Decompose(linear_algebra::Inverse(est.covariance) - est.prior_information,
+                              &c->values, &c->rank);
+  const Eigen::MatrixXd lambda_l = data.vectors * c->values.asDiagonal() * data.vectors.transpose();
   const Eigen::MatrixXd lambda = to_b * lambda_l * to_b.transpose();
   const Eigen::MatrixXd p_ref = to_b * ref.covariance * to_b.transpose();
   c->w = Symmetric(
-      (Eigen::MatrixXd::Identity(n, n) + lambda * p_ref).partialPivLu().solve(lambda));
+      linear_algebra::SolveByLu(Eigen::MatrixXd::Identity(n, n) + lambda * p_ref, lambda));
   Decompose(c->w, &c->values, &c->rank);
   if (c->rank == 0) return false;
   c->chi2 = c->d.dot(c->w * c->d);
@@ -191,14 +189,14 @@ void CompareGroup(const Group& g, const Comparison& c, double p_value,
 
   // Detectability: along each axis of b and along the weakest direction.
   const Eigen::MatrixXd w_gg = c.w.block(g.start, g.start, g.size, g.size);
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(w_gg);
+  const linear_algebra::SymmetricEigen eig = linear_algebra::DecomposeSymmetric(w_gg);
   const double top = std::max(c.values.maxCoeff(), 0.0);
   Eigen::Vector3d axes = Eigen::Vector3d::Zero();
   for (int k = 0; k < g.size; ++k) {
     const double m = SmallestDetected(w_gg, Eigen::VectorXd::Unit(g.size, k), c.limit, top);
     axes[k] = std::isfinite(m) ? m : 0.0;
   }
-  const Eigen::VectorXd weakest = eig.eigenvectors().col(0);
+  const Eigen::VectorXd weakest = eig.vectors.col(0);
   const double weakest_m = SmallestDetected(w_gg, weakest, c.limit, top);
   if (g.start == 0) {
     *out->mutable_rotation_difference_deg() = ToProto(Eigen::Vector3d(d_g * kDegPerRad));

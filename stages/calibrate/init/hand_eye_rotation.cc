@@ -4,7 +4,8 @@
 #include <cmath>
 
 #include <Eigen/Eigenvalues>
-#include <Eigen/SVD>
+
+#include "common/linear_algebra/dense_decompositions.h"
 
 namespace tiltcal::calibrate {
 namespace {
@@ -81,9 +82,9 @@ HandEyeResult EstimateHandEyeRotation(const std::vector<RotationPair>& pairs,
   const Eigen::Vector3d ev = spread_solver.eigenvalues().cwiseMax(0.0);
   result.rotation_spread_rad = Eigen::Vector3d(ev(2), ev(1), ev(0)).cwiseSqrt();
 
-  Eigen::JacobiSVD<Eigen::MatrixXd> svd(a, Eigen::ComputeFullV);
-  result.singular_values = svd.singularValues();
-  const Eigen::Vector4d x = svd.matrixV().col(3);  // (w, x, y, z)
+  const linear_algebra::RightSingularVectors svd = linear_algebra::DecomposeSingular(a);
+  result.singular_values = svd.values;
+  const Eigen::Vector4d x = svd.v.col(3);  // (w, x, y, z)
   Eigen::Quaterniond q_bl(x(0), x(1), x(2), x(3));
   q_bl.normalize();
   if (q_bl.w() < 0.0) q_bl.coeffs() = -q_bl.coeffs();

@@ -11,6 +11,7 @@
 #include <Eigen/SparseCore>
 
 #include "common/geometry/angles.h"
+#include "common/linear_algebra/dense_decompositions.h"
 #include "stages/calibrate/report/error_correlation.h"
 #include "stages/calibrate/report/marginal_covariance.h"
 #include "stages/calibrate/report/typed_jacobian.h"
@@ -279,9 +280,9 @@ Eigen::MatrixXd ScaleDataInformation(const Eigen::MatrixXd& covariance,
       sub_prior(r, c) = prior_information(free[r], free[c]);
     }
   }
-  const Eigen::MatrixXd information = sub_covariance.inverse();
+  const Eigen::MatrixXd information = linear_algebra::Inverse(sub_covariance);
   const Eigen::MatrixXd scaled = (information - sub_prior) / sigma0_squared + sub_prior;
-  const Eigen::MatrixXd sub_out = scaled.inverse();
+  const Eigen::MatrixXd sub_out = linear_algebra::Inverse(scaled);
   Eigen::MatrixXd out = Eigen::MatrixXd::Zero(size, size);
   for (int r = 0; r < n; ++r) {
     for (int c = 0; c < n; ++c) out(free[r], free[c]) = 0.5 * (sub_out(r, c) + sub_out(c, r));

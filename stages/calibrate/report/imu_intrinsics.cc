@@ -4,11 +4,10 @@
 
 #include <ceres/crs_matrix.h>
 
-#include <Eigen/Cholesky>
-
 #include "common/geometry/angles.h"
 #include "common/imu/triad_errors.h"
 #include "common/io/eigen_proto.h"
+#include "common/linear_algebra/dense_decompositions.h"
 #include "stages/calibrate/report/covariance_report.h"
 
 namespace tiltcal::calibrate {
@@ -92,11 +91,11 @@ Status ScoreTestImuIntrinsics(ceres::Problem* problem, CalibrationState* state,
     }
   }
   const Eigen::Map<const Eigen::VectorXd> g(gradient.data(), n);
-  const Eigen::LDLT<Eigen::MatrixXd> ldlt(h);
-  if (ldlt.info() != Eigen::Success) {
+  bool factorised = false;
+  const Eigen::VectorXd step = -linear_algebra::SolveByLdlt(h, g, &factorised);
+  if (!factorised) {
     return Status::Error("IMU intrinsics score test: the information is not positive");
   }
-  const Eigen::VectorXd step = -ldlt.solve(g);
   score->chi2 = -g.dot(step) / score->sigma0_squared;
   score->dof = n;
   column = 0;

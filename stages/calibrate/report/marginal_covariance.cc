@@ -2,10 +2,10 @@
 
 #include <string>
 
-#include <Eigen/Eigenvalues>
 #include <Eigen/OrderingMethods>
 #include <Eigen/SparseCholesky>
 
+#include "common/linear_algebra/dense_decompositions.h"
 #include "stages/calibrate/report/unit_diagonal.h"
 
 namespace tiltcal::calibrate {
@@ -54,15 +54,15 @@ Status MarginalCovarianceOfLastColumns(
     schur -= b.transpose() * a_inv_b;
   }
   schur = 0.5 * (schur + schur.transpose());
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(schur);
-  if (eig.info() != Eigen::Success || !(eig.eigenvalues()[0] > min_relative_pivot)) {
+  const linear_algebra::SymmetricEigen eig = linear_algebra::DecomposeSymmetric(schur);
+  if (!eig.converged || !(eig.values[0] > min_relative_pivot)) {
     return Status::Error("covariance: the Jacobian is rank deficient (the extrinsic and time offset: "
                          "smallest eigenvalue " +
-                         std::to_string(eig.eigenvalues()[0]) +
+                         std::to_string(eig.values[0]) +
                          " of the unit-diagonal marginal information)");
   }
-  const Eigen::MatrixXd inverse = eig.eigenvectors() * eig.eigenvalues().cwiseInverse().asDiagonal() *
-                                  eig.eigenvectors().transpose();
+  const Eigen::MatrixXd inverse =
+      eig.vectors * eig.values.cwiseInverse().asDiagonal() * eig.vectors.transpose();
   const Eigen::VectorXd last_scale = scale.tail(k);
   *covariance = last_scale.asDiagonal() * inverse * last_scale.asDiagonal();
   return Status::Ok();
