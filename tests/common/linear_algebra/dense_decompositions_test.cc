@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdlib>
+
 #include <Eigen/Core>
 
 namespace tiltcal::linear_algebra {
@@ -64,7 +66,9 @@ TEST(DenseDecompositions, SingularValuesAreTheLengthsOfAV) {
   EXPECT_LT((svd.v.transpose() * svd.v - Eigen::MatrixXd::Identity(4, 4)).norm(), 1e-12);
   for (int k = 0; k < 4; ++k) {
     EXPECT_NEAR((a * svd.v.col(k)).norm(), svd.values[k], 1e-12);
-    if (k > 0) EXPECT_LE(svd.values[k], svd.values[k - 1]);
+    if (k > 0) {
+      EXPECT_LE(svd.values[k], svd.values[k - 1]);
+    }
   }
   // A V = U S with orthogonal U: the columns of A V are orthogonal.
   const Eigen::MatrixXd av = a * svd.v;
