@@ -2,7 +2,7 @@
 # Unpacks Debian's libpcl-dev (PCL's headers, its CMake package and the .so
 # links) into a prefix, without installing the package's dependencies.
 # libpcl-dev depends on every PCL library, VTK, Qt, OpenNI and the whole of
-# Boost, for PCL's viewers and grabbers: about 330 packages (1 GB), which
+# Boost, for PCL's viewers and grabbers: about 330 packages (0.8 GB), which
 # tiltcal does not use. The PCL libraries tiltcal links come from their own
 # packages (PCL_PACKAGES in scripts/setup.sh, which calls this). In the
 # prefix, each .so link points at the installed library of the same
