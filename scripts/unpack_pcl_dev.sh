@@ -31,9 +31,10 @@ trap 'rm -rf "$work"' EXIT
 download() {
   (cd "$work" && apt-get download -qq -o APT::Sandbox::User=root "libpcl-dev=$version")
 }
-if ! download 2>/dev/null; then
-  apt-get update -qq
-  download || { echo "unpack_pcl_dev.sh: apt-get download libpcl-dev=$version failed" >&2; exit 1; }
+# Stale or absent package lists: update them once and retry.
+if ! download 2>/dev/null && ! { apt-get update -qq && download; }; then
+  echo "unpack_pcl_dev.sh: apt-get download libpcl-dev=$version failed" >&2
+  exit 1
 fi
 dpkg-deb -x "$work"/libpcl-dev_*.deb "$work/root"
 
