@@ -98,10 +98,12 @@ if [ ${#missing[@]} -ne 0 ]; then
     "${missing[@]}" >/dev/null
   echo "setup: Debian packages done" >&2
 fi
-# PCL's headers and CMake package, without libpcl-dev's dependencies.
+# PCL's headers and CMake package, without libpcl-dev's dependencies
+# (sudo only when they are missing or of another version).
+unpack_pcl_dev=$(dirname "${BASH_SOURCE[0]}")/unpack_pcl_dev.sh
 if [ "$ONLY" != --parsers_only ] && ! dpkg-query -W -f='${db:Status-Abbrev}' libpcl-dev 2>/dev/null |
-     grep -q '^ii'; then
-  $SUDO "$(dirname "${BASH_SOURCE[0]}")/unpack_pcl_dev.sh"
+     grep -q '^ii' && ! "$unpack_pcl_dev" --check; then
+  $SUDO "$unpack_pcl_dev"
 fi
 
 # The npm packages of the ROS 2 test oracles (tests/oracle/write_ros2_bags.mjs),

@@ -10,11 +10,15 @@
 # so that CMake finds only those. The top CMakeLists.txt searches the
 # prefix after the system's paths: where libpcl-dev is installed, it is
 # found first, and setup.sh does not call this.
-#   unpack_pcl_dev.sh [PREFIX]   default /opt/tiltcal/libpcl-dev
+#   unpack_pcl_dev.sh [--check] [PREFIX]   default /opt/tiltcal/libpcl-dev
 # Idempotent: does nothing when PREFIX holds the version of the installed
-# libpcl-common. Writes PREFIX atomically (unpacked beside it, then
-# renamed). Needs write access to PREFIX's parent and apt's package lists.
+# libpcl-common; --check only tells whether it does (exit 0) or not (1),
+# and needs no write access. Writes PREFIX atomically (unpacked beside it,
+# then renamed). Needs write access to PREFIX's parent and apt's package
+# lists.
 set -euo pipefail
+CHECK=0
+if [ "${1:-}" = --check ]; then CHECK=1; shift; fi
 PREFIX=${1:-/opt/tiltcal/libpcl-dev}
 
 version=$(dpkg-query -W -f='${db:Status-Abbrev} ${Version}\n' 'libpcl-common*' 2>/dev/null |
@@ -24,6 +28,7 @@ if [ -z "$version" ]; then
   exit 1
 fi
 [ "$(cat "$PREFIX/tiltcal-version" 2>/dev/null)" != "$version" ] || exit 0
+[ "$CHECK" = 0 ] || exit 1
 
 mkdir -p "$(dirname "$PREFIX")"
 work=$(mktemp -d "$(dirname "$PREFIX")/.libpcl-dev.XXXXXX")
