@@ -101,8 +101,7 @@ fi
 # PCL's headers and CMake package, without libpcl-dev's dependencies
 # (sudo only when they are missing or of another version).
 unpack_pcl_dev=$(dirname "${BASH_SOURCE[0]}")/unpack_pcl_dev.sh
-if [ "$ONLY" != --parsers_only ] && ! dpkg-query -W -f='${db:Status-Abbrev}' libpcl-dev 2>/dev/null |
-     grep -q '^ii' && ! "$unpack_pcl_dev" --check; then
+if [ "$ONLY" != --parsers_only ] && ! "$unpack_pcl_dev" --check; then
   $SUDO "$unpack_pcl_dev"
 fi
 

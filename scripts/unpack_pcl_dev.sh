@@ -9,11 +9,11 @@
 # version, and the links to libraries that are not installed are removed,
 # so that CMake finds only those. The top CMakeLists.txt searches the
 # prefix after the system's paths: where libpcl-dev is installed, it is
-# found first, and setup.sh does not call this.
+# found first, and this does nothing.
 #   unpack_pcl_dev.sh [--check] [PREFIX]   default /opt/tiltcal/libpcl-dev
-# Idempotent: does nothing when PREFIX holds the version of the installed
-# libpcl-common; --check only tells whether it does (exit 0) or not (1),
-# and needs no write access. Writes PREFIX atomically (unpacked beside it,
+# Idempotent: does nothing when libpcl-dev is installed or PREFIX holds the
+# version of the installed libpcl-common; --check only tells whether there
+# is nothing to do (exit 0) or not (1), and needs no write access. Writes PREFIX atomically (unpacked beside it,
 # then renamed). Needs write access to PREFIX's parent and apt's package
 # lists.
 set -euo pipefail
@@ -21,8 +21,13 @@ CHECK=0
 if [ "${1:-}" = --check ]; then CHECK=1; shift; fi
 PREFIX=${1:-/opt/tiltcal/libpcl-dev}
 
-version=$(dpkg-query -W -f='${db:Status-Abbrev} ${Version}\n' 'libpcl-common*' 2>/dev/null |
-  awk '$1 == "ii" { print $2; exit }' || true)
+# The version of the first installed package matching $1; empty if none.
+installed_version() {
+  dpkg-query -W -f='${db:Status-Abbrev} ${Version}\n' "$1" 2>/dev/null |
+    awk '$1 == "ii" { print $2; exit }' || true
+}
+[ -z "$(installed_version libpcl-dev)" ] || exit 0
+version=$(installed_version 'libpcl-common*')
 if [ -z "$version" ]; then
   echo "unpack_pcl_dev.sh: libpcl-common is not installed (scripts/setup.sh installs it)" >&2
   exit 1
