@@ -86,6 +86,9 @@ function(tiltcal_use_pch target kind)
     target_precompile_headers(${owner} PRIVATE ${header})
   endif()
   target_precompile_headers(${target} REUSE_FROM ${owner})
+  # The owner's dependencies bring their definitions (fmt's FMT_SHARED, say):
+  # without them a target that needs no fmt would not match the header.
+  target_link_libraries(${target} PRIVATE ${deps})
 endfunction()
 
 # tiltcal_add_library(NAME SRCS ... DEPS ... [NO_PCH])
