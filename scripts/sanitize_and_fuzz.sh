@@ -39,9 +39,9 @@ TESTS=(decode_bags_test io_test checked_conversion_test imu_test ros1_unit_test
 if [ ! -f "$BUILD_DIR/build.ninja" ]; then
   # -O1 and line tables only: half the compile time of -O2 -g, still
   # symbolised reports (the tests' own files at -O0: tests/CMakeLists.txt).
-  # The precompiled headers of the release build
-  # (cmake/tiltcal_helpers.cmake) and a unity build (each target's sources
-  # compiled as one file) parse the headers once per build and per target.
+  # The precompiled headers of the release build (cmake/tiltcal_helpers.cmake)
+  # and a unity build (each target's sources compiled as one file) parse the
+  # headers once per build and per target.
   cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_UNITY_BUILD=ON \
     -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only -DNDEBUG" \
     -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only -DNDEBUG" \
