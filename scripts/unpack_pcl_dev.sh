@@ -13,9 +13,10 @@
 #   unpack_pcl_dev.sh [--check] [PREFIX]   default /opt/tiltcal/libpcl-dev
 # Idempotent: does nothing when libpcl-dev is installed or PREFIX holds the
 # version of the installed libpcl-common; --check only tells whether there
-# is nothing to do (exit 0) or not (1), and needs no write access. Writes PREFIX atomically (unpacked beside it,
-# then renamed). Needs write access to PREFIX's parent and apt's package
-# lists.
+# is nothing to do (exit 0) or not (1), and needs no write access. PREFIX
+# is unpacked beside itself and then renamed into place, so a failure
+# leaves the old one whole. Needs write access to PREFIX's parent and apt's
+# package lists.
 set -euo pipefail
 CHECK=0
 if [ "${1:-}" = --check ]; then CHECK=1; shift; fi
